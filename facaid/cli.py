@@ -1,0 +1,191 @@
+"""The ``facaid`` command line: ``facaid <command> --help`` describes each command."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+from facaid.generator import STYLE_NAMES
+
+DEFAULT_CMP = Path(__file__).resolve().parents[2] / "shared" / "data" / "cmp" / "annotations.jsonl"
+
+
+class CliError(Exception):
+    pass
+
+
+def _read_json(path: str) -> Any:
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise CliError(f"cannot read {path}: {exc.strerror}") from None
+    except UnicodeDecodeError:
+        raise CliError(f"{path} is not a UTF-8 text file") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise CliError(f"{path}: malformed JSON: {exc}") from None
+
+
+def load_segmentation_or_procedure(obj: Any):
+    """A segmentation from a segmentation, a procedure, or a dataset sample record."""
+    from facaid.grammar.execute import to_segmentation
+    from facaid.grammar.procedure import Procedure
+    from facaid.segmentation import Segmentation
+
+    if isinstance(obj, dict) and "procedure" in obj and "format" not in obj:
+        obj = obj["procedure"]
+    if isinstance(obj, dict) and obj.get("format") is not None:
+        return to_segmentation(Procedure.from_dict(obj))
+    return Segmentation.from_dict(obj)
+
+
+def _write_json(path: str | None, payload: dict) -> None:
+    if path:
+        Path(path).write_text(json.dumps(payload, indent=2) + "\n")
+        print(f"wrote {path}")
+
+
+# --- commands -----------------------------------------------------------------------------------------------
+
+def cmd_generate(args: argparse.Namespace) -> None:
+    if args.stats:
+        return _generate_stats(args)
+    if not args.out:
+        raise CliError("--out DIR is required (or use --stats)")
+    from facaid.generator.dataset import write_dataset
+
+    t0 = time.perf_counter()
+    paths = write_dataset(args.out, args.count, args.seed, style=args.style, shard_size=args.shard_size,
+                          workers=args.workers, progress=not args.quiet)
+    dt = time.perf_counter() - t0
+    print(f"wrote {args.count} facades in {len(paths)} shard(s) to {args.out} "
+          f"in {dt:.1f} s ({args.count / dt:.0f} facades/s)")
+
+
+def _generate_stats(args: argparse.Namespace) -> None:
+    from tqdm import tqdm
+
+    from facaid.generator import generate
+    from facaid.generator.dataset import sample_seed
+    from facaid.generator.stats import class_stats, distance, format_table, load_cmp
+
+    cmp_path = Path(args.cmp)
+    if not cmp_path.is_file():
+        raise CliError(f"CMP annotations not found at {cmp_path} (pass --cmp PATH)")
+    segs = [generate(sample_seed(args.seed, i), args.style).segmentation
+            for i in tqdm(range(args.count), desc="generate", disable=args.quiet)]
+    generated = class_stats(segs)
+    real = class_stats(load_cmp(cmp_path))
+    print(f"{args.count} generated facades (seed {args.seed}) vs {real.facades} CMP facades")
+    print(format_table(generated, real))
+    _write_json(args.json, {"generated": generated.to_dict(), "cmp": real.to_dict(),
+                            "area_distance": distance(generated, real)})
+
+
+def cmd_render(args: argparse.Namespace) -> None:
+    from PIL import Image
+
+    from facaid.render import legend, overlay, render_segmentation
+    from facaid.segmentation import rasterize
+
+    seg = load_segmentation_or_procedure(_read_json(args.input))
+    if args.photo:
+        try:
+            photo = Image.open(args.photo)
+            photo.load()
+        except (OSError, Image.DecompressionBombError) as exc:
+            raise CliError(f"cannot read photo {args.photo}: {exc}") from None
+        image = overlay(photo, rasterize(seg), args.alpha)
+    else:
+        image = render_segmentation(seg, outline=args.outline)
+    if args.legend:
+        strip = legend()
+        canvas = Image.new("RGB", (max(image.width, strip.width), image.height + strip.height), (255, 255, 255))
+        canvas.paste(image, (0, 0))
+        canvas.paste(strip, (0, image.height))
+        image = canvas
+    image.save(args.out)
+    print(f"wrote {args.out} ({image.width}x{image.height})")
+
+
+def cmd_demo(args: argparse.Namespace) -> None:
+    from facaid.generator import generate
+    from facaid.render import render_segmentation, side_by_side
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    images = []
+    for k, style in enumerate(STYLE_NAMES):
+        sample = generate(args.seed + k, style)
+        (out / f"{style}.procedure.json").write_text(sample.procedure.to_json(indent=1) + "\n")
+        (out / f"{style}.segmentation.json").write_text(json.dumps(sample.segmentation.to_dict()) + "\n")
+        image = render_segmentation(sample.segmentation, outline=True)
+        image.save(out / f"{style}.png")
+        images.append(image)
+        print(f"{style:<11} {sample.procedure.width}x{sample.procedure.height} px, "
+              f"{sum(1 for _ in sample.procedure.nodes())} nodes, {len(sample.segmentation.rects)} rectangles")
+    side_by_side(images, height=320).save(out / "gallery.png")
+    print(f"wrote procedures, segmentations and pictures to {out}/ (gallery.png shows them all)")
+
+
+# --- parser ---------------------------------------------------------------------------------------------------
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="facaid", description="FaçAID: facade segmentations to procedures.")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    g = sub.add_parser("generate", help="generate facades with their procedures (sharded dataset)",
+                       description="Generate facades with their derivation trees into sharded .jsonl.gz files, "
+                                   "or with --stats compare generated statistics with the CMP annotations.")
+    g.add_argument("--count", type=int, default=1000, help="number of facades (default 1000)")
+    g.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
+    g.add_argument("--out", help="output directory")
+    g.add_argument("--style", choices=STYLE_NAMES, help="one style preset (default: all, picked per facade)")
+    g.add_argument("--shard-size", type=int, default=1000, help="facades per shard file (default 1000)")
+    g.add_argument("--workers", type=int, default=None, help="processes (default: all cores)")
+    g.add_argument("--stats", action="store_true", help="report per-class statistics against CMP instead")
+    g.add_argument("--cmp", default=str(DEFAULT_CMP), help="CMP annotations.jsonl for --stats")
+    g.add_argument("--json", help="write the --stats figures to this JSON file")
+    g.add_argument("--quiet", action="store_true", help="no progress bar")
+    g.set_defaults(func=cmd_generate)
+
+    r = sub.add_parser("render", help="render a segmentation or procedure JSON to PNG",
+                       description="Render a segmentation, a procedure or a dataset sample to a PNG in the "
+                                   "documented palette, or as an overlay on a photo.")
+    r.add_argument("input", help="segmentation or procedure JSON file")
+    r.add_argument("--out", required=True, help="output PNG")
+    r.add_argument("--photo", help="draw the labels over this photo")
+    r.add_argument("--alpha", type=float, default=0.5, help="overlay opacity (default 0.5)")
+    r.add_argument("--outline", action="store_true", help="outline element rectangles")
+    r.add_argument("--legend", action="store_true", help="add a legend strip")
+    r.set_defaults(func=cmd_render)
+
+    d = sub.add_parser("demo", help="generate one facade per style with pictures",
+                       description="Generate one facade per style preset and write procedures, "
+                                   "segmentations and PNGs.")
+    d.add_argument("--out", default="out/demo", help="output directory (default out/demo)")
+    d.add_argument("--seed", type=int, default=1)
+    d.set_defaults(func=cmd_demo)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    from facaid.grammar.procedure import ProcedureError
+    from facaid.segmentation import SegmentationError
+
+    args = build_parser().parse_args(argv)
+    try:
+        args.func(args)
+    except (CliError, ProcedureError, SegmentationError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,407 @@
+"""The heuristics that grow a facade's derivation tree from its style S.
+
+H_p (which production) is every ``choose_*`` method: it picks the rule for a role (repeat or mirror a row,
+group identical floors, where the entrance goes, ...). H_a (which arguments) is every ``sample_*`` method and
+the size arithmetic around it. Both read S and the context so that facades stay coherent: every floor shares
+one column layout (windows line up), floors of one type are identical, sizes follow architectural ranges.
+All lengths are sampled in metres and emitted in pixels through `Builder.abs` and `Builder.flt`.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass, replace
+
+from facaid.generator.styles import Style
+from facaid.grammar.procedure import Node, Procedure, Size
+
+WALL = "facade"
+
+
+@dataclass(frozen=True)
+class FloorType:
+    """What the tiles of one upper floor look like (H_a, shared by every floor of this type)."""
+
+    window_w: float  # metres
+    window_h: float
+    top_gap: float  # wall above the window unit
+    hood: bool
+    sill: bool
+    deco: bool  # ornament above the hood
+    balcony: str  # "none", "band" (across the floor) or "tile" (one per window)
+    railing: bool  # balconette in front of the lower window
+    roller: bool  # roller blind in the top of the window
+    shutters: bool
+    band_below: bool  # a molding band under the floor
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The column layout every floor of a facade shares."""
+
+    bays: int
+    bay_w: float
+    pillar_w: float
+    margin_w: float
+    symmetric: bool
+
+    @property
+    def width(self) -> float:
+        pillars = (self.bays + 1) * self.pillar_w if self.pillar_w > 0 else 0.0
+        return 2 * self.margin_w + self.bays * self.bay_w + pillars
+
+
+class Builder:
+    """Grows one derivation tree in metres; `build_procedure` scales it to pixels."""
+
+    def __init__(self, rng: random.Random):
+        self.rng = rng
+        self.balcony_h = 1.0
+
+    # --- sizes and small helpers ---------------------------------------------------------------------
+    @staticmethod
+    def abs(metres: float) -> Size:
+        return Size("abs", max(metres, 0.0))
+
+    @staticmethod
+    def flt(metres: float) -> Size:
+        return Size("flt", max(metres, 0.01))
+
+    def chance(self, p: float) -> bool:
+        return self.rng.random() < p
+
+    def centered(self, width: float, child: Node, role: str | None = None) -> Node:
+        """``child`` of the given width centred in wall."""
+        return Node.split("x", [(self.flt(1), Node.leaf(WALL)), (self.abs(width), child),
+                                (self.flt(1), Node.leaf(WALL))], role=role)
+
+    # --- H_a: the column layout and the floor types --------------------------------------------------
+    def sample_layout(self, s: Style) -> Layout:
+        bays = s.bays
+        symmetric = s.symmetric and bays >= 3
+        return Layout(bays, s.bay_w, s.pillar_w, s.margin_w, symmetric)
+
+    def sample_floor_types(self, s: Style, layout: Layout) -> list[FloorType]:
+        """One floor type per upper floor, top to bottom."""
+        rng = self.rng
+        base_w = min(layout.bay_w * s.window_w, layout.bay_w - 0.3)
+        roller = self.chance(s.roller)
+        railing = self.chance(s.railing)
+
+        def make(height_factor: float, **kw) -> FloorType:
+            window_h = s.floor_h * s.window_h * height_factor
+            top_gap = max(0.15, (s.floor_h - window_h) * rng.uniform(0.25, 0.45))
+            ft = FloorType(window_w=base_w, window_h=window_h, top_gap=top_gap, hood=s.hood, sill=s.sill,
+                           deco=False, balcony="none", railing=railing, roller=roller, shutters=s.shutters,
+                           band_below=s.bands)
+            return replace(ft, **kw)
+
+        n = s.floors
+        plain = make(1.0)
+        types = [plain] * n  # bottom upper floor is index n - 1
+        if s.balcony_floors == "haussmann":
+            noble = make(1.12, hood=s.hood_noble, deco=s.deco, balcony="band", railing=False)
+            top = make(0.92, balcony="band", railing=False, band_below=False)
+            types[n - 1] = noble
+            if n >= 4:
+                types[0] = top
+            if n >= 5 and self.chance(0.5):
+                types[1] = make(0.96)
+        elif s.balcony_floors == "modern" and self.chance(0.35):
+            types = [make(1.0, balcony=self.rng.choice(["band", "tile"]), sill=False)] * n
+        elif s.balcony_floors == "per_tile":
+            with_balcony = make(1.0, balcony="tile", railing=False)
+            types = [with_balcony if self.chance(0.5) else plain for _ in range(n)]
+        elif s.balcony_floors == "rare" and n >= 2 and self.chance(0.3):
+            types[n - 1] = make(1.05, hood=s.hood_noble, deco=s.deco, balcony=self.rng.choice(["band", "tile"]))
+        elif s.hood_noble and not s.hood:
+            types[n - 1] = make(1.05, hood=True, deco=s.deco)
+        return types
+
+    # --- tiles ---------------------------------------------------------------------------------------------
+    def window_unit(self, ft: FloorType, height: float) -> tuple[Node, float]:
+        """The window with its blinds or balconette (role window); returns (node, width)."""
+        rng = self.rng
+        node = Node.leaf("window")
+        if ft.roller:
+            blind = height * rng.uniform(0.15, 0.45)
+            node = Node.split("y", [(self.abs(blind), Node.leaf("blind")), (self.flt(height - blind), node)])
+        if ft.railing:
+            rail = min(0.9, height * 0.35)
+            node = Node.split("y", [(self.flt(height - rail), node), (self.abs(rail), Node.leaf("balcony"))])
+        width = ft.window_w
+        if ft.shutters:
+            shutter = ft.window_w * rng.uniform(0.4, 0.5)
+            node = Node.split("x", [(self.abs(shutter), Node.leaf("blind")), (self.flt(ft.window_w), node),
+                                    (self.abs(shutter), Node.leaf("blind"))])
+            width += 2 * shutter
+        node.role = "window"
+        return node, width
+
+    def tile(self, ft: FloorType, bay_w: float, floor_h: float) -> Node:
+        """One window unit in its bay (role tile): hood, ornament, sill and balcony around the window."""
+        rng = self.rng
+        unit, unit_w = self.window_unit(ft, ft.window_h)
+        unit_w = min(unit_w, bay_w * 0.96)
+        overhang = min(rng.uniform(0.08, 0.2), (bay_w * 0.98 - unit_w) / 2) if (ft.hood or ft.sill) else 0.0
+        col_w = unit_w + 2 * max(overhang, 0.0)
+        window_h = ft.window_h
+        items: list[tuple[Size, Node]] = []
+        used = 0.0
+        if ft.deco:
+            h = rng.uniform(0.25, 0.5)
+            items.append((self.abs(h), self.centered_in(col_w, unit_w * rng.uniform(0.5, 1.0), "deco")))
+            used += h
+        if ft.hood:
+            h = rng.uniform(0.15, 0.35)
+            items.append((self.abs(h), Node.leaf("cornice")))
+            used += h
+        if ft.balcony == "tile":
+            bal = min(1.0, window_h * 0.4)
+            items.append((self.abs(window_h - bal), self.pad(unit, unit_w, col_w)))
+            items.append((self.abs(bal), Node.leaf("balcony")))
+        else:
+            items.append((self.abs(window_h), self.pad(unit, unit_w, col_w)))
+            if ft.sill and ft.balcony != "band":
+                h = rng.uniform(0.08, 0.18)
+                items.append((self.abs(h), Node.leaf("sill")))
+                used += h
+        top = ft.top_gap
+        bottom = floor_h - top - used - window_h
+        if ft.balcony == "band":
+            top = max(0.1, floor_h - used - window_h)
+            bottom = 0.0
+        column_items = [(self.flt(top), Node.leaf(WALL))] + items
+        if bottom > 0.05:
+            column_items.append((self.flt(bottom), Node.leaf(WALL)))
+        column = Node.split("y", column_items)
+        return self.centered(col_w, column, role="tile")
+
+    def pad(self, node: Node, width: float, outer: float) -> Node:
+        """``node`` centred in wall inside a slightly wider column (a mirror split)."""
+        side = (outer - width) / 2
+        if side < 0.02:
+            return node
+        return Node.mirror("x", [(self.abs(side), Node.leaf(WALL)), (self.flt(width), node)], center=True)
+
+    def centered_in(self, outer: float, width: float, label: str) -> Node:
+        return self.pad(Node.leaf(label), width, outer)
+
+    # --- rows and floors ---------------------------------------------------------------------------------
+    def choose_row(self, layout: Layout, tile: Node, center: Node | None) -> Node:
+        """H_p for a row of bays: a repeat, or a mirror around a distinct centre bay; pillars between bays."""
+        pillar = layout.pillar_w > 0
+        if center is not None and layout.bays % 2 == 1 and layout.bays >= 3:
+            half = layout.bays // 2
+            if pillar:
+                side = Node.repeat("x", half, [(self.abs(layout.pillar_w), Node.leaf("pillar")),
+                                                (self.flt(layout.bay_w), tile)])
+                side_w = half * (layout.bay_w + layout.pillar_w)
+                return Node.mirror("x", [(self.flt(side_w), side),
+                                         (self.abs(layout.pillar_w), Node.leaf("pillar")),
+                                         (self.flt(layout.bay_w), center)], center=True, role="bay")
+            side = Node.repeat("x", half, [(self.flt(layout.bay_w), tile)])
+            return Node.mirror("x", [(self.flt(half * layout.bay_w), side), (self.flt(layout.bay_w), center)],
+                               center=True, role="bay")
+        if pillar:
+            return Node.repeat("x", layout.bays, [(self.abs(layout.pillar_w), Node.leaf("pillar")),
+                                                  (self.flt(layout.bay_w), tile)], tail=1, role="bay")
+        return Node.repeat("x", layout.bays, [(self.flt(layout.bay_w), tile)], role="bay")
+
+    def with_margins(self, layout: Layout, row: Node, margin_label: str = WALL) -> Node:
+        if layout.margin_w < 0.05:
+            return row
+        return Node.split("x", [(self.abs(layout.margin_w), Node.leaf(margin_label)),
+                                (self.flt(layout.width - 2 * layout.margin_w), row),
+                                (self.abs(layout.margin_w), Node.leaf(margin_label))])
+
+    def floor(self, s: Style, layout: Layout, ft: FloorType) -> Node:
+        tile = self.tile(ft, layout.bay_w, s.floor_h if ft.balcony != "band" else s.floor_h - self.balcony_h)
+        center = None
+        if layout.symmetric and self.chance(0.35):
+            wider = replace(ft, window_w=min(ft.window_w * 1.25, layout.bay_w - 0.3), deco=ft.deco or ft.hood)
+            center = self.tile(wider, layout.bay_w, s.floor_h)
+        row = self.with_margins(layout, self.choose_row(layout, tile, center))
+        if ft.balcony == "band":
+            return Node.split("y", [(self.flt(s.floor_h - self.balcony_h), row),
+                                    (self.abs(self.balcony_h), self.balcony_band(layout))], role="floor")
+        row.role = "floor"
+        return row
+
+    def balcony_band(self, layout: Layout) -> Node:
+        inset = layout.margin_w * self.rng.uniform(0.3, 1.0) if layout.margin_w > 0.1 else 0.0
+        if inset < 0.05:
+            return Node.leaf("balcony", role="band")
+        return Node.mirror("x", [(self.abs(inset), Node.leaf(WALL)), (self.flt(layout.width), Node.leaf("balcony"))],
+                           center=True, role="band")
+
+    def choose_floors(self, s: Style, layout: Layout, types: list[FloorType]) -> tuple[Node, float]:
+        """H_p for the stack of upper floors: runs of identical floors become repeats. Returns (node, height)."""
+        self.balcony_h = self.rng.uniform(0.8, 1.1)
+        band_h = self.rng.uniform(0.15, 0.35)
+        items: list[tuple[Size, Node]] = []
+        height = 0.0
+        i = 0
+        while i < len(types):
+            j = i
+            while j + 1 < len(types) and types[j + 1] is types[i]:
+                j += 1
+            ft, n = types[i], j - i + 1
+            floor = self.floor(s, layout, ft)
+            pattern = [(self.flt(s.floor_h), floor)]
+            unit_h = s.floor_h
+            if ft.band_below:
+                pattern.append((self.abs(band_h), Node.leaf("molding", role="band")))
+                unit_h += band_h
+            if n > 1 or len(pattern) > 1:
+                items.append((self.flt(n * unit_h), Node.repeat("y", n, pattern, role="floors")))
+            else:
+                items.append(pattern[0])
+            height += n * unit_h
+            i = j + 1
+        if len(items) == 1:
+            return items[0][1], height
+        return Node.split("y", items, role="floors"), height
+
+    # --- ground floor and attic -------------------------------------------------------------------------------
+    def entrance(self, bay_w: float, height: float, hood: bool) -> Node:
+        rng = self.rng
+        door_w = min(bay_w * 0.85, rng.uniform(1.1, 1.9))
+        door_h = min(height - 0.3, rng.uniform(2.3, 3.2))
+        items: list[tuple[Size, Node]] = [(self.flt(height - door_h), Node.leaf(WALL))]
+        if hood and height - door_h > 0.5:
+            items.append((self.abs(0.25), Node.leaf("cornice")))
+        items.append((self.abs(door_h), Node.leaf("door")))
+        return self.centered(door_w, Node.split("y", items), role="entrance")
+
+    def shopfront(self, height: float) -> Node:
+        rng = self.rng
+        top = height * rng.uniform(0.05, 0.2)
+        side = rng.uniform(0.05, 0.3)
+        shop = Node.split("y", [(self.abs(top), Node.leaf(WALL)), (self.flt(height - top), Node.leaf("shop"))])
+        return Node.mirror("x", [(self.abs(side), Node.leaf(WALL)), (self.flt(2.0), shop)], center=True,
+                           role="shopfront")
+
+    def ground_window(self, s: Style, layout: Layout) -> Node:
+        ft = FloorType(window_w=min(layout.bay_w * s.window_w, layout.bay_w - 0.3),
+                       window_h=s.ground_h * self.rng.uniform(0.4, 0.55), top_gap=s.ground_h * 0.2,
+                       hood=s.hood, sill=s.sill, deco=False, balcony="none", railing=False,
+                       roller=self.chance(0.3), shutters=s.shutters, band_below=False)
+        return self.tile(ft, layout.bay_w, s.ground_h)
+
+    def choose_ground(self, s: Style, layout: Layout) -> Node:
+        """H_p for the ground floor: shops, an entrance, windows, in the shared column layout."""
+        h = s.ground_h
+        kind = s.ground
+        if kind == "mixed":
+            kind = self.rng.choice(["shops_entrance", "house", "glass"])
+        entrance = self.entrance(layout.bay_w, h, s.hood)
+        if kind == "shops_entrance":
+            bay = self.shopfront(h)
+        elif kind == "glass":
+            bay = self.shopfront(h) if self.chance(0.5) else Node.leaf("shop")
+        elif kind == "commercial":
+            shop = self.shopfront(h)
+            inner = layout.width - 2 * layout.margin_w
+            door_side = self.rng.random() < 0.5
+            items = [(self.flt(inner - layout.bay_w), shop), (self.abs(layout.bay_w), entrance)]
+            if door_side:
+                items.reverse()
+            return self.with_margins(layout, Node.split("x", items, role="ground"))
+        else:  # house
+            bay = self.ground_window(s, layout)
+        if layout.symmetric and layout.bays % 2 == 1:
+            row = self.choose_row(layout, bay, entrance)
+        else:
+            bays = [bay.copy() for _ in range(layout.bays)]
+            bays[self.rng.randrange(layout.bays)] = entrance
+            pillar = layout.pillar_w > 0
+            items: list[tuple[Size, Node]] = []
+            for b in bays:
+                if pillar:
+                    items.append((self.abs(layout.pillar_w), Node.leaf("pillar")))
+                items.append((self.flt(layout.bay_w), b))
+            if pillar:
+                items.append((self.abs(layout.pillar_w), Node.leaf("pillar")))
+            row = Node.split("x", items, role="bay")
+        node = self.with_margins(layout, row)
+        node.role = "ground"
+        return node
+
+    def attic(self, s: Style, layout: Layout) -> tuple[Node, float]:
+        """Roof storey with dormers above the main cornice (role attic). Returns (node, height)."""
+        rng = self.rng
+        roof_h = s.floor_h * rng.uniform(0.6, 1.0)
+        cornice_h = rng.uniform(0.3, 0.6)
+        if s.dormers:
+            dw, dh = layout.bay_w * rng.uniform(0.3, 0.45), roof_h * rng.uniform(0.45, 0.65)
+            dormer = Node.split("y", [(self.flt(roof_h - dh), Node.leaf(WALL)), (self.abs(dh), Node.leaf("window")),
+                                      (self.flt(roof_h * 0.15), Node.leaf(WALL))])
+            every = rng.choice([1, 1, 2]) if layout.bays >= 4 else 1
+            row = Node.repeat("x", max(1, layout.bays // every),
+                              [(self.flt(layout.bay_w * every), self.centered(dw, dormer, role="tile"))])
+            roof = self.with_margins(layout, row)
+        else:
+            roof = Node.leaf(WALL)
+        node = Node.split("y", [(self.flt(roof_h), roof), (self.abs(cornice_h), Node.leaf("molding", role="band"))],
+                          role="attic")
+        return node, roof_h + cornice_h
+
+    # --- whole facades -----------------------------------------------------------------------------------------
+    def facade(self, s: Style) -> tuple[Node, float, float]:
+        """One building: attic, upper floors, ground floor. Returns (node, width, height) in metres."""
+        layout = self.sample_layout(s)
+        types = self.sample_floor_types(s, layout)
+        items: list[tuple[Size, Node]] = []
+        height = 0.0
+        if s.attic:
+            attic, h = self.attic(s, layout)
+            items.append((self.flt(h), attic))
+            height += h
+        if s.floors > 0:
+            floors, h = self.choose_floors(s, layout, types)
+            items.append((self.flt(h), floors))
+            height += h
+        if s.bands and self.chance(0.6):
+            h = self.rng.uniform(0.2, 0.45)
+            items.append((self.abs(h), Node.leaf("molding", role="band")))
+            height += h
+        items.append((self.flt(s.ground_h), self.choose_ground(s, layout)))
+        height += s.ground_h
+        return Node.split("y", items, role="facade"), layout.width, height
+
+
+def _scaled(node: Node, scale: float) -> Node:
+    node.sizes = [s if s.mode == "rel" else Size(s.mode, round(s.value * scale, 1)) for s in node.sizes]
+    for child in node.children:
+        _scaled(child, scale)
+    return node
+
+
+def build_procedure(rng: random.Random, styles: list[Style], long_side: float) -> Procedure:
+    """The whole image: one facade (or several wings side by side), background around it, with the longer
+    side ``long_side`` pixels."""
+    b = Builder(rng)
+    built = [b.facade(s) for s in styles]
+    width_m = sum(w for _, w, _ in built)
+    height_m = max(h for _, _, h in built)
+    wings: list[tuple[Size, Node]] = []
+    for node, w, h in built:
+        if len(built) > 1 and h < height_m - 0.05:
+            node = Node.split("y", [(b.flt(height_m - h), Node.leaf("background", role="margin")),
+                                    (b.flt(h), node)])
+        wings.append((b.flt(w), node))
+    body = wings[0][1] if len(wings) == 1 else Node.split("x", wings, role="facade")
+    sky_m = height_m * styles[0].sky / max(1e-6, 1 - styles[0].sky)
+    side_m = width_m * rng.uniform(0.03, 0.15) if styles[0].side_bg else 0.0
+    if side_m > 0:
+        body = Node.split("x", [(b.abs(side_m), Node.leaf("background", role="margin")), (b.flt(width_m), body),
+                                (b.abs(side_m), Node.leaf("background", role="margin"))])
+    if sky_m > 0.05:
+        body = Node.split("y", [(b.abs(sky_m), Node.leaf("background", role="margin")), (b.flt(height_m), body)])
+    body.role = "image"
+    total_w, total_h = width_m + 2 * side_m, height_m + (sky_m if sky_m > 0.05 else 0.0)
+    scale = long_side / max(total_w, total_h)
+    width_px = max(8, round(total_w * scale))
+    height_px = max(8, round(total_h * scale))
+    return Procedure(width_px, height_px, _scaled(body, scale))

@@ -1,0 +1,25 @@
+"""The FaçAID split grammar: procedures (derivation trees), their JSON form, and their execution."""
+
+from facaid.grammar.execute import execute, layout, to_segmentation
+from facaid.grammar.procedure import (
+    GRAMMAR_VERSION,
+    Node,
+    Procedure,
+    ProcedureError,
+    Size,
+    parse_procedure,
+    validate,
+)
+
+__all__ = [
+    "GRAMMAR_VERSION",
+    "Node",
+    "Procedure",
+    "ProcedureError",
+    "Size",
+    "execute",
+    "layout",
+    "parse_procedure",
+    "to_segmentation",
+    "validate",
+]

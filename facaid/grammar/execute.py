@@ -1,0 +1,192 @@
+"""The numeric executor: the reference semantics of the grammar, in plain Python floats.
+
+`execute` returns the leaf rectangles (a partition of the image) in depth-first order. The differentiable
+executor in `facaid.grammar.differentiable` computes the same boxes with torch and is checked against this one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from facaid.grammar.procedure import MAX_COUNT, MAX_LEAVES, Node, Procedure, ProcedureError, Size
+from facaid.labels import BACKGROUND, LABEL_ID
+from facaid.segmentation import Rect, Segmentation
+
+
+def nominal(size: Size, length: float) -> float:
+    """The length a size asks for before floating sizes share the remainder."""
+    return size.value * length if size.mode == "rel" else size.value
+
+
+def repeat_count(node: Node, length: float) -> int:
+    """How many times a repeat node lays out its pattern in a region of the given length."""
+    if node.count != "fill":
+        return node.count
+    pattern = sum(nominal(s, length) for s in node.sizes)
+    tail = sum(nominal(s, length) for s in node.sizes[: node.tail])
+    return max(1, min(MAX_COUNT, int((length - tail) / pattern + 0.5)))
+
+
+def expand(node: Node, length: float) -> tuple[list[Size], list[Node], list[bool]]:
+    """The plain split a repeat or mirror node stands for: (sizes, children, reflected) along its axis."""
+    if node.rule == "split":
+        return node.sizes, node.children, [False] * len(node.children)
+    if node.rule == "repeat":
+        n = repeat_count(node, length)
+        t = node.tail
+        return (node.sizes * n + node.sizes[:t], node.children * n + node.children[:t],
+                [False] * (len(node.children) * n + t))
+    # mirror
+    back = list(range(len(node.children) - (2 if node.center else 1), -1, -1))
+    return (node.sizes + [node.sizes[i] for i in back], node.children + [node.children[i] for i in back],
+            [False] * len(node.children) + [True] * len(back))
+
+
+def layout(sizes: list[Size], length: float) -> list[float]:
+    """Lengths of the children of a split of the given length (see the rules in `procedure`)."""
+    fixed = 0.0
+    weights = 0.0
+    for s in sizes:
+        if s.mode == "flt":
+            weights += s.value
+        else:
+            fixed += s.value * length if s.mode == "rel" else s.value
+    if weights > 0:
+        scale = length / fixed if fixed > length else 1.0
+        share = max(length - fixed, 0.0) / weights
+    else:
+        scale = length / fixed if fixed > 0 else 0.0
+        share = 0.0
+    out = []
+    for s in sizes:
+        if s.mode == "flt":
+            out.append(s.value * share)
+        elif s.mode == "rel":
+            out.append(s.value * length * scale)
+        else:
+            out.append(s.value * scale)
+    return out
+
+
+@dataclass
+class Trace:
+    """What the differentiable executor needs: one record per node instance, depth-first."""
+
+    depth: list[int] = field(default_factory=list)
+    parent: list[int] = field(default_factory=list)  # instance index of the parent, -1 for the root
+    param: list[int] = field(default_factory=list)  # index of the size in Procedure.parameters(), -1 at root
+    mode: list[str] = field(default_factory=list)
+    axis: list[str] = field(default_factory=list)  # the axis the parent splits along
+    flip: list[bool] = field(default_factory=list)  # laid out from the far end (inside a reflection)
+    leaves: list[int] = field(default_factory=list)  # instance indices of the leaves, depth-first
+
+
+class _Executor:
+    def __init__(self, proc: Procedure, trace: Trace | None):
+        self.out: list[tuple[int, float, float, float, float]] = []
+        self.trace = trace
+        self.offsets: dict[int, int] = {}
+        if trace is not None:
+            k = 0
+            for _, node in proc.root.walk():
+                self.offsets[id(node)] = k
+                k += len(node.sizes)
+
+    def run(self, node: Node, box: tuple[float, float, float, float], flips: tuple[bool, bool],
+            where: tuple, me: int) -> None:
+        # ``where`` is (parent's where, child index): the node path, formatted only for an error
+        if node.rule == "leaf":
+            if len(self.out) >= MAX_LEAVES:
+                raise ProcedureError(_path(where), f"expands to more than {MAX_LEAVES} rectangles")
+            self.out.append((LABEL_ID[node.label], *box))
+            if self.trace is not None:
+                self.trace.leaves.append(me)
+            return
+        x0, y0, x1, y1 = box
+        along_x = node.axis == "x"
+        lo, hi = (x0, x1) if along_x else (y0, y1)
+        sizes, children, reflected = expand(node, hi - lo)
+        lengths = layout(sizes, hi - lo)
+        flip = flips[0] if along_x else flips[1]
+        mirrored = (not flips[0], flips[1]) if along_x else (flips[0], not flips[1])
+        pidx = self._param_indices(node, len(sizes)) if self.trace is not None else None
+        n_pattern = len(node.children)
+        pos = hi if flip else lo
+        last = len(children) - 1
+        for i, child in enumerate(children):
+            length = lengths[i]
+            if flip:
+                a, b = (lo if i == last else pos - length), pos
+                pos = a
+            else:
+                a, b = pos, (hi if i == last else pos + length)
+                pos = b
+            sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)
+            child_id = -1
+            if self.trace is not None:
+                t = self.trace
+                child_id = len(t.depth)
+                t.depth.append(t.depth[me] + 1)
+                t.parent.append(me)
+                t.param.append(self.offsets[id(node)] + pidx[i])
+                t.mode.append(sizes[i].mode)
+                t.axis.append(node.axis)
+                t.flip.append(flip)
+            self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), child_id)
+
+    @staticmethod
+    def _param_indices(node: Node, n: int) -> list[int]:
+        """For each expanded child, the index of its size among the node's own sizes."""
+        k = len(node.sizes)
+        if node.rule == "mirror":
+            return list(range(k)) + list(range(k - (2 if node.center else 1), -1, -1))
+        return [i % k for i in range(n)]  # a repeat's copies share the pattern's sizes
+
+
+def _path(where: tuple) -> str:
+    parts = []
+    while where:
+        where, i = where
+        parts.append(str(i))
+    return "/".join(["root", *reversed(parts)])
+
+
+def execute(proc: Procedure, trace: Trace | None = None) -> list[tuple[int, float, float, float, float]]:
+    """Execute a procedure: its leaves as (label_id, x0, y0, x1, y1) floats, depth-first.
+
+    The leaves partition the image [0, width) x [0, height); some may be empty (zero length).
+    """
+    ex = _Executor(proc, trace)
+    if trace is not None:
+        trace.depth.append(0)
+        trace.parent.append(-1)
+        trace.param.append(-1)
+        trace.mode.append("")
+        trace.axis.append("")
+        trace.flip.append(False)
+    ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
+    return ex.out
+
+
+def count_leaves(proc: Procedure) -> int:
+    return len(execute(proc))
+
+
+def to_segmentation(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None
+                    ) -> Segmentation:
+    """Round the executed leaves to whole pixels: background and empty leaves are dropped.
+
+    Edges are rounded, not sizes, so neighbours that share an edge keep sharing it and nothing overlaps.
+    """
+    if leaves is None:
+        leaves = execute(proc)
+    w, h = round(proc.width), round(proc.height)
+    arr = np.array(leaves, dtype=np.float64).reshape(-1, 5)
+    arr = arr[arr[:, 0] != BACKGROUND]
+    box = np.rint(arr[:, 1:]).astype(np.int64)  # half to even, like round()
+    np.clip(box, 0, [w, h, w, h], out=box)
+    keep = (box[:, 0] < box[:, 2]) & (box[:, 1] < box[:, 3])
+    rows = np.concatenate([arr[keep, :1].astype(np.int64), box[keep]], axis=1)
+    return Segmentation(w, h, tuple(Rect(*r) for r in rows.tolist()))

@@ -1,0 +1,113 @@
+import gzip
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from facaid.cli import main
+from facaid.generator import generate
+from facaid.labels import LABELS, PALETTE
+from facaid.render import colorize, legend, overlay, render_segmentation
+from facaid.segmentation import Segmentation, rasterize
+
+
+def test_colorize_uses_the_documented_palette():
+    label_map = np.arange(12, dtype=np.uint8).reshape(3, 4)
+    image = np.asarray(colorize(label_map))
+    for i, name in enumerate(LABELS):
+        assert tuple(image[i // 4, i % 4]) == PALETTE[name]
+
+
+def test_render_and_overlay_sizes():
+    seg = generate(3).segmentation
+    image = render_segmentation(seg, outline=True)
+    assert image.size == (seg.width, seg.height)
+    photo = Image.new("RGB", (seg.width // 2, seg.height // 2), (255, 255, 255))
+    blended = overlay(photo, rasterize(seg), alpha=1.0)
+    assert np.array_equal(np.asarray(blended), np.asarray(colorize(rasterize(seg))))
+    with pytest.raises(ValueError, match="alpha"):
+        overlay(photo, rasterize(seg), alpha=2)
+    assert legend().width == 96 * 12
+
+
+def test_cli_render_procedure_segmentation_and_overlay(tmp_path, capsys):
+    sample = generate(11, "tenement")
+    proc_path = tmp_path / "p.json"
+    proc_path.write_text(sample.procedure.to_json())
+    seg_path = tmp_path / "s.json"
+    seg_path.write_text(sample.segmentation.to_json())
+    assert main(["render", str(proc_path), "--out", str(tmp_path / "p.png"), "--legend"]) == 0
+    assert main(["render", str(seg_path), "--out", str(tmp_path / "s.png")]) == 0
+    a = np.asarray(Image.open(tmp_path / "s.png"))
+    assert a.shape == (sample.segmentation.height, sample.segmentation.width, 3)
+    # a procedure renders exactly like its flattened execution
+    b = np.asarray(Image.open(tmp_path / "p.png"))[: a.shape[0], : a.shape[1]]
+    assert np.array_equal(a, b)
+    photo = tmp_path / "photo.jpg"
+    Image.new("RGB", (50, 60), (10, 200, 30)).save(photo)
+    assert main(["render", str(seg_path), "--out", str(tmp_path / "o.png"), "--photo", str(photo),
+                 "--alpha", "0.3"]) == 0
+
+
+@pytest.mark.parametrize(
+    "content, message",
+    [
+        ("{not json", "malformed JSON"),
+        ('{"width": 10, "height": 10, "rects": [{"label": "window", "x0": 5, "y0": 0, "x1": 2, "y1": 3}]}',
+         "rects[0] needs 0 <= x0 < x1"),
+        ('{"format": "facaid-procedure", "version": 1, "grammar": "facaid-split-1", "width": 10, "height": 10,'
+         ' "root": {"rule": "leaf", "label": "sky"}}', "node root: leaf label 'sky'"),
+    ],
+)
+def test_cli_rejects_bad_input_with_a_message(tmp_path, capsys, content, message):
+    path = tmp_path / "bad.json"
+    path.write_text(content)
+    assert main(["render", str(path), "--out", str(tmp_path / "x.png")]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_cli_missing_and_binary_files(tmp_path, capsys):
+    assert main(["render", str(tmp_path / "nope.json"), "--out", str(tmp_path / "x.png")]) == 2
+    assert "cannot read" in capsys.readouterr().err
+    binary = tmp_path / "b.json"
+    binary.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe")
+    assert main(["render", str(binary), "--out", str(tmp_path / "x.png")]) == 2
+    assert "not a UTF-8 text file" in capsys.readouterr().err
+
+
+def test_cli_generate_writes_shards(tmp_path, capsys):
+    out = tmp_path / "ds"
+    assert main(["generate", "--count", "12", "--seed", "3", "--out", str(out), "--shard-size", "5",
+                 "--workers", "1", "--quiet"]) == 0
+    assert "wrote 12 facades in 3 shard(s)" in capsys.readouterr().out
+    with gzip.open(out / "shard-00002.jsonl.gz", "rt") as f:
+        lines = [json.loads(x) for x in f]
+    assert len(lines) == 2
+    Segmentation.from_dict(lines[0]["segmentation"])
+    assert main(["generate", "--count", "3"]) == 2
+    assert "--out DIR is required" in capsys.readouterr().err
+
+
+def test_cli_stats(tmp_path, capsys, cmp_records):
+    small = tmp_path / "cmp.jsonl"
+    small.write_text("\n".join(json.dumps(r) for r in cmp_records[:5]) + "\n")
+    report = tmp_path / "stats.json"
+    assert main(["generate", "--stats", "--count", "20", "--cmp", str(small), "--json", str(report),
+                 "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "20 generated facades" in out and "5 CMP facades" in out
+    figures = json.loads(report.read_text())
+    assert figures["generated"]["facades"] == 20
+    assert set(figures["generated"]["classes"]) == set(LABELS)
+
+
+def test_demo_and_console_script(tmp_path):
+    assert main(["demo", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "gallery.png").is_file()
+    assert (tmp_path / "haussmann.procedure.json").is_file()
+    done = subprocess.run([sys.executable, "-m", "facaid.cli", "--help"], capture_output=True, text=True)
+    assert done.returncode == 0 and "generate" in done.stdout
