@@ -63,6 +63,14 @@ class Segmentation:
         return parse_segmentation(obj, clip=clip)
 
     @classmethod
+    def from_array(cls, width: int, height: int, rows: np.ndarray) -> Segmentation:
+        """From int rows (label, x0, y0, x1, y1), trusted to be valid (made by this library)."""
+        return cls(width, height, tuple(map(Rect._make, rows.tolist())))
+
+    def to_array(self) -> np.ndarray:
+        return np.array(self.rects, dtype=np.int64).reshape(-1, 5)
+
+    @classmethod
     def from_json(cls, text: str | bytes, *, clip: bool = False) -> Segmentation:
         try:
             obj = json.loads(text)
@@ -146,12 +154,12 @@ def rasterize(seg: Segmentation) -> np.ndarray:
     return out
 
 
-def _compressed_grid(seg: Segmentation) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _compressed_grid(width: int, height: int, arr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The label map on the grid of all rectangle edges: (xs, ys, grid) with grid[j, i] the label of
-    the cell [xs[i], xs[i+1]) x [ys[j], ys[j+1])."""
-    arr = np.array([r for r in paint_order(seg.rects)], dtype=np.int64).reshape(-1, 5)
-    xs = np.unique(np.concatenate([[0, seg.width], arr[:, 1], arr[:, 3]]))
-    ys = np.unique(np.concatenate([[0, seg.height], arr[:, 2], arr[:, 4]]))
+    the cell [xs[i], xs[i+1]) x [ys[j], ys[j+1]). ``arr`` holds rows (label, x0, y0, x1, y1)."""
+    arr = arr[np.argsort(np.asarray(PRIORITY)[arr[:, 0]], kind="stable")]  # paint order
+    xs = np.unique(np.concatenate([[0, width], arr[:, 1], arr[:, 3]]))
+    ys = np.unique(np.concatenate([[0, height], arr[:, 2], arr[:, 4]]))
     ix0, ix1 = np.searchsorted(xs, arr[:, 1]), np.searchsorted(xs, arr[:, 3])
     iy0, iy1 = np.searchsorted(ys, arr[:, 2]), np.searchsorted(ys, arr[:, 4])
     grid = np.zeros((len(ys) - 1, len(xs) - 1), dtype=np.uint8)
@@ -202,11 +210,16 @@ def flatten(seg: Segmentation, *, wall: str = "pieces") -> Segmentation:
     order gives the same label map with far fewer rectangles. Both forms are canonical: equal label maps give
     equal outputs.
     """
+    return Segmentation.from_array(seg.width, seg.height, flatten_array(seg.width, seg.height, seg.to_array(), wall))
+
+
+def flatten_array(width: int, height: int, arr: np.ndarray, wall: str = "pieces") -> np.ndarray:
+    """`flatten` on int rows (label, x0, y0, x1, y1); returns rows in the same form."""
     if wall not in ("pieces", "footprint"):
         raise ValueError(f"wall must be 'pieces' or 'footprint', got {wall!r}")
-    if not seg.rects:
-        return Segmentation(seg.width, seg.height, ())
-    xs, ys, grid = _compressed_grid(seg)
+    if len(arr) == 0:
+        return np.zeros((0, 5), dtype=np.int64)
+    xs, ys, grid = _compressed_grid(width, height, arr)
     if wall == "pieces":
         cells = _decompose(grid)
     else:
@@ -214,8 +227,7 @@ def flatten(seg: Segmentation, *, wall: str = "pieces") -> Segmentation:
         elements = np.where(grid > FACADE, grid, 0).astype(np.uint8)
         cells = np.concatenate([_decompose(footprint), _decompose(elements)])
     out = np.stack([cells[:, 0], xs[cells[:, 1]], ys[cells[:, 2]], xs[cells[:, 3]], ys[cells[:, 4]]], axis=1)
-    out = out[np.lexsort((out[:, 0], out[:, 1], out[:, 2]))]
-    return Segmentation(seg.width, seg.height, tuple(Rect(*row) for row in out.tolist()))
+    return out[np.lexsort((out[:, 0], out[:, 1], out[:, 2]))]
 
 
 def class_areas(label_map: np.ndarray) -> np.ndarray:

@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 from facaid.generator.heuristics import build_procedure
 from facaid.generator.styles import PRESETS, STYLE_NAMES, Style, sample_style
-from facaid.grammar.execute import execute, to_segmentation
+from facaid.grammar.execute import execute, leaf_array
 from facaid.grammar.procedure import Procedure
-from facaid.segmentation import Segmentation, flatten
+from facaid.segmentation import Segmentation, flatten_array
 
 __all__ = ["PRESETS", "STYLE_NAMES", "Sample", "Style", "generate", "generate_procedure", "sample_style"]
 
@@ -48,5 +48,6 @@ def generate_procedure(seed: int, style: str | None = None) -> Procedure:
 
 def generate(seed: int, style: str | None = None) -> Sample:
     proc = generate_procedure(seed, style)
-    seg = flatten(to_segmentation(proc, execute(proc)))
+    w, h = round(proc.width), round(proc.height)
+    seg = Segmentation.from_array(w, h, flatten_array(w, h, leaf_array(proc, execute(proc))))
     return Sample(seed, proc.meta["style"], proc, seg)

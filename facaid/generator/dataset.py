@@ -15,6 +15,7 @@ from collections.abc import Iterator
 from multiprocessing import get_context
 from pathlib import Path
 
+import orjson
 from tqdm import tqdm
 
 from facaid.generator import STYLE_NAMES, generate
@@ -44,10 +45,10 @@ def _write_shard(job: tuple[str, int, int, int, int, str | None]) -> tuple[str, 
     out_dir, shard, start, stop, seed, style = job
     path = Path(out_dir) / f"shard-{shard:05d}.jsonl.gz"
     tmp = path.with_suffix(".tmp")
-    with gzip.open(tmp, "wt", compresslevel=1, encoding="utf-8") as f:
+    with gzip.open(tmp, "wb", compresslevel=1) as f:
         for i in range(start, stop):
-            f.write(json.dumps(sample_record(seed, i, style), separators=(",", ":")))
-            f.write("\n")
+            f.write(orjson.dumps(sample_record(seed, i, style)))
+            f.write(b"\n")
     os.replace(tmp, path)
     return str(path), stop - start
 
@@ -93,6 +94,6 @@ def read_dataset(path: str | Path) -> Iterator[dict]:
     else:
         files = [path]
     for file in files:
-        with gzip.open(file, "rt", encoding="utf-8") as f:
+        with gzip.open(file, "rb") as f:
             for line in f:
-                yield json.loads(line)
+                yield orjson.loads(line)

@@ -32,6 +32,7 @@ class FloorType:
     railing: bool  # balconette in front of the lower window
     roller: bool  # roller blind in the top of the window
     shutters: bool
+    surround: bool  # a molding frame around the window
     band_below: bool  # a molding band under the floor
 
 
@@ -92,8 +93,8 @@ class Builder:
             window_h = s.floor_h * s.window_h * height_factor
             top_gap = max(0.15, (s.floor_h - window_h) * rng.uniform(0.25, 0.45))
             ft = FloorType(window_w=base_w, window_h=window_h, top_gap=top_gap, hood=s.hood, sill=s.sill,
-                           deco=False, balcony="none", railing=railing, roller=roller, shutters=s.shutters,
-                           band_below=s.bands)
+                           deco=s.deco and s.hood and self.chance(0.5), balcony="none", railing=railing,
+                           roller=roller, shutters=s.shutters, surround=s.surround, band_below=s.bands)
             return replace(ft, **kw)
 
         n = s.floors
@@ -107,11 +108,11 @@ class Builder:
                 types[0] = top
             if n >= 5 and self.chance(0.5):
                 types[1] = make(0.96)
-        elif s.balcony_floors == "modern" and self.chance(0.35):
+        elif s.balcony_floors == "modern" and self.chance(0.25):
             types = [make(1.0, balcony=self.rng.choice(["band", "tile"]), sill=False)] * n
         elif s.balcony_floors == "per_tile":
             with_balcony = make(1.0, balcony="tile", railing=False)
-            types = [with_balcony if self.chance(0.5) else plain for _ in range(n)]
+            types = [with_balcony if self.chance(0.3) else plain for _ in range(n)]
         elif s.balcony_floors == "rare" and n >= 2 and self.chance(0.3):
             types[n - 1] = make(1.05, hood=s.hood_noble, deco=s.deco, balcony=self.rng.choice(["band", "tile"]))
         elif s.hood_noble and not s.hood:
@@ -130,6 +131,12 @@ class Builder:
             rail = min(0.9, height * 0.35)
             node = Node.split("y", [(self.flt(height - rail), node), (self.abs(rail), Node.leaf("balcony"))])
         width = ft.window_w
+        if ft.surround:
+            frame = rng.uniform(0.1, 0.22)
+            node = Node.split("y", [(self.abs(frame), Node.leaf("molding")),
+                                    (self.flt(height), Node.mirror("x", [(self.abs(frame), Node.leaf("molding")),
+                                                                         (self.flt(width), node)], center=True))])
+            width += 2 * frame
         if ft.shutters:
             shutter = ft.window_w * rng.uniform(0.4, 0.5)
             node = Node.split("x", [(self.abs(shutter), Node.leaf("blind")), (self.flt(ft.window_w), node),
@@ -143,7 +150,7 @@ class Builder:
         rng = self.rng
         unit, unit_w = self.window_unit(ft, ft.window_h)
         unit_w = min(unit_w, bay_w * 0.96)
-        overhang = min(rng.uniform(0.08, 0.2), (bay_w * 0.98 - unit_w) / 2) if (ft.hood or ft.sill) else 0.0
+        overhang = min(rng.uniform(0.1, 0.3), (bay_w * 0.98 - unit_w) / 2) if (ft.hood or ft.sill) else 0.0
         col_w = unit_w + 2 * max(overhang, 0.0)
         window_h = ft.window_h
         items: list[tuple[Size, Node]] = []
@@ -153,7 +160,7 @@ class Builder:
             items.append((self.abs(h), self.centered_in(col_w, unit_w * rng.uniform(0.5, 1.0), "deco")))
             used += h
         if ft.hood:
-            h = rng.uniform(0.15, 0.35)
+            h = rng.uniform(0.25, 0.55)
             items.append((self.abs(h), Node.leaf("cornice")))
             used += h
         if ft.balcony == "tile":
@@ -163,7 +170,7 @@ class Builder:
         else:
             items.append((self.abs(window_h), self.pad(unit, unit_w, col_w)))
             if ft.sill and ft.balcony != "band":
-                h = rng.uniform(0.08, 0.18)
+                h = rng.uniform(0.15, 0.3)
                 items.append((self.abs(h), Node.leaf("sill")))
                 used += h
         top = ft.top_gap
@@ -276,9 +283,15 @@ class Builder:
 
     def shopfront(self, height: float) -> Node:
         rng = self.rng
-        top = height * rng.uniform(0.05, 0.2)
-        side = rng.uniform(0.05, 0.3)
-        shop = Node.split("y", [(self.abs(top), Node.leaf(WALL)), (self.flt(height - top), Node.leaf("shop"))])
+        top = height * rng.uniform(0.1, 0.35)
+        side = rng.uniform(0.05, 0.4)
+        items = [(self.abs(top), Node.leaf(WALL))]
+        if self.chance(0.3):  # a sign or ornament over the shop window
+            sign = min(0.6, height * 0.15)
+            items.append((self.abs(sign), Node.leaf("deco")))
+            top += sign
+        items.append((self.flt(height - top), Node.leaf("shop")))
+        shop = Node.split("y", items)
         return Node.mirror("x", [(self.abs(side), Node.leaf(WALL)), (self.flt(2.0), shop)], center=True,
                            role="shopfront")
 
@@ -286,7 +299,7 @@ class Builder:
         ft = FloorType(window_w=min(layout.bay_w * s.window_w, layout.bay_w - 0.3),
                        window_h=s.ground_h * self.rng.uniform(0.4, 0.55), top_gap=s.ground_h * 0.2,
                        hood=s.hood, sill=s.sill, deco=False, balcony="none", railing=False,
-                       roller=self.chance(0.3), shutters=s.shutters, band_below=False)
+                       roller=self.chance(0.3), shutters=s.shutters, surround=s.surround, band_below=False)
         return self.tile(ft, layout.bay_w, s.ground_h)
 
     def choose_ground(self, s: Style, layout: Layout) -> Node:
@@ -310,7 +323,9 @@ class Builder:
             return self.with_margins(layout, Node.split("x", items, role="ground"))
         else:  # house
             bay = self.ground_window(s, layout)
-        if layout.symmetric and layout.bays % 2 == 1:
+        if kind != "house" and self.chance(0.3):  # shops only, the entrance is elsewhere
+            row = self.choose_row(layout, bay, None)
+        elif layout.symmetric and layout.bays % 2 == 1:
             row = self.choose_row(layout, bay, entrance)
         else:
             bays = [bay.copy() for _ in range(layout.bays)]

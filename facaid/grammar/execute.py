@@ -12,7 +12,7 @@ import numpy as np
 
 from facaid.grammar.procedure import MAX_COUNT, MAX_LEAVES, Node, Procedure, ProcedureError, Size
 from facaid.labels import BACKGROUND, LABEL_ID
-from facaid.segmentation import Rect, Segmentation
+from facaid.segmentation import Segmentation
 
 
 def nominal(size: Size, length: float) -> float:
@@ -87,6 +87,7 @@ class _Executor:
     def __init__(self, proc: Procedure, trace: Trace | None):
         self.out: list[tuple[int, float, float, float, float]] = []
         self.trace = trace
+        self.layouts: dict[tuple[int, float], tuple] = {}  # repeated copies share their layout
         self.offsets: dict[int, int] = {}
         if trace is not None:
             k = 0
@@ -98,20 +99,21 @@ class _Executor:
             where: tuple, me: int) -> None:
         # ``where`` is (parent's where, child index): the node path, formatted only for an error
         if node.rule == "leaf":
-            if len(self.out) >= MAX_LEAVES:
-                raise ProcedureError(_path(where), f"expands to more than {MAX_LEAVES} rectangles")
-            self.out.append((LABEL_ID[node.label], *box))
-            if self.trace is not None:
-                self.trace.leaves.append(me)
+            self.leaf(node, box, where, me)
             return
         x0, y0, x1, y1 = box
         along_x = node.axis == "x"
         lo, hi = (x0, x1) if along_x else (y0, y1)
-        sizes, children, reflected = expand(node, hi - lo)
-        lengths = layout(sizes, hi - lo)
+        key = (id(node), hi - lo)
+        cached = self.layouts.get(key)
+        if cached is None:
+            sizes, children, reflected = expand(node, hi - lo)
+            cached = self.layouts[key] = (sizes, children, reflected, layout(sizes, hi - lo))
+        sizes, children, reflected, lengths = cached
         flip = flips[0] if along_x else flips[1]
         mirrored = (not flips[0], flips[1]) if along_x else (flips[0], not flips[1])
-        pidx = self._param_indices(node, len(sizes)) if self.trace is not None else None
+        trace = self.trace
+        pidx = self._param_indices(node, len(sizes)) if trace is not None else None
         n_pattern = len(node.children)
         pos = hi if flip else lo
         last = len(children) - 1
@@ -125,16 +127,25 @@ class _Executor:
                 pos = b
             sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)
             child_id = -1
-            if self.trace is not None:
-                t = self.trace
-                child_id = len(t.depth)
-                t.depth.append(t.depth[me] + 1)
-                t.parent.append(me)
-                t.param.append(self.offsets[id(node)] + pidx[i])
-                t.mode.append(sizes[i].mode)
-                t.axis.append(node.axis)
-                t.flip.append(flip)
-            self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), child_id)
+            if trace is not None:
+                child_id = len(trace.depth)
+                trace.depth.append(trace.depth[me] + 1)
+                trace.parent.append(me)
+                trace.param.append(self.offsets[id(node)] + pidx[i])
+                trace.mode.append(sizes[i].mode)
+                trace.axis.append(node.axis)
+                trace.flip.append(flip)
+            if child.rule == "leaf":  # most nodes are leaves: no call
+                self.leaf(child, sub, (where, i % n_pattern), child_id)
+            else:
+                self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), child_id)
+
+    def leaf(self, node: Node, box: tuple[float, float, float, float], where: tuple, me: int) -> None:
+        if len(self.out) >= MAX_LEAVES:
+            raise ProcedureError(_path(where), f"expands to more than {MAX_LEAVES} rectangles")
+        self.out.append((LABEL_ID[node.label], *box))
+        if self.trace is not None:
+            self.trace.leaves.append(me)
 
     @staticmethod
     def _param_indices(node: Node, n: int) -> list[int]:
@@ -174,9 +185,10 @@ def count_leaves(proc: Procedure) -> int:
     return len(execute(proc))
 
 
-def to_segmentation(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None
-                    ) -> Segmentation:
-    """Round the executed leaves to whole pixels: background and empty leaves are dropped.
+def leaf_array(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None
+               ) -> np.ndarray:
+    """The executed leaves rounded to whole pixels as int64 rows (label, x0, y0, x1, y1); background and empty
+    leaves are dropped.
 
     Edges are rounded, not sizes, so neighbours that share an edge keep sharing it and nothing overlaps.
     """
@@ -188,5 +200,10 @@ def to_segmentation(proc: Procedure, leaves: list[tuple[int, float, float, float
     box = np.rint(arr[:, 1:]).astype(np.int64)  # half to even, like round()
     np.clip(box, 0, [w, h, w, h], out=box)
     keep = (box[:, 0] < box[:, 2]) & (box[:, 1] < box[:, 3])
-    rows = np.concatenate([arr[keep, :1].astype(np.int64), box[keep]], axis=1)
-    return Segmentation(w, h, tuple(Rect(*r) for r in rows.tolist()))
+    return np.concatenate([arr[keep, :1].astype(np.int64), box[keep]], axis=1)
+
+
+def to_segmentation(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None
+                    ) -> Segmentation:
+    """The executed procedure as a segmentation (see `leaf_array`)."""
+    return Segmentation.from_array(round(proc.width), round(proc.height), leaf_array(proc, leaves))
