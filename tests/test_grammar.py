@@ -149,9 +149,10 @@ def test_too_deep_and_too_many_nodes():
            "root": node}
     with pytest.raises(ProcedureError, match="tree too deep"):
         Procedure.from_dict(doc)
+    door = {"rule": "leaf", "label": "door"}
+    pair = {"rule": "split", "axis": "x", "sizes": [["flt", 1]] * 2, "children": [door] * 2}
     wide = {"rule": "split", "axis": "x", "sizes": [["flt", 1]] * 64,
-            "children": [{"rule": "split", "axis": "y", "sizes": [["flt", 1]] * 64,
-                          "children": [{"rule": "leaf", "label": "window"}] * 64}] * 64}
+            "children": [{"rule": "split", "axis": "y", "sizes": [["flt", 1]] * 64, "children": [pair] * 64}] * 64}
     doc["root"] = wide
     with pytest.raises(ProcedureError, match=f"too many nodes \\(more than {MAX_NODES}\\)"):
         Procedure.from_dict(doc)

@@ -54,7 +54,7 @@ ROLES = (
 )
 
 MAX_DEPTH = 32
-MAX_NODES = 4096
+MAX_NODES = 8192
 MAX_CHILDREN = 64
 MAX_COUNT = 256
 MAX_LEAVES = 100_000  # rectangles after repeats and mirrors are expanded
