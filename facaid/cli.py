@@ -10,8 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from facaid.generator import STYLE_NAMES
-
-DEFAULT_CMP = Path(__file__).resolve().parents[2] / "shared" / "data" / "cmp" / "annotations.jsonl"
+from facaid.paths import DEFAULT_CHECKPOINT, DEFAULT_CMP
 
 
 class CliError(Exception):
@@ -113,6 +112,32 @@ def cmd_render(args: argparse.Namespace) -> None:
     print(f"wrote {args.out} ({image.width}x{image.height})")
 
 
+def cmd_train(args: argparse.Namespace) -> None:
+    from facaid.train import train
+
+    last = train(args.config, out=args.out, resume=args.resume, steps=args.steps, until=args.until,
+                 progress=not args.quiet)
+    print(f"checkpoint: {last}")
+
+
+def cmd_evaluate(args: argparse.Namespace) -> None:
+    import torch
+
+    from facaid.evaluation.synthetic import evaluate_synthetic, write_report
+    from facaid.model import load_model
+
+    if args.threads:
+        torch.set_num_threads(args.threads)
+    model, tokenizer = load_model(args.checkpoint)
+    result = evaluate_synthetic(model, tokenizer, args.count, args.seed, noise_count=args.noise_count,
+                                unconstrained_count=args.unconstrained_count, progress=not args.quiet)
+    result["checkpoint"] = str(args.checkpoint)
+    report = write_report(result, args.report)
+    print(report.read_text().split("## Noise")[0].strip())
+    print(f"report: {report}")
+    _write_json(args.json, result)
+
+
 def cmd_demo(args: argparse.Namespace) -> None:
     from facaid.generator import generate
     from facaid.render import render_segmentation, side_by_side
@@ -165,6 +190,33 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--legend", action="store_true", help="add a legend strip")
     r.set_defaults(func=cmd_render)
 
+    t = sub.add_parser("train", help="train the transformer on freshly generated facades",
+                       description="Train the encoder-decoder transformer per a TOML config ([model], [tokenizer], "
+                                   "[train]); checkpoints to OUT/last, resumable.")
+    t.add_argument("--config", required=True, help="TOML config, e.g. configs/small.toml")
+    t.add_argument("--out", help="run directory (default: the config's train.out)")
+    t.add_argument("--resume", action="store_true", help="continue from OUT/last")
+    t.add_argument("--steps", type=int, help="override train.steps (the schedule's length)")
+    t.add_argument("--until", type=int, help="stop after this step (resume later with --resume)")
+    t.add_argument("--quiet", action="store_true", help="no progress bar")
+    t.set_defaults(func=cmd_train)
+
+    e = sub.add_parser("evaluate", help="evaluate a checkpoint on held-out generated facades",
+                       description="NLL with and without nullification, validity, exact structure rate, tree edit "
+                                   "distance, production frequencies, noise robustness, latency; writes a "
+                                   "Markdown report with PNG plots.")
+    e.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory (default: shipped)")
+    e.add_argument("--count", type=int, default=1000, help="facades (default 1000)")
+    e.add_argument("--seed", type=int, default=1000, help="held-out dataset seed (default 1000)")
+    e.add_argument("--noise-count", type=int, default=100, help="facades in the noise curve (default 100)")
+    e.add_argument("--unconstrained-count", type=int, default=200,
+                   help="facades decoded without the grammar mask (default 200)")
+    e.add_argument("--report", default="out/evaluate", help="report directory (default out/evaluate)")
+    e.add_argument("--json", help="write the figures to this JSON file")
+    e.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
+    e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.set_defaults(func=cmd_evaluate)
+
     d = sub.add_parser("demo", help="generate one facade per style with pictures",
                        description="Generate one facade per style preset and write procedures, "
                                    "segmentations and PNGs.")
@@ -181,7 +233,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         args.func(args)
-    except (CliError, ProcedureError, SegmentationError, ValueError) as exc:
+    except (CliError, ProcedureError, SegmentationError, ValueError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     return 0

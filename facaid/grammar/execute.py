@@ -88,6 +88,7 @@ class _Executor:
         self.out: list[tuple[int, float, float, float, float]] = []
         self.trace = trace
         self.layouts: dict[tuple[int, float], tuple] = {}  # repeated copies share their layout
+        self.fill_counts: dict[int, int] = {}
         self.offsets: dict[int, int] = {}
         if trace is not None:
             k = 0
@@ -110,6 +111,8 @@ class _Executor:
             sizes, children, reflected = expand(node, hi - lo)
             cached = self.layouts[key] = (sizes, children, reflected, layout(sizes, hi - lo))
         sizes, children, reflected, lengths = cached
+        if node.count == "fill":
+            self.fill_counts[id(node)] = (len(children) - node.tail) // len(node.children)
         flip = flips[0] if along_x else flips[1]
         mirrored = (not flips[0], flips[1]) if along_x else (flips[0], not flips[1])
         trace = self.trace
@@ -179,6 +182,14 @@ def execute(proc: Procedure, trace: Trace | None = None) -> list[tuple[int, floa
         trace.flip.append(False)
     ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
     return ex.out
+
+
+def fill_counts(proc: Procedure) -> dict[int, int]:
+    """The count each ``"fill"`` repeat resolves to, keyed by ``id(node)`` (the last copy's, if it occurs in
+    regions of several lengths)."""
+    ex = _Executor(proc, None)
+    ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
+    return ex.fill_counts
 
 
 def count_leaves(proc: Procedure) -> int:

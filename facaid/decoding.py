@@ -1,0 +1,184 @@
+"""Grammar-constrained decoding ("invalid state nullification"): every decoded sequence is a procedure.
+
+`GrammarLogitsProcessor` has the signature of a Hugging Face ``LogitsProcessor``: called with
+``(input_ids, scores)`` it returns a copy of the scores with every token the token grammar forbids set to
+``-inf``. `decode` runs our own cached loop with it: greedy or sampling, K candidates in one batch, from a
+given prefix if asked. `best_of_k` executes the candidates and keeps the one that reproduces the input best.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from facaid.grammar.procedure import Procedure
+from facaid.metrics import pixel_accuracy, scaled_label_map, scaled_procedure_map
+from facaid.model import MAX_LOCAL, FacaidModel, batch_inputs
+from facaid.segmentation import Segmentation
+from facaid.tokenizer import BOS, EOS, PAD, TokenError, TokenGrammar, Tokenizer
+
+
+class GrammarLogitsProcessor:
+    """Mask scores (B, V) so that only tokens the grammar allows after ``input_ids`` (B, T) remain.
+
+    Each row follows its own `TokenGrammar`; rows are matched by index across calls, and each call consumes the
+    tokens appended since the last one (a leading BOS is skipped). A row that has ended allows only PAD.
+    """
+
+    def __init__(self, tokenizer: Tokenizer, sizes: list[tuple[float, float]], max_len: int | None = None):
+        if not sizes:
+            raise ValueError("sizes must name the (width, height) of every row, got none")
+        for w, h in sizes:
+            if not (w > 0 and h > 0):
+                raise ValueError(f"image sizes must be positive, got {(w, h)!r}")
+        self.tokenizer = tokenizer
+        self.grammars = [TokenGrammar(tokenizer.vocab, w, h, max_len) for w, h in sizes]
+        self.seen = [0] * len(sizes)
+
+    def advance(self, input_ids: torch.Tensor) -> None:
+        rows = input_ids.tolist()
+        for b, (grammar, row) in enumerate(zip(self.grammars, rows, strict=True)):
+            start = self.seen[b]
+            if start == 0 and row and row[0] == BOS:
+                start = 1
+            for t in row[start:]:
+                if grammar.done:
+                    break
+                grammar.step(t)
+            self.seen[b] = len(row)
+
+    def mask(self) -> np.ndarray:
+        masks = []
+        for b, g in enumerate(self.grammars):
+            if g.done:
+                m = np.zeros(len(self.tokenizer.vocab), dtype=bool)
+                m[PAD] = True
+            else:
+                m = g.allowed()
+                if not m.any():
+                    raise ValueError(f"constraint is unsatisfiable for row {b} after {g.length} tokens")
+            masks.append(m)
+        return np.stack(masks)
+
+    def __call__(self, input_ids: torch.Tensor, scores: torch.Tensor) -> torch.Tensor:
+        if scores.dim() != 2 or scores.shape[1] != len(self.tokenizer.vocab):
+            raise ValueError(f"scores must be (batch, {len(self.tokenizer.vocab)}), got {tuple(scores.shape)}")
+        if input_ids.shape[0] != len(self.grammars) or scores.shape[0] != len(self.grammars):
+            raise ValueError(f"expected {len(self.grammars)} rows, got input_ids {tuple(input_ids.shape)} and "
+                             f"scores {tuple(scores.shape)}")
+        self.advance(input_ids)
+        allowed = torch.from_numpy(self.mask()).to(scores.device)
+        return scores.masked_fill(~allowed, float("-inf"))
+
+
+@dataclass
+class Candidate:
+    ids: list[int]  # BOS ... EOS
+    logprob: float  # of the generated tokens under the masked distribution
+    procedure: Procedure | None  # None only for an invalid unconstrained sequence
+    accuracy: float | None = None  # pixel accuracy against the input, when scored
+    error: str | None = None  # why an unconstrained sequence is invalid
+
+
+def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> list[int]:
+    """The tokens of the first ``nodes`` nodes of a procedure in BFS order (BOS included), for partial
+    inference: the model keeps them and continues."""
+    ids, local = tokenizer.encode_procedure(proc)
+    starts = [i for i, k in enumerate(local) if k == 0 and i > 0]  # node groups start at local index 0
+    if nodes >= len(starts) - 1:
+        return ids[:-1]
+    return ids[: starts[nodes]]
+
+
+@torch.no_grad()
+def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: int = 1, sample: bool = False,
+           temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None,
+           max_len: int | None = None, constrained: bool = True) -> list[Candidate]:
+    """K candidate procedures for a segmentation (greedy when ``sample`` is False; then K copies are equal).
+
+    ``constrained=False`` decodes without the grammar mask, to measure what nullification buys: a sequence
+    that breaks the grammar stops there and comes back with ``procedure=None`` and the error."""
+    if k < 1:
+        raise ValueError(f"k must be at least 1, got {k}")
+    if temperature <= 0:
+        raise ValueError(f"temperature must be positive, got {temperature}")
+    device = next(model.parameters()).device
+    max_len = max_len or tokenizer.config.max_out
+    rows = tokenizer.encode_segmentation(seg)
+    rects, mask = batch_inputs([rows], device)
+    memory, memory_mask = model.encode(rects, mask)
+    memory, memory_mask = memory.expand(k, -1, -1).contiguous(), memory_mask.expand(k, -1).contiguous()
+    start = [BOS] + [t for t in (prefix or []) if t != BOS]
+    processor = GrammarLogitsProcessor(tokenizer, [(seg.width, seg.height)] * k, max_len)
+    seqs = [list(start) for _ in range(k)]
+    processor.advance(torch.tensor(seqs))  # a prefix that breaks the grammar raises TokenError here
+    logprob = torch.zeros(k, dtype=torch.float64)
+    gen = torch.Generator().manual_seed(seed)
+    ids = torch.tensor(seqs, device=device)
+    local = torch.tensor([tokenizer.local_indices(s, tokenizer.vocab) for s in seqs], device=device)
+    past = None
+    errors: list[str | None] = [None] * k
+    while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
+        logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past, use_cache=True)
+        scores = logits[:, -1].float() / temperature  # (K, V)
+        if constrained:
+            scores = scores.masked_fill(~torch.from_numpy(processor.mask()).to(device), float("-inf"))
+        logp = torch.log_softmax(scores, dim=-1)
+        if sample:
+            nxt = torch.multinomial(logp.exp().cpu(), 1, generator=gen).squeeze(1)
+        else:
+            nxt = logp.argmax(-1).cpu()
+        prev_local = local[:, -1].tolist()
+        new_local = []
+        for b, t in enumerate(nxt.tolist()):
+            g = processor.grammars[b]
+            if g.done or errors[b]:
+                t = PAD
+            else:
+                logprob[b] += float(logp[b, t])
+                try:
+                    g.step(t)
+                except TokenError as exc:
+                    errors[b] = str(exc)
+            seqs[b].append(t)
+            new_local.append(tokenizer.vocab.next_local(t, prev_local[b]))
+        processor.seen = [len(s) for s in seqs]
+        ids = nxt.view(k, 1).to(device)
+        local = torch.tensor(new_local, device=device).view(k, 1)
+    out = []
+    for b, g in enumerate(processor.grammars):
+        if not g.done:
+            if not constrained:
+                error = errors[b] or f"no <eos> within {max_len} tokens"
+                out.append(Candidate([t for t in seqs[b] if t != PAD], float(logprob[b]), None, error=error))
+                continue
+            # the length budget guarantees this never happens; kept as a loud check
+            raise RuntimeError(f"candidate {b} did not finish within {max_len} tokens")
+        seq = seqs[b][: seqs[b].index(EOS) + 1]
+        proc = g.procedure()
+        proc.meta = {"source": "model"}
+        out.append(Candidate(seq, float(logprob[b]), proc))
+    return out
+
+
+def score(candidate: Candidate, seg: Segmentation, target: np.ndarray | None = None, scale: float = 0.25) -> float:
+    """Pixel accuracy of the candidate's execution against the segmentation, at reduced resolution."""
+    if target is None:
+        target = scaled_label_map(seg, scale)
+    candidate.accuracy = pixel_accuracy(scaled_procedure_map(candidate.procedure, scale), target)
+    return candidate.accuracy
+
+
+def best_of_k(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, k: int = 8, *,
+              temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None) -> Candidate:
+    """The greedy candidate and K-1 samples, executed and reranked by pixel accuracy (then likelihood)."""
+    candidates = decode(model, tokenizer, seg, k=1, prefix=prefix)
+    if k > 1:
+        candidates += decode(model, tokenizer, seg, k=k - 1, sample=True, temperature=temperature, seed=seed,
+                             prefix=prefix)
+    target = scaled_label_map(seg, 0.25)
+    for c in candidates:
+        score(c, seg, target)
+    return max(candidates, key=lambda c: (c.accuracy, c.logprob))

@@ -1,0 +1,1 @@
+"""Evaluation: tree edit distance, noise, held-out synthetic facades, reports."""

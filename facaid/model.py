@@ -1,0 +1,166 @@
+"""The encoder-decoder transformer: flattened segmentation rows in, procedure tokens out.
+
+Built from Hugging Face parts: a bidirectional BERT encoder over the rectangle rows and a GPT-2 decoder with
+cross-attention. Both take our own embeddings (``inputs_embeds``): the five fields of a rectangle are embedded
+separately and summed (one token per rectangle) or laid out as five tokens with a field index; output
+tokens add the embedding of their local index within their node group. `FacaidModel.save_pretrained` writes
+config.json and model.safetensors; the checkpoint also holds the tokenizer and the grammar version.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import torch
+import torch.nn.functional as F
+from torch import nn
+from transformers import BertConfig, BertModel, GPT2Config, GPT2Model, PretrainedConfig, PreTrainedModel
+
+from facaid.grammar.procedure import GRAMMAR_VERSION
+from facaid.tokenizer import PAD, Tokenizer, TokenizerConfig
+
+MAX_LOCAL = 72  # rule, role, count, up to 64 sizes, end
+
+
+class FacaidConfig(PretrainedConfig):
+    model_type = "facaid"
+
+    def __init__(self, d_model: int = 128, encoder_layers: int = 3, decoder_layers: int = 3, heads: int = 4,
+                 ffn: int = 512, dropout: float = 0.0, tokenizer: dict | None = None,
+                 grammar: str = GRAMMAR_VERSION, **kwargs):
+        super().__init__(**kwargs)
+        self.d_model = d_model
+        self.encoder_layers = encoder_layers
+        self.decoder_layers = decoder_layers
+        self.heads = heads
+        self.ffn = ffn
+        self.dropout = dropout
+        self.tokenizer = tokenizer if tokenizer is not None else TokenizerConfig().to_dict()
+        self.grammar = grammar
+
+    @property
+    def tokenizer_config(self) -> TokenizerConfig:
+        return TokenizerConfig(**self.tokenizer)
+
+
+class FacaidModel(PreTrainedModel):
+    config_class = FacaidConfig
+    base_model_prefix = "facaid"
+    main_input_name = "rects"
+
+    def __init__(self, config: FacaidConfig):
+        super().__init__(config)
+        tok = Tokenizer(config.tokenizer_config)
+        tc = config.tokenizer_config
+        d = config.d_model
+        self.rect_tokens = tc.rect_tokens
+        self.fields = nn.ModuleList(nn.Embedding(n, d) for n in tok.input_vocab_sizes)
+        self.field_index = nn.Embedding(5, d)
+        self.encoder = BertModel(BertConfig(
+            vocab_size=1, hidden_size=d, num_hidden_layers=config.encoder_layers,
+            num_attention_heads=config.heads, intermediate_size=config.ffn,
+            max_position_embeddings=(tc.max_rects + 1) * tc.rect_tokens, type_vocab_size=1,
+            hidden_dropout_prob=config.dropout, attention_probs_dropout_prob=config.dropout,
+        ), add_pooling_layer=False)
+        self.token_embedding = nn.Embedding(len(tok.vocab), d)
+        self.local_embedding = nn.Embedding(MAX_LOCAL, d)
+        self.decoder = GPT2Model(GPT2Config(
+            vocab_size=1, n_positions=tc.max_out, n_embd=d, n_layer=config.decoder_layers, n_head=config.heads,
+            n_inner=config.ffn, add_cross_attention=True, resid_pdrop=config.dropout,
+            embd_pdrop=config.dropout, attn_pdrop=config.dropout, bos_token_id=None, eos_token_id=None,
+        ))
+        self.lm_head = nn.Linear(d, len(tok.vocab), bias=False)
+        self.post_init()
+
+    def _init_weights(self, module: nn.Module) -> None:
+        if isinstance(module, nn.Linear):
+            nn.init.normal_(module.weight, std=0.02)
+            if module.bias is not None:
+                nn.init.zeros_(module.bias)
+        elif isinstance(module, nn.Embedding):
+            nn.init.normal_(module.weight, std=0.02)
+        elif isinstance(module, nn.LayerNorm):
+            nn.init.ones_(module.weight)
+            nn.init.zeros_(module.bias)
+
+    def encode(self, rects: torch.Tensor, rect_mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """rects (B, N, 5) int, rect_mask (B, N) bool -> memory (B, M, d) and its mask (B, M)."""
+        embs = [emb(rects[..., f]) for f, emb in enumerate(self.fields)]  # 5 x (B, N, d)
+        if self.rect_tokens == 1:
+            x = torch.stack(embs, 0).sum(0)  # (B, N, d)
+            mask = rect_mask
+        else:
+            b, n = rects.shape[:2]
+            x = torch.stack(embs, 2) + self.field_index.weight  # (B, N, 5, d)
+            x = x.reshape(b, n * 5, -1)  # (B, 5N, d)
+            mask = rect_mask.repeat_interleave(5, dim=1)  # (B, 5N)
+        h = self.encoder(inputs_embeds=x, attention_mask=mask.long()).last_hidden_state  # (B, M, d)
+        return h, mask
+
+    def decode(self, ids: torch.Tensor, local: torch.Tensor, memory: torch.Tensor, memory_mask: torch.Tensor,
+               past=None, use_cache: bool = False):
+        """ids, local (B, T) -> logits (B, T, V) and the cache."""
+        x = self.token_embedding(ids) + self.local_embedding(local)  # (B, T, d)
+        out = self.decoder(inputs_embeds=x, encoder_hidden_states=memory,
+                           encoder_attention_mask=memory_mask.long(), past_key_values=past, use_cache=use_cache)
+        return self.lm_head(out.last_hidden_state), out.past_key_values  # (B, T, V)
+
+    def forward(self, rects: torch.Tensor, rect_mask: torch.Tensor, ids: torch.Tensor, local: torch.Tensor,
+                targets: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor | None]:
+        """Teacher-forced logits (B, T, V) and, given targets (B, T) with -100 for ignored, the mean loss."""
+        memory, memory_mask = self.encode(rects, rect_mask)
+        logits, _ = self.decode(ids, local, memory, memory_mask)
+        loss = None
+        if targets is not None:
+            loss = F.cross_entropy(logits.reshape(-1, logits.shape[-1]), targets.reshape(-1), ignore_index=-100)
+        return logits, loss
+
+
+def load_model(path: str | Path, device: str | torch.device = "cpu") -> tuple[FacaidModel, Tokenizer]:
+    """Load a checkpoint directory; fail clearly if it was made for another grammar version."""
+    path = Path(path)
+    if not (path / "config.json").is_file():
+        raise FileNotFoundError(f"no checkpoint at {path} (config.json missing)")
+    config = FacaidConfig.from_pretrained(path)
+    if config.grammar != GRAMMAR_VERSION:
+        raise ValueError(f"checkpoint {path} was trained for grammar {config.grammar!r}; this build runs "
+                         f"{GRAMMAR_VERSION!r}")
+    tokenizer = Tokenizer.load(path / "tokenizer.json")
+    if tokenizer.config != config.tokenizer_config:
+        raise ValueError(f"checkpoint {path}: tokenizer.json does not match config.json")
+    model = FacaidModel.from_pretrained(path, config=config).to(device)
+    model.eval()
+    return model, tokenizer
+
+
+def save_model(model: FacaidModel, tokenizer: Tokenizer, path: str | Path) -> None:
+    path = Path(path)
+    path.mkdir(parents=True, exist_ok=True)
+    model.save_pretrained(path, safe_serialization=True)
+    tokenizer.save(path / "tokenizer.json")
+
+
+def batch_inputs(rows: list, device: str | torch.device = "cpu") -> tuple[torch.Tensor, torch.Tensor]:
+    """Pad encoded segmentations (each (N_i, 5)) into rects (B, N, 5) and rect_mask (B, N)."""
+    n = max(len(r) for r in rows)
+    rects = torch.zeros(len(rows), n, 5, dtype=torch.long)
+    mask = torch.zeros(len(rows), n, dtype=torch.bool)
+    for i, r in enumerate(rows):
+        rects[i, : len(r)] = torch.as_tensor(r)
+        mask[i, : len(r)] = True
+    return rects.to(device), mask.to(device)
+
+
+def batch_outputs(seqs: list[tuple[list[int], list[int]]], device: str | torch.device = "cpu"
+                  ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Teacher forcing: (ids, local, targets) each (B, T) from (ids, local) pairs with BOS ... EOS."""
+    t = max(len(ids) for ids, _ in seqs) - 1
+    ids = torch.full((len(seqs), t), PAD, dtype=torch.long)
+    local = torch.zeros(len(seqs), t, dtype=torch.long)
+    targets = torch.full((len(seqs), t), -100, dtype=torch.long)
+    for i, (seq, loc) in enumerate(seqs):
+        n = len(seq) - 1
+        ids[i, :n] = torch.as_tensor(seq[:-1])
+        local[i, :n] = torch.as_tensor(loc[:-1]).clamp(max=MAX_LOCAL - 1)
+        targets[i, :n] = torch.as_tensor(seq[1:])
+    return ids.to(device), local.to(device), targets.to(device)

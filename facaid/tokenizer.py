@@ -1,0 +1,393 @@
+"""Tokens for the transformer: segmentations in, procedures out, and the token grammar of procedures.
+
+Input: each rectangle of the flattened segmentation (footprint layer plus elements) becomes five fields
+(label, x, y, w, h), quantized at ``coord_bins`` steps of the image size, with a bottom-left origin and sorted
+by y then x; a first row carries the image's aspect ratio. The model embeds a row either as five tokens or as
+one token whose five field embeddings are summed (``TokenizerConfig.rect_tokens``).
+
+Output: the derivation tree in breadth-first order, each node a group of tokens:
+
+    leaf   := LABEL
+    inner  := RULE ROLE [COUNT | CENTER] SIZE+ END
+
+RULE is ``split_x`` ... ``mirror_y``; ROLE is a role or ``role:none``; a repeat has its COUNT, a mirror its
+CENTER; each SIZE is one token (mode and quantized value); END closes the node and, for a repeat, carries its
+tail (``end:0`` ... ``end:3``). The children of a node follow later, in BFS order, one group each.
+`TokenGrammar` knows which tokens may come next in any state: the tokenizer parses with it and the decoder
+masks with it, so every decoded sequence is a valid procedure.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import deque
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from facaid.grammar.execute import fill_counts
+from facaid.grammar.procedure import (
+    GRAMMAR_VERSION,
+    MAX_CHILDREN,
+    MAX_DEPTH,
+    MAX_LEAVES,
+    MAX_NODES,
+    ROLES,
+    Node,
+    Procedure,
+    Size,
+)
+from facaid.labels import LABELS
+from facaid.segmentation import Segmentation, flatten_array
+
+PAD, BOS, EOS = 0, 1, 2
+RULE_NAMES = ("split_x", "split_y", "repeat_x", "repeat_y", "mirror_x", "mirror_y")
+
+
+class TokenError(ValueError):
+    """A token sequence that is not a procedure (the message gives the position)."""
+
+
+@dataclass(frozen=True)
+class TokenizerConfig:
+    coord_bins: int = 128  # input quantization of x, y, w, h
+    aspect_bins: int = 64
+    size_bins: int = 128  # abs and flt sizes: sqrt-spaced fractions of the image side
+    rel_bins: int = 64
+    max_count: int = 64
+    max_tail: int = 3
+    max_rects: int = 512
+    max_out: int = 1024
+    rect_tokens: int = 1  # 1: one token per rectangle (summed field embeddings); 5: one per field
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+# --- output vocabulary ---------------------------------------------------------------------------------------
+
+@dataclass
+class Vocabulary:
+    """Output token strings and the id ranges of each kind."""
+
+    config: TokenizerConfig
+    tokens: list[str] = field(default_factory=list)
+    ranges: dict[str, range] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        c = self.config
+        groups = {
+            "special": ["<pad>", "<bos>", "<eos>"],
+            "rule": list(RULE_NAMES),
+            "label": [f"label:{name}" for name in LABELS],
+            "role": ["role:none", *(f"role:{r}" for r in ROLES)],
+            "count": [f"count:{n}" for n in range(1, c.max_count + 1)],
+            "center": ["center:0", "center:1"],
+            "abs": [f"abs:{q}" for q in range(c.size_bins)],
+            "flt": [f"flt:{q}" for q in range(c.size_bins)],
+            "rel": [f"rel:{q}" for q in range(c.rel_bins)],
+            "end": [f"end:{t}" for t in range(c.max_tail + 1)],
+        }
+        for name, items in groups.items():
+            self.ranges[name] = range(len(self.tokens), len(self.tokens) + len(items))
+            self.tokens.extend(items)
+        self.index = {t: i for i, t in enumerate(self.tokens)}
+        self.kinds = [name for name, r in self.ranges.items() for _ in r]  # kind of each token id
+
+    def __len__(self) -> int:
+        return len(self.tokens)
+
+    def id(self, token: str) -> int:
+        return self.index[token]
+
+    def kind(self, token_id: int) -> str:
+        if not 0 <= token_id < len(self.kinds):
+            raise TokenError(f"token id {token_id} is outside the vocabulary of {len(self)}")
+        return self.kinds[token_id]
+
+    def next_local(self, token_id: int, prev_local: int) -> int:
+        """Local index of a token within its node group: a rule, a label or a special token starts a group."""
+        return 0 if self.kinds[token_id] in ("rule", "label", "special") else prev_local + 1
+
+
+# --- quantization -------------------------------------------------------------------------------------------------
+
+def quantize_size(value: float, side: float, bins: int) -> int:
+    """abs/flt sizes: the fraction of the image side, sqrt-spaced so small parts keep precision."""
+    frac = min(max(value / side, 0.0), 1.0)
+    return min(bins - 1, round(math.sqrt(frac) * (bins - 1)))
+
+
+def dequantize_size(q: int, side: float, bins: int) -> float:
+    return (q / (bins - 1)) ** 2 * side
+
+
+def quantize_rel(value: float, bins: int) -> int:
+    return min(bins - 1, max(0, round(value * (bins - 1))))
+
+
+# --- the token grammar ----------------------------------------------------------------------------------------------
+
+@dataclass
+class _Open:
+    """The node whose tokens are being read."""
+
+    node: Node
+    depth: int
+    mult: int  # copies of this node after expansion
+    phase: str  # "role", "extra", "sizes"
+
+
+class TokenGrammar:
+    """The automaton of procedure token sequences: what may come next, and the tree read so far.
+
+    One instance follows one sequence (after BOS). `allowed()` is a boolean mask over the vocabulary;
+    `step(token)` consumes a token and raises `TokenError` when it is not allowed. The constraints keep every
+    completion valid: depth, node and expansion limits, and a length budget (``max_out``) that always leaves
+    room to close every open node with leaves.
+    """
+
+    def __init__(self, vocab: Vocabulary, width: float, height: float, max_len: int | None = None):
+        self.vocab = vocab
+        self.width, self.height = float(width), float(height)
+        self.max_len = max_len or vocab.config.max_out
+        self.length = 1  # BOS
+        self.nodes = 0
+        self.expanded = 1  # leaves the expansion may have: sum of copies over every created slot
+        self.pending: deque[tuple[Node | None, int, int]] = deque([(None, 0, 1)])  # (parent, depth, copies)
+        self.root: Node | None = None
+        self.open: _Open | None = None
+        self.done = False
+        r = vocab.ranges
+        self._masks = {name: self._mask(r[name]) for name in r}
+        self._eos = self._mask(range(EOS, EOS + 1))
+
+    def _mask(self, ids: range) -> np.ndarray:
+        m = np.zeros(len(self.vocab), dtype=bool)
+        m[ids.start : ids.stop] = True
+        return m
+
+    # Length budget. The state is kept feasible: the tokens so far plus the fewest that can finish the
+    # sequence (one leaf per open slot, the rest of the open node, EOS) never exceed max_len. Leaves and the
+    # mandatory tokens of a node keep it so; a new inner node or an extra size is allowed only if it does.
+    _INNER_MIN = 5  # role, count or center, one size, its leaf child, end
+
+    def allowed(self) -> np.ndarray:
+        m = self._masks
+        if self.done:
+            return np.zeros(len(self.vocab), dtype=bool)
+        room = self.max_len - self.length - 1  # tokens left before the final EOS
+        if self.open is None:
+            if not self.pending:
+                return self._eos.copy()
+            _, depth, _ = self.pending[0]
+            out = m["label"].copy()
+            if (depth + 1 < MAX_DEPTH and self.nodes + 2 <= MAX_NODES
+                    and 1 + self._INNER_MIN + len(self.pending) - 1 <= room):
+                out |= m["rule"]
+            return out
+        o = self.open
+        if o.phase == "role":
+            return m["role"].copy()
+        if o.phase == "extra":
+            if o.node.rule == "mirror":
+                return m["center"].copy()
+            out = m["count"].copy()
+            counts = self.vocab.ranges["count"]
+            for n in range(1, len(counts) + 1):  # copies of the children: count, plus one for a tail
+                if self.expanded + o.mult * (n + 1) > MAX_LEAVES:
+                    out[counts.start + n - 1 :] = False
+                    break
+            return out
+        k = len(o.node.sizes)
+        out = np.zeros(len(self.vocab), dtype=bool)
+        more = (k == 0 or (k < MAX_CHILDREN and self.nodes + len(self.pending) + 1 <= MAX_NODES
+                           and 1 + len(self.pending) + 1 + 1 <= room))  # size, open slots, new child, end
+        if more and self.expanded + self._child_copies(o) <= MAX_LEAVES:
+            out |= m["abs"] | m["flt"] | m["rel"]
+        if k > 0:
+            ends = self.vocab.ranges["end"]
+            tails = min(k, len(ends)) if o.node.rule == "repeat" else 1  # a tail is shorter than the pattern
+            out[ends.start : ends.start + tails] = True
+        return out
+
+    def _child_copies(self, o: _Open) -> int:
+        if o.node.rule == "repeat":
+            return o.mult * (o.node.count + 1)
+        if o.node.rule == "mirror":
+            return o.mult * 2
+        return o.mult
+
+    def step(self, token: int) -> None:
+        if not 0 <= token < len(self.vocab) or not self.allowed()[token]:
+            name = self.vocab.tokens[token] if 0 <= token < len(self.vocab) else str(token)
+            raise TokenError(f"token {self.length} ({name}) is not allowed here")
+        self.length += 1
+        v = self.vocab
+        kind = v.kind(token)
+        text = v.tokens[token]
+        if kind == "special":  # EOS
+            self.done = True
+            return
+        if self.open is None:
+            parent, depth, copies = self.pending.popleft()
+            if kind == "label":
+                node = Node.leaf(text.split(":", 1)[1])
+            else:
+                rule, axis = text.split("_")
+                node = Node(rule, axis=axis)
+                if rule == "repeat":
+                    node.count = 1
+                self.open = _Open(node, depth, copies, "role")
+            self.nodes += 1
+            if parent is None:
+                self.root = node
+            else:
+                parent.children.append(node)
+            return
+        o = self.open
+        if kind == "role":
+            role = text.split(":", 1)[1]
+            o.node.role = None if role == "none" else role
+            o.phase = "sizes" if o.node.rule == "split" else "extra"
+        elif kind == "count":
+            o.node.count = int(text.split(":")[1])
+            o.phase = "sizes"
+        elif kind == "center":
+            o.node.center = text.endswith("1")
+            o.phase = "sizes"
+        elif kind in ("abs", "flt", "rel"):
+            q = int(text.split(":")[1])
+            side = self.width if o.node.axis == "x" else self.height
+            if kind == "rel":
+                value = q / (v.config.rel_bins - 1)
+            else:
+                value = dequantize_size(q, side, v.config.size_bins)
+            o.node.sizes.append(Size(kind, value))
+            copies = self._child_copies(o)
+            self.expanded += copies
+            self.pending.append((o.node, o.depth + 1, copies))
+        elif kind == "end":
+            o.node.tail = int(text.split(":")[1])
+            self.open = None
+        else:
+            raise TokenError(f"token {self.length - 1} ({text}) is not allowed here")
+
+    def procedure(self) -> Procedure:
+        if not self.done:
+            raise TokenError("the sequence ended before <eos>")
+        return Procedure(self.width, self.height, self.root)
+
+
+# --- the tokenizer ---------------------------------------------------------------------------------------------------
+
+class Tokenizer:
+    def __init__(self, config: TokenizerConfig | None = None):
+        self.config = config or TokenizerConfig()
+        self.vocab = Vocabulary(self.config)
+
+    # input
+    @property
+    def input_vocab_sizes(self) -> tuple[int, int, int, int, int]:
+        """Sizes of the five field embeddings (label incl. the <image> row, x, y, w, h)."""
+        c = self.config
+        return (len(LABELS) + 1, max(c.coord_bins, c.aspect_bins), c.coord_bins, c.coord_bins + 1,
+                c.coord_bins + 1)
+
+    def encode_segmentation(self, seg: Segmentation) -> np.ndarray:
+        """(N + 1, 5) int64 rows (label, x, y, w, h); row 0 is the <image> row with the aspect ratio."""
+        c = self.config
+        arr = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
+        if len(arr) > c.max_rects:
+            raise ValueError(f"too many rectangles for the model: {len(arr)} after flattening "
+                             f"(at most {c.max_rects})")
+        return self.encode_rect_array(seg.width, seg.height, arr)
+
+    def encode_rect_array(self, width: int, height: int, arr: np.ndarray) -> np.ndarray:
+        c = self.config
+        r = c.coord_bins
+        x = np.minimum(arr[:, 1] * r // width, r - 1)
+        y = np.minimum((height - arr[:, 4]) * r // height, r - 1)  # bottom-left origin
+        w = np.clip(np.rint((arr[:, 3] - arr[:, 1]) * r / width), 1, r)
+        h = np.clip(np.rint((arr[:, 4] - arr[:, 2]) * r / height), 1, r)
+        rows = np.stack([arr[:, 0], x, y, w, h], axis=1).astype(np.int64)
+        rows = rows[np.lexsort((rows[:, 1], rows[:, 2]))]
+        aspect = math.log(width / height)  # in [-log 16, log 16] for sane images
+        qa = min(c.aspect_bins - 1, max(0, round((aspect / math.log(16) + 1) / 2 * (c.aspect_bins - 1))))
+        meta = np.array([[len(LABELS), qa, 0, 0, 0]], dtype=np.int64)
+        return np.concatenate([meta, rows])
+
+    # output
+    def encode_procedure(self, proc: Procedure) -> tuple[list[int], list[int]]:
+        """(token ids with BOS and EOS, local index of each token within its node group)."""
+        v, c = self.vocab, self.config
+        ids, local = [BOS], [0]
+        fills = fill_counts(proc) if any(n.count == "fill" for _, n in proc.nodes()) else {}
+        queue: deque[Node] = deque([proc.root])
+        while queue:
+            node = queue.popleft()
+            group: list[int] = []
+            if node.rule == "leaf":
+                group.append(v.id(f"label:{node.label}"))
+            else:
+                group.append(v.id(f"{node.rule}_{node.axis}"))
+                group.append(v.id(f"role:{node.role or 'none'}"))
+                if node.rule == "repeat":
+                    count = fills[id(node)] if node.count == "fill" else node.count
+                    group.append(v.id(f"count:{min(count, c.max_count)}"))
+                elif node.rule == "mirror":
+                    group.append(v.id(f"center:{int(node.center)}"))
+                side = proc.width if node.axis == "x" else proc.height
+                for s in node.sizes:
+                    if s.mode == "rel":
+                        group.append(v.id(f"rel:{quantize_rel(s.value, c.rel_bins)}"))
+                    else:
+                        group.append(v.id(f"{s.mode}:{quantize_size(s.value, side, c.size_bins)}"))
+                group.append(v.id(f"end:{min(node.tail, c.max_tail)}"))
+                queue.extend(node.children)
+            ids.extend(group)
+            local.extend(range(len(group)))
+        ids.append(EOS)
+        local.append(0)
+        return ids, local
+
+    def decode_procedure(self, ids: list[int], width: float, height: float) -> Procedure:
+        """Parse output tokens (with or without BOS) back into a procedure; raise `TokenError` if invalid."""
+        grammar = TokenGrammar(self.vocab, width, height, max_len=max(self.config.max_out, len(ids) + 1))
+        for t in ids[1:] if ids and ids[0] == BOS else ids:
+            if t == PAD:
+                break
+            grammar.step(int(t))
+            if grammar.done:
+                break
+        proc = grammar.procedure()
+        proc.meta = {"source": "model"}
+        return proc
+
+    @staticmethod
+    def local_indices(ids: list[int], vocab: Vocabulary) -> list[int]:
+        """Local index of each token within its node group, from the ids alone (used while decoding)."""
+        out, k = [], 0
+        for t in ids:
+            k = vocab.next_local(t, k)
+            out.append(k)
+        return out
+
+    # persistence
+    def save(self, path) -> None:
+        payload = {"grammar": GRAMMAR_VERSION, "config": self.config.to_dict(), "output_tokens": self.vocab.tokens}
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(payload, f, indent=1)
+
+    @classmethod
+    def load(cls, path) -> Tokenizer:
+        with open(path, encoding="utf-8") as f:
+            payload = json.load(f)
+        if payload.get("grammar") != GRAMMAR_VERSION:
+            raise ValueError(f"tokenizer made for grammar {payload.get('grammar')!r}; this build runs "
+                             f"{GRAMMAR_VERSION!r}")
+        tok = cls(TokenizerConfig(**payload["config"]))
+        if tok.vocab.tokens != payload["output_tokens"]:
+            raise ValueError("the saved vocabulary does not match this build's vocabulary")
+        return tok

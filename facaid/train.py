@@ -1,0 +1,261 @@
+"""Training: `facaid train --config FILE` on freshly generated facades, with validation, checkpoints, resume.
+
+The config is TOML with three tables, ``[model]`` (FacaidConfig fields), ``[tokenizer]`` (TokenizerConfig
+fields) and ``[train]`` (TrainConfig fields). Every sample is generated on the fly from its own seed, so a run
+never sees the same facade twice and the validation facades (another dataset seed) are held out. Batches are
+cut from pools sorted by length, which keeps padding low. A checkpoint (``OUT/last``) is written every
+``save_every`` steps and at the end; ``--resume`` continues from it exactly where it stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+import time
+import tomllib
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import torch
+from tqdm import tqdm
+
+from facaid.generator import generate
+from facaid.generator.dataset import sample_seed
+from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model, save_model
+from facaid.tokenizer import Tokenizer, TokenizerConfig
+
+
+@dataclass
+class TrainConfig:
+    out: str = "runs/default"
+    seed: int = 1  # training dataset seed
+    val_seed: int = 2  # validation dataset seed (held out)
+    val_count: int = 256
+    batch_size: int = 32
+    pool_batches: int = 32  # batches per length-sorted pool
+    lr: float = 1e-3
+    min_lr: float = 1e-4
+    weight_decay: float = 0.01
+    warmup: int = 300
+    steps: int = 10000
+    max_hours: float = 3.0  # stop (and save) when this much wall time has passed in this run
+    eval_every: int = 500
+    save_every: int = 500
+    grad_clip: float = 1.0
+    threads: int = 0  # torch threads on CPU; 0: all cores
+
+
+def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
+    with open(path, "rb") as f:
+        raw = tomllib.load(f)
+    unknown = set(raw) - {"model", "tokenizer", "train"}
+    if unknown:
+        raise ValueError(f"{path}: unknown table(s) {', '.join(sorted(unknown))}")
+
+    def build(cls, table: str):
+        values = raw.get(table, {})
+        names = {f.name for f in fields(cls)}
+        bad = set(values) - names
+        if bad:
+            raise ValueError(f"{path}: unknown key(s) in [{table}]: {', '.join(sorted(bad))}")
+        return cls(**values)
+
+    tok = build(TokenizerConfig, "tokenizer")
+    train = build(TrainConfig, "train")
+    model_values = raw.get("model", {})
+    allowed = {"d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout"}
+    bad = set(model_values) - allowed
+    if bad:
+        raise ValueError(f"{path}: unknown key(s) in [model]: {', '.join(sorted(bad))}")
+    return FacaidConfig(tokenizer=tok.to_dict(), **model_values), tok, train
+
+
+class SampleStream:
+    """Endless (rects, (ids, local)) examples from generated facades, skipping those too long for the model."""
+
+    def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0):
+        self.tokenizer = tokenizer
+        self.seed = seed
+        self.index = start
+        self.skipped = 0
+
+    def example(self, index: int):
+        s = generate(sample_seed(self.seed, index))
+        c = self.tokenizer.config
+        out = self.tokenizer.encode_procedure(s.procedure)
+        if len(out[0]) > c.max_out:
+            return None
+        try:
+            rows = self.tokenizer.encode_segmentation(s.segmentation)
+        except ValueError:  # too many rectangles
+            return None
+        return rows, out
+
+    def __next__(self):
+        while True:
+            ex = self.example(self.index)
+            self.index += 1
+            if ex is not None:
+                return ex
+            self.skipped += 1
+
+
+class PooledBatches:
+    """Batches of similar length: fill a pool, sort it by output length, cut it, shuffle the batches.
+
+    Its position (where the current pool starts in the stream, which pool, how many of its batches were
+    used) is saved with a checkpoint, so a resumed run sees exactly the batches an uninterrupted one would."""
+
+    def __init__(self, stream: SampleStream, batch_size: int, pool_batches: int, seed: int,
+                 position: dict | None = None):
+        self.stream, self.batch_size, self.pool_batches, self.seed = stream, batch_size, pool_batches, seed
+        self.pool_start, self.pool_number, self.used = stream.index, 0, 0
+        self.batches: list = []
+        if position:
+            self.pool_start, self.pool_number, self.used = (position["pool_start"], position["pool_number"],
+                                                            position["used"])
+            self.stream.index = self.pool_start
+            self._fill()
+
+    def _fill(self) -> None:
+        self.pool_start = self.stream.index
+        pool = [next(self.stream) for _ in range(self.batch_size * self.pool_batches)]
+        pool.sort(key=lambda ex: (len(ex[1][0]), len(ex[0])))
+        self.batches = [pool[i : i + self.batch_size] for i in range(0, len(pool), self.batch_size)]
+        random.Random(f"{self.seed}:{self.pool_number}").shuffle(self.batches)
+
+    def position(self) -> dict:
+        return {"pool_start": self.pool_start, "pool_number": self.pool_number, "used": self.used}
+
+    def __next__(self) -> list:
+        if not self.batches:
+            self._fill()
+        elif self.used == len(self.batches):
+            self.pool_number += 1
+            self.used = 0
+            self._fill()
+        batch = self.batches[self.used]
+        self.used += 1
+        return batch
+
+
+def lr_at(step: int, cfg: TrainConfig) -> float:
+    if step < cfg.warmup:
+        return cfg.lr * (step + 1) / cfg.warmup
+    t = min(1.0, (step - cfg.warmup) / max(1, cfg.steps - cfg.warmup))
+    return cfg.min_lr + 0.5 * (cfg.lr - cfg.min_lr) * (1 + math.cos(math.pi * t))
+
+
+@torch.no_grad()
+def validation_loss(model: FacaidModel, examples: list, batch_size: int, device) -> float:
+    model.eval()
+    total, count = 0.0, 0
+    examples = sorted(examples, key=lambda ex: len(ex[1][0]))
+    for i in range(0, len(examples), batch_size):
+        chunk = examples[i : i + batch_size]
+        rects, mask = batch_inputs([ex[0] for ex in chunk], device)
+        ids, local, targets = batch_outputs([ex[1] for ex in chunk], device)
+        _, loss = model(rects, mask, ids, local, targets)
+        n = int((targets != -100).sum())
+        total += float(loss) * n
+        count += n
+    model.train()
+    return total / count
+
+
+def train(config_path: str | Path, out: str | None = None, resume: bool = False, steps: int | None = None,
+          until: int | None = None, progress: bool = True) -> Path:
+    """Train per the config; returns the checkpoint directory (OUT/last).
+
+    ``steps`` overrides the schedule's length; ``until`` stops (and saves) after that step without changing
+    the schedule, so that a long run can be done in parts with ``resume``."""
+    model_cfg, tok_cfg, cfg = load_config(config_path)
+    if out is not None:
+        cfg.out = out
+    if steps is not None:
+        cfg.steps = steps
+    out_dir = Path(cfg.out)
+    last = out_dir / "last"
+    device = torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    if device.type == "cpu" and cfg.threads:
+        torch.set_num_threads(cfg.threads)
+    torch.manual_seed(cfg.seed)
+    tokenizer = Tokenizer(tok_cfg)
+    state = {"step": 0, "sample_index": 0, "skipped": 0, "elapsed": 0.0, "batches": None}
+    if resume and (last / "state.pt").is_file():
+        model, tokenizer = load_model(last, device)
+        if tokenizer.config != tok_cfg:
+            raise ValueError(f"{last} was trained with another tokenizer config than {config_path}")
+        saved = torch.load(last / "state.pt", map_location=device, weights_only=False)
+        state.update(saved["state"])
+    else:
+        model = FacaidModel(model_cfg).to(device)
+        saved = None
+    model.train()
+    decay = [p for n, p in model.named_parameters() if p.dim() >= 2]
+    no_decay = [p for n, p in model.named_parameters() if p.dim() < 2]
+    opt = torch.optim.AdamW([{"params": decay, "weight_decay": cfg.weight_decay},
+                             {"params": no_decay, "weight_decay": 0.0}], lr=cfg.lr, betas=(0.9, 0.98))
+    if saved is not None:
+        opt.load_state_dict(saved["optimizer"])
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "config.toml").write_text(Path(config_path).read_text())
+    log_path = out_dir / "log.jsonl"
+
+    val_stream = SampleStream(tokenizer, cfg.val_seed)
+    val = [next(val_stream) for _ in range(cfg.val_count)]
+    stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"])
+    stream.skipped = state["skipped"]
+    batches = PooledBatches(stream, cfg.batch_size, cfg.pool_batches, cfg.seed, state["batches"])
+    stop = min(cfg.steps, until) if until is not None else cfg.steps
+    use_amp = device.type == "cuda"
+    started = time.perf_counter()
+    elapsed0 = state["elapsed"]
+    step = state["step"]
+    bar = tqdm(total=cfg.steps, initial=step, disable=not progress, desc="train", unit="step")
+    loss_avg = None
+
+    def checkpoint() -> None:
+        state.update(step=step, sample_index=stream.index, skipped=stream.skipped, batches=batches.position(),
+                     elapsed=elapsed0 + time.perf_counter() - started)
+        tmp = out_dir / "last.tmp"
+        save_model(model, tokenizer, tmp)
+        torch.save({"state": state, "optimizer": opt.state_dict()}, tmp / "state.pt")
+        if last.exists():
+            for f in last.iterdir():
+                f.unlink()
+            last.rmdir()
+        tmp.rename(last)
+
+    while step < stop:
+        if time.perf_counter() - started > cfg.max_hours * 3600:
+            break
+        batch = next(batches)
+        rects, mask = batch_inputs([ex[0] for ex in batch], device)
+        ids, local, targets = batch_outputs([ex[1] for ex in batch], device)
+        for group in opt.param_groups:
+            group["lr"] = lr_at(step, cfg)
+        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=use_amp):
+            _, loss = model(rects, mask, ids, local, targets)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)
+        opt.step()
+        step += 1
+        loss_value = loss.item()
+        loss_avg = loss_value if loss_avg is None else 0.98 * loss_avg + 0.02 * loss_value
+        bar.update(1)
+        bar.set_postfix(loss=f"{loss_avg:.3f}", lr=f"{lr_at(step, cfg):.1e}")
+        if step % cfg.eval_every == 0 or step == cfg.steps:
+            val_loss = validation_loss(model, val, cfg.batch_size, device)
+            record = {"step": step, "train_loss": loss_avg, "val_loss": val_loss, "samples": stream.index,
+                      "skipped": stream.skipped, "hours": (elapsed0 + time.perf_counter() - started) / 3600}
+            with open(log_path, "a") as f:
+                f.write(json.dumps(record) + "\n")
+            bar.write(json.dumps(record))
+        if step % cfg.save_every == 0:
+            checkpoint()
+    bar.close()
+    checkpoint()
+    return last

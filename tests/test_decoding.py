@@ -1,0 +1,98 @@
+import numpy as np
+import pytest
+import torch
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from facaid.decoding import GrammarLogitsProcessor, best_of_k, decode, prefix_from_procedure
+from facaid.generator import generate
+from facaid.grammar import execute, validate
+from facaid.model import FacaidConfig, FacaidModel
+from facaid.tokenizer import BOS, EOS, PAD, TokenGrammar, Tokenizer, TokenizerConfig
+
+CONFIG = TokenizerConfig(max_rects=1000, max_out=160)
+TOK = Tokenizer(CONFIG)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(40, 160))
+def test_random_logits_always_give_a_valid_procedure(seed, max_len):
+    rng = np.random.default_rng(seed)
+    proc = GrammarLogitsProcessor(TOK, [(300.0, 200.0)], max_len=max_len)
+    ids = [BOS]
+    while True:
+        scores = torch.from_numpy(rng.normal(0, 3, size=(1, len(TOK.vocab))).astype(np.float32))
+        masked = proc(torch.tensor([ids]), scores)
+        assert torch.equal(torch.isfinite(masked), torch.from_numpy(proc.mask()))
+        if proc.grammars[0].done:
+            break
+        ids.append(int(masked.argmax()))
+    assert ids[-1] == EOS and len(ids) <= max_len
+    result = TOK.decode_procedure(ids, 300, 200)
+    validate(result)
+    assert len(execute(result)) >= 1
+
+
+def test_mask_matches_an_explicit_boolean_matrix():
+    v = TOK.vocab
+    proc = GrammarLogitsProcessor(TOK, [(100.0, 100.0), (100.0, 100.0)])
+    ids = torch.tensor([[BOS, v.id("split_y")], [BOS, v.id("label:window")]])
+    scores = torch.zeros(2, len(v))
+    out = proc(ids, scores)
+    expected = np.zeros((2, len(v)), dtype=bool)
+    expected[0, list(v.ranges["role"])] = True  # after a rule: its role
+    expected[1, EOS] = True  # a lone leaf is a whole procedure
+    assert np.array_equal(torch.isfinite(out).numpy(), expected)
+    assert torch.equal(scores, torch.zeros(2, len(v)))  # a masked copy, never in place
+    ids = torch.cat([ids, torch.tensor([[v.id("role:none")], [EOS]])], 1)
+    out = proc(ids, torch.zeros(2, len(v)))
+    assert torch.isfinite(out[1]).nonzero().flatten().tolist() == [PAD]
+
+
+def test_processor_validates_its_arguments():
+    with pytest.raises(ValueError, match="positive"):
+        GrammarLogitsProcessor(TOK, [(0.0, 10.0)])
+    proc = GrammarLogitsProcessor(TOK, [(10.0, 10.0)])
+    with pytest.raises(ValueError, match=r"scores must be \(batch, "):
+        proc(torch.tensor([[BOS]]), torch.zeros(1, 5))
+    with pytest.raises(ValueError, match="expected 1 rows"):
+        proc(torch.tensor([[BOS], [BOS]]), torch.zeros(2, len(TOK.vocab)))
+
+
+def test_length_budget_closes_deep_trees():
+    v = TOK.vocab
+    g = TokenGrammar(v, 100, 100, max_len=12)
+    g.step(v.id("split_x"))
+    g.step(v.id("role:none"))
+    for _ in range(3):
+        g.step(v.id("flt:5"))
+    allowed = g.allowed()
+    assert allowed[v.id("end:0")]
+    assert not allowed[v.id("flt:5")]  # a fourth child would not fit
+    g.step(v.id("end:0"))
+    assert not g.allowed()[v.id("split_y")]  # nor a new inner node
+
+
+@pytest.fixture(scope="module")
+def tiny_model():
+    torch.manual_seed(0)
+    return FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32,
+                                    tokenizer=CONFIG.to_dict())).eval()
+
+
+def test_decode_greedy_sampling_and_prefix(tiny_model):
+    seg = generate(4).segmentation
+    greedy = decode(tiny_model, TOK, seg, k=2)
+    assert greedy[0].ids == greedy[1].ids
+    samples = decode(tiny_model, TOK, seg, k=3, sample=True, seed=1)
+    for c in greedy + samples:
+        validate(c.procedure)
+        assert c.ids[0] == BOS and c.ids[-1] == EOS and len(c.ids) <= CONFIG.max_out
+        assert c.logprob <= 0
+    assert decode(tiny_model, TOK, seg, k=3, sample=True, seed=1)[0].ids == samples[0].ids
+    target = generate(4).procedure
+    prefix = prefix_from_procedure(TOK, target, nodes=2)
+    cont = decode(tiny_model, TOK, seg, prefix=prefix, max_len=400)[0]
+    assert cont.ids[: len(prefix)] == prefix
+    best = best_of_k(tiny_model, TOK, seg, k=3)
+    assert 0.0 <= best.accuracy <= 1.0

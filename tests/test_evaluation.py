@@ -1,0 +1,81 @@
+import json
+
+import pytest
+import torch
+
+from facaid.cli import main
+from facaid.decoding import decode
+from facaid.evaluation.noise import changed_fraction, perturb
+from facaid.evaluation.synthetic import evaluate_synthetic, nll, write_report
+from facaid.generator import generate
+from facaid.model import FacaidConfig, FacaidModel, save_model
+from facaid.segmentation import flatten
+from facaid.tokenizer import Tokenizer, TokenizerConfig
+
+CONFIG = TokenizerConfig(max_rects=1000, max_out=200)
+
+
+@pytest.fixture(scope="module")
+def tiny():
+    torch.manual_seed(0)
+    model = FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32,
+                                     tokenizer=CONFIG.to_dict())).eval()
+    return model, Tokenizer(CONFIG)
+
+
+@pytest.mark.parametrize("level", [0.05, 0.1, 0.2])
+def test_noise_hits_its_level(level):
+    seg = generate(12, "tenement").segmentation
+    noisy, measured = perturb(seg, level, seed=3)
+    assert abs(measured - level) < 0.35 * level
+    assert measured == pytest.approx(changed_fraction(flatten(seg, wall="footprint"), noisy))
+    assert perturb(seg, level, seed=3)[0] == noisy  # seeded
+    with pytest.raises(ValueError, match="between 0 and 1"):
+        perturb(seg, 1.5)
+
+
+def test_nullification_never_raises_the_nll(tiny):
+    model, tok = tiny
+    examples = []
+    for seed in range(40):
+        s = generate(seed)
+        tokens = tok.encode_procedure(s.procedure)
+        if len(tokens[0]) <= CONFIG.max_out:
+            examples.append({"rows": tok.encode_segmentation(s.segmentation), "tokens": tokens,
+                             "width": s.procedure.width, "height": s.procedure.height})
+    plain, nullified = nll(model, tok, examples[:4])
+    assert 0 < nullified < plain
+
+
+def test_unconstrained_decoding_reports_invalid_sequences(tiny):
+    model, tok = tiny
+    c = decode(model, tok, generate(2).segmentation, constrained=False)[0]
+    assert c.procedure is None and c.error  # an untrained model breaks the grammar at once
+
+
+def test_evaluate_and_report(tiny, tmp_path):
+    model, tok = tiny
+    result = evaluate_synthetic(model, tok, count=3, seed=1000, noise_count=1, unconstrained_count=1,
+                                progress=False)
+    assert result["count"] == 3 and result["validity"]["constrained"] == 1.0
+    assert result["validity"]["unconstrained"] == 0.0
+    assert 0.0 <= result["exact_structure_rate"] <= 1.0
+    assert [p["level"] for p in result["noise"]] == [0.0, 0.05, 0.1, 0.15, 0.2]
+    assert sum(result["ted"]["histogram"].values()) == 3
+    report = write_report(result, tmp_path / "report")
+    text = report.read_text()
+    assert "NLL per token, with nullification" in text
+    for png in ("ted.png", "productions.png", "noise.png"):
+        assert (tmp_path / "report" / png).stat().st_size > 1000
+
+
+def test_cli_evaluate(tiny, tmp_path, capsys):
+    model, tok = tiny
+    save_model(model, tok, tmp_path / "ckpt")
+    out = tmp_path / "figures.json"
+    assert main(["evaluate", "--checkpoint", str(tmp_path / "ckpt"), "--count", "2", "--noise-count", "0",
+                 "--unconstrained-count", "1", "--report", str(tmp_path / "rep"), "--json", str(out),
+                 "--quiet"]) == 0
+    assert json.loads(out.read_text())["count"] == 2
+    assert main(["evaluate", "--checkpoint", str(tmp_path / "missing"), "--count", "2"]) == 2
+    assert "no checkpoint" in capsys.readouterr().err

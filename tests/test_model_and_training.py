@@ -1,0 +1,141 @@
+import json
+
+import pytest
+import torch
+
+from facaid.generator import generate
+from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model, save_model
+from facaid.tokenizer import Tokenizer, TokenizerConfig
+from facaid.train import load_config, lr_at, train
+
+TINY = {"d_model": 16, "encoder_layers": 1, "decoder_layers": 1, "heads": 2, "ffn": 32}
+
+
+def tiny(rect_tokens=1, max_out=768):
+    tc = TokenizerConfig(max_rects=1000, max_out=max_out, rect_tokens=rect_tokens)
+    torch.manual_seed(0)
+    return FacaidModel(FacaidConfig(tokenizer=tc.to_dict(), **TINY)), Tokenizer(tc)
+
+
+def batch(tok, seeds):
+    samples = [generate(s) for s in seeds]
+    rects, mask = batch_inputs([tok.encode_segmentation(s.segmentation) for s in samples])
+    ids, local, targets = batch_outputs([tok.encode_procedure(s.procedure) for s in samples])
+    return rects, mask, ids, local, targets
+
+
+@pytest.mark.parametrize("rect_tokens", [1, 5])
+def test_forward_shapes_and_loss(rect_tokens):
+    model, tok = tiny(rect_tokens)
+    rects, mask, ids, local, targets = batch(tok, [1, 2, 3])
+    logits, loss = model(rects, mask, ids, local, targets)
+    assert logits.shape == (*ids.shape, len(tok.vocab))
+    assert loss.item() == pytest.approx(torch.log(torch.tensor(float(len(tok.vocab)))).item(), rel=0.1)
+    memory, memory_mask = model.encode(rects, mask)
+    assert memory.shape[1] == rects.shape[1] * rect_tokens
+
+
+def test_padding_does_not_change_a_sequence():
+    model, tok = tiny()
+    model.eval()
+    rects, mask, ids, local, _ = batch(tok, [7, 8])
+    alone = batch(tok, [7])
+    with torch.no_grad():
+        both = model(rects, mask, ids, local)[0][0]
+        one = model(*alone[:4])[0][0]
+    n = alone[2].shape[1]
+    assert torch.allclose(both[:n], one, atol=1e-5)
+
+
+def test_cached_and_uncached_decoding_agree():
+    model, tok = tiny()
+    model.eval()
+    rects, mask, ids, local, _ = batch(tok, [9])
+    with torch.no_grad():
+        memory, mmask = model.encode(rects, mask)
+        full, _ = model.decode(ids, local, memory, mmask)
+        first, past = model.decode(ids[:, :10], local[:, :10], memory, mmask, use_cache=True)
+        nxt, _ = model.decode(ids[:, 10:11], local[:, 10:11], memory, mmask, past, use_cache=True)
+    assert torch.allclose(full[:, 10], nxt[:, 0], atol=1e-5)
+
+
+def test_save_load_round_trip_and_grammar_check(tmp_path):
+    model, tok = tiny()
+    save_model(model, tok, tmp_path / "ckpt")
+    loaded, tok2 = load_model(tmp_path / "ckpt")
+    assert tok2.vocab.tokens == tok.vocab.tokens
+    rects, mask, ids, local, _ = batch(tok, [3])
+    model.eval()
+    with torch.no_grad():
+        assert torch.equal(model(rects, mask, ids, local)[0], loaded(rects, mask, ids, local)[0])
+    assert (tmp_path / "ckpt" / "model.safetensors").is_file()
+    cfg = json.loads((tmp_path / "ckpt" / "config.json").read_text())
+    cfg["grammar"] = "facaid-split-0"
+    (tmp_path / "ckpt" / "config.json").write_text(json.dumps(cfg))
+    with pytest.raises(ValueError, match="trained for grammar 'facaid-split-0'"):
+        load_model(tmp_path / "ckpt")
+    with pytest.raises(FileNotFoundError, match="no checkpoint"):
+        load_model(tmp_path / "nothing")
+
+
+def write_config(path, out, steps=6, extra=""):
+    path.write_text(f"""
+[model]
+d_model = 16
+encoder_layers = 1
+decoder_layers = 1
+heads = 2
+ffn = 32
+[tokenizer]
+max_rects = 400
+max_out = 400
+[train]
+out = "{out}"
+batch_size = 4
+pool_batches = 2
+steps = {steps}
+warmup = 2
+eval_every = 3
+save_every = 3
+val_count = 4
+{extra}
+""")
+
+
+def test_training_lowers_the_loss_and_resumes_exactly(tmp_path):
+    cfg = tmp_path / "c.toml"
+    write_config(cfg, tmp_path / "run", steps=9, extra="lr = 3e-3")
+    last = train(cfg, until=6, progress=False)
+    log = [json.loads(x) for x in (tmp_path / "run" / "log.jsonl").read_text().splitlines()]
+    assert [r["step"] for r in log] == [3, 6]
+    assert log[-1]["val_loss"] < log[0]["val_loss"]
+    state = torch.load(last / "state.pt", weights_only=False)["state"]
+    assert state["step"] == 6 and state["sample_index"] > 0
+    # stopping at 6 and resuming to 9 == training 9 straight (same batches, same optimizer state)
+    train(cfg, resume=True, progress=False)
+    write_config(cfg, tmp_path / "straight", steps=9, extra="lr = 3e-3")
+    train(cfg, progress=False)
+    a, _ = load_model(tmp_path / "run" / "last")
+    b, _ = load_model(tmp_path / "straight" / "last")
+    for (name, p), (_, q) in zip(a.named_parameters(), b.named_parameters(), strict=True):
+        assert torch.allclose(p, q, atol=1e-5), name
+
+
+def test_config_errors(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[train]\nbatch = 3\n")
+    with pytest.raises(ValueError, match=r"unknown key\(s\) in \[train\]: batch"):
+        load_config(bad)
+    bad.write_text("[optimizer]\nlr = 3\n")
+    with pytest.raises(ValueError, match="unknown table"):
+        load_config(bad)
+
+
+def test_learning_rate_schedule():
+    from facaid.train import TrainConfig
+
+    cfg = TrainConfig(lr=1e-3, min_lr=1e-4, warmup=10, steps=110)
+    assert lr_at(0, cfg) == pytest.approx(1e-4)
+    assert lr_at(9, cfg) == pytest.approx(1e-3)
+    assert lr_at(110, cfg) == pytest.approx(1e-4)
+    assert lr_at(60, cfg) == pytest.approx(5.5e-4)

@@ -1,0 +1,73 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from facaid.generator import STYLE_NAMES, generate
+from facaid.grammar import Node, Procedure, Size, execute, validate
+from facaid.tokenizer import BOS, EOS, TokenError, TokenGrammar, Tokenizer, TokenizerConfig
+
+TOK = Tokenizer(TokenizerConfig(max_rects=2000, max_out=2000))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**63), st.sampled_from(STYLE_NAMES))
+def test_procedure_tokens_round_trip(seed, style):
+    proc = generate(seed, style).procedure
+    ids, local = TOK.encode_procedure(proc)
+    assert ids[0] == BOS and ids[-1] == EOS
+    assert Tokenizer.local_indices(ids, TOK.vocab) == local
+    back = TOK.decode_procedure(ids, proc.width, proc.height)
+    validate(back)
+    assert TOK.encode_procedure(back)[0] == ids  # tokens are a fixed point
+    # same structure, sizes within quantization: the executions agree to a few pixels
+    a, b = execute(proc), execute(back)
+    assert [x[0] for x in a] == [x[0] for x in b]
+    err = np.abs(np.array([x[1:] for x in a]) - np.array([x[1:] for x in b])).max()
+    assert err < 0.05 * max(proc.width, proc.height)
+
+
+def test_segmentation_rows_sorted_bottom_up():
+    seg = generate(5).segmentation
+    rows = TOK.encode_segmentation(seg)
+    assert rows[0, 0] == 12  # the <image> row
+    keys = [(y, x) for _, x, y, _, _ in rows[1:].tolist()]
+    assert keys == sorted(keys)
+    assert rows[:, 1:].min() >= 0 and rows[1:, 1:3].max() < 128 and rows[1:, 3:].max() <= 128
+
+
+def test_too_many_rectangles_is_a_clear_error():
+    small = Tokenizer(TokenizerConfig(max_rects=3))
+    with pytest.raises(ValueError, match="too many rectangles for the model"):
+        small.encode_segmentation(generate(1).segmentation)
+
+
+def test_fill_repeats_are_encoded_with_their_resolved_count():
+    root = Node.repeat("x", "fill", [(Size("flt", 40), Node.leaf("window"))])
+    ids, _ = TOK.encode_procedure(Procedure(400, 50, root))
+    assert "count:10" in [TOK.vocab.tokens[i] for i in ids]
+
+
+def test_grammar_rejects_bad_sequences_with_position():
+    v = TOK.vocab
+    g = TokenGrammar(v, 100, 100)
+    with pytest.raises(TokenError, match=r"token 1 \(role:tile\) is not allowed here"):
+        g.step(v.id("role:tile"))
+    g = TokenGrammar(v, 100, 100)
+    g.step(v.id("repeat_x"))
+    g.step(v.id("role:none"))
+    g.step(v.id("count:3"))
+    g.step(v.id("abs:10"))
+    with pytest.raises(TokenError, match="end:1"):
+        g.step(v.id("end:1"))  # a tail must be shorter than the pattern
+    with pytest.raises(TokenError, match="ended before <eos>"):
+        TOK.decode_procedure([BOS, v.id("split_x")], 10, 10)
+
+
+def test_save_and_load(tmp_path):
+    TOK.save(tmp_path / "tokenizer.json")
+    assert Tokenizer.load(tmp_path / "tokenizer.json").vocab.tokens == TOK.vocab.tokens
+    text = (tmp_path / "tokenizer.json").read_text().replace("facaid-split-1", "facaid-split-0")
+    (tmp_path / "old.json").write_text(text)
+    with pytest.raises(ValueError, match="made for grammar 'facaid-split-0'"):
+        Tokenizer.load(tmp_path / "old.json")
