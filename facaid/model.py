@@ -1,7 +1,7 @@
 """The encoder-decoder transformer: flattened segmentation rows in, procedure tokens out.
 
-Built from Hugging Face parts: a bidirectional BERT encoder over the rectangle rows and a GPT-2 decoder with
-cross-attention. Both take our own embeddings (``inputs_embeds``): the five fields of a rectangle are embedded
+Built from Hugging Face parts: an encoder over the rectangle rows (bidirectional BERT, or a causal GPT-2 as in
+the paper: ``FacaidConfig.encoder``) and a GPT-2 decoder with cross-attention. Both take our own embeddings (``inputs_embeds``): the five fields of a rectangle are embedded
 separately and summed (one token per rectangle) or laid out as five tokens with a field index; output
 tokens add the embedding of their local index within their node group. `FacaidModel.save_pretrained` writes
 config.json and model.safetensors; the checkpoint also holds the tokenizer and the grammar version.
@@ -26,9 +26,12 @@ class FacaidConfig(PretrainedConfig):
     model_type = "facaid"
 
     def __init__(self, d_model: int = 128, encoder_layers: int = 3, decoder_layers: int = 3, heads: int = 4,
-                 ffn: int = 512, dropout: float = 0.0, tokenizer: dict | None = None,
-                 grammar: str = GRAMMAR_VERSION, **kwargs):
+                 ffn: int = 512, dropout: float = 0.0, encoder: str = "bidirectional",
+                 tokenizer: dict | None = None, grammar: str = GRAMMAR_VERSION, **kwargs):
         super().__init__(**kwargs)
+        if encoder not in ("bidirectional", "causal"):
+            raise ValueError(f"encoder must be 'bidirectional' (BERT) or 'causal' (GPT-2), got {encoder!r}")
+        self.encoder = encoder
         self.d_model = d_model
         self.encoder_layers = encoder_layers
         self.decoder_layers = decoder_layers
@@ -56,12 +59,20 @@ class FacaidModel(PreTrainedModel):
         self.rect_tokens = tc.rect_tokens
         self.fields = nn.ModuleList(nn.Embedding(n, d) for n in tok.input_vocab_sizes)
         self.field_index = nn.Embedding(5, d)
-        self.encoder = BertModel(BertConfig(
-            vocab_size=1, hidden_size=d, num_hidden_layers=config.encoder_layers,
-            num_attention_heads=config.heads, intermediate_size=config.ffn,
-            max_position_embeddings=(tc.max_rects + 1) * tc.rect_tokens, type_vocab_size=1,
-            hidden_dropout_prob=config.dropout, attention_probs_dropout_prob=config.dropout,
-        ), add_pooling_layer=False)
+        max_input = (tc.max_rects + 1) * tc.rect_tokens
+        if config.encoder == "bidirectional":
+            self.encoder = BertModel(BertConfig(
+                vocab_size=1, hidden_size=d, num_hidden_layers=config.encoder_layers,
+                num_attention_heads=config.heads, intermediate_size=config.ffn,
+                max_position_embeddings=max_input, type_vocab_size=1,
+                hidden_dropout_prob=config.dropout, attention_probs_dropout_prob=config.dropout,
+            ), add_pooling_layer=False)
+        else:  # a causal GPT-2 encoder, as in the paper
+            self.encoder = GPT2Model(GPT2Config(
+                vocab_size=1, n_positions=max_input, n_embd=d, n_layer=config.encoder_layers, n_head=config.heads,
+                n_inner=config.ffn, resid_pdrop=config.dropout, embd_pdrop=config.dropout,
+                attn_pdrop=config.dropout, bos_token_id=None, eos_token_id=None,
+            ))
         self.token_embedding = nn.Embedding(len(tok.vocab), d)
         self.local_embedding = nn.Embedding(MAX_LOCAL, d)
         self.decoder = GPT2Model(GPT2Config(

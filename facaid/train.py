@@ -64,7 +64,7 @@ def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainC
     tok = build(TokenizerConfig, "tokenizer")
     train = build(TrainConfig, "train")
     model_values = raw.get("model", {})
-    allowed = {"d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout"}
+    allowed = {"d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder"}
     bad = set(model_values) - allowed
     if bad:
         raise ValueError(f"{path}: unknown key(s) in [model]: {', '.join(sorted(bad))}")

@@ -11,10 +11,10 @@ from facaid.train import load_config, lr_at, train
 TINY = {"d_model": 16, "encoder_layers": 1, "decoder_layers": 1, "heads": 2, "ffn": 32}
 
 
-def tiny(rect_tokens=1, max_out=768):
+def tiny(rect_tokens=1, max_out=768, encoder="bidirectional"):
     tc = TokenizerConfig(max_rects=1000, max_out=max_out, rect_tokens=rect_tokens)
     torch.manual_seed(0)
-    return FacaidModel(FacaidConfig(tokenizer=tc.to_dict(), **TINY)), Tokenizer(tc)
+    return FacaidModel(FacaidConfig(tokenizer=tc.to_dict(), encoder=encoder, **TINY)), Tokenizer(tc)
 
 
 def batch(tok, seeds):
@@ -24,9 +24,9 @@ def batch(tok, seeds):
     return rects, mask, ids, local, targets
 
 
-@pytest.mark.parametrize("rect_tokens", [1, 5])
-def test_forward_shapes_and_loss(rect_tokens):
-    model, tok = tiny(rect_tokens)
+@pytest.mark.parametrize("rect_tokens, encoder", [(1, "bidirectional"), (5, "bidirectional"), (1, "causal")])
+def test_forward_shapes_and_loss(rect_tokens, encoder):
+    model, tok = tiny(rect_tokens, encoder=encoder)
     rects, mask, ids, local, targets = batch(tok, [1, 2, 3])
     logits, loss = model(rects, mask, ids, local, targets)
     assert logits.shape == (*ids.shape, len(tok.vocab))
@@ -122,6 +122,8 @@ def test_training_lowers_the_loss_and_resumes_exactly(tmp_path):
 
 
 def test_config_errors(tmp_path):
+    with pytest.raises(ValueError, match="encoder must be"):
+        FacaidConfig(encoder="lstm")
     bad = tmp_path / "bad.toml"
     bad.write_text("[train]\nbatch = 3\n")
     with pytest.raises(ValueError, match=r"unknown key\(s\) in \[train\]: batch"):

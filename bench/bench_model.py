@@ -1,0 +1,83 @@
+"""Model speed: training step time with one vs five tokens per rectangle, and inference latency.
+
+    .venv/bin/python bench/bench_model.py [--steps 5] [--facades 30] [--checkpoint DIR]
+
+Training steps use the shipped config's model size on the same length-sorted batch of generated facades; the
+two input layouts are timed alternately in one run and compared as a ratio. Inference: greedy, constrained,
+batch 1, the shipped checkpoint, median over held-out facades (target: <= 300 ms on 2 CPU cores).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import torch
+
+from facaid.decoding import decode
+from facaid.generator import generate
+from facaid.generator.dataset import sample_seed
+from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model
+from facaid.paths import DEFAULT_CHECKPOINT
+from facaid.tokenizer import Tokenizer, TokenizerConfig
+
+
+def train_step_times(steps: int, batch_size: int = 32) -> dict[int, float]:
+    samples = [generate(sample_seed(7, i)) for i in range(batch_size)]
+    times: dict[int, list[float]] = {1: [], 5: []}
+    setups = {}
+    for rt in (1, 5):
+        tc = TokenizerConfig(max_rects=1000, max_out=1024, rect_tokens=rt)
+        tok = Tokenizer(tc)
+        torch.manual_seed(0)
+        model = FacaidModel(FacaidConfig(tokenizer=tc.to_dict()))
+        rects, mask = batch_inputs([tok.encode_segmentation(s.segmentation) for s in samples])
+        ids, local, targets = batch_outputs([tok.encode_procedure(s.procedure) for s in samples])
+        setups[rt] = (model, torch.optim.AdamW(model.parameters(), 1e-4), (rects, mask, ids, local, targets))
+    for _ in range(steps):
+        for rt, (model, opt, batch) in setups.items():
+            t0 = time.perf_counter()
+            _, loss = model(*batch)
+            loss.backward()
+            opt.step()
+            opt.zero_grad()
+            times[rt].append(time.perf_counter() - t0)
+    return {rt: statistics.median(v[1:] or v) for rt, v in times.items()}
+
+
+def inference_latency(checkpoint: str, facades: int) -> list[float]:
+    model, tok = load_model(checkpoint)
+    out = []
+    i = 0
+    while len(out) < facades:
+        s = generate(sample_seed(1000, i))
+        i += 1
+        try:
+            tok.encode_segmentation(s.segmentation)
+        except ValueError:
+            continue
+        t0 = time.perf_counter()
+        decode(model, tok, s.segmentation)
+        out.append(time.perf_counter() - t0)
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--steps", type=int, default=5)
+    parser.add_argument("--facades", type=int, default=30)
+    parser.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT))
+    args = parser.parse_args()
+    print(f"torch threads: {torch.get_num_threads()}")
+    t = train_step_times(args.steps)
+    print(f"training step, batch 32: 1 token/rect {t[1]:.2f} s, 5 tokens/rect {t[5]:.2f} s "
+          f"(5-token / 1-token = {t[5] / t[1]:.2f})")
+    if args.facades:
+        lat = inference_latency(args.checkpoint, args.facades)
+        print(f"inference, greedy, batch 1, {len(lat)} facades: median {1000 * statistics.median(lat):.0f} ms, "
+              f"p90 {1000 * sorted(lat)[int(0.9 * (len(lat) - 1))]:.0f} ms")
+
+
+if __name__ == "__main__":
+    main()
