@@ -1,10 +1,11 @@
 """The encoder-decoder transformer: flattened segmentation rows in, procedure tokens out.
 
 Built from Hugging Face parts: an encoder over the rectangle rows (bidirectional BERT, or a causal GPT-2 as in
-the paper: ``FacaidConfig.encoder``) and a GPT-2 decoder with cross-attention. Both take our own embeddings (``inputs_embeds``): the five fields of a rectangle are embedded
-separately and summed (one token per rectangle) or laid out as five tokens with a field index; output
-tokens add the embedding of their local index within their node group. `FacaidModel.save_pretrained` writes
-config.json and model.safetensors; the checkpoint also holds the tokenizer and the grammar version.
+the paper: ``FacaidConfig.encoder``) and a GPT-2 decoder with cross-attention. Both take our own embeddings
+(``inputs_embeds``): the five fields of a rectangle are embedded separately and summed (one token per
+rectangle) or laid out as five tokens with a field index; output tokens add the embedding of their local
+index within their node group. `FacaidModel.save_pretrained` writes config.json and model.safetensors; the
+checkpoint also holds the tokenizer and the grammar version.
 """
 
 from __future__ import annotations

@@ -89,7 +89,7 @@ def compile_plan(proc: Procedure) -> Plan:
     )
 
 
-def _split_level(lv: Level, boxes: torch.Tensor, params: torch.Tensor) -> torch.Tensor:
+def _split_level(lv: Level, boxes: torch.Tensor, params: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
     pb = boxes[lv.parent]  # (N, 4)
     lo = torch.where(lv.is_y, pb[:, 1], pb[:, 0])
     hi = torch.where(lv.is_y, pb[:, 3], pb[:, 2])
@@ -114,20 +114,31 @@ def _split_level(lv: Level, boxes: torch.Tensor, params: torch.Tensor) -> torch.
     y0 = torch.where(lv.is_y, a, pb[:, 1])
     x1 = torch.where(lv.is_y, pb[:, 2], b)
     y1 = torch.where(lv.is_y, b, pb[:, 3])
-    return torch.stack([x0, y0, x1, y1], dim=1)  # (N, 4)
+    # how far fixed sizes overflow a node that has floating children (there the fixed ones are scaled down
+    # and stop responding to their own values: an optimizer is steered back with this)
+    first = lv.group_first
+    overflow = torch.where(has_float[first], (fixed_sum[first] - length[first]).clamp_min(0.0), 0.0).sum()
+    return torch.stack([x0, y0, x1, y1], dim=1), overflow  # (N, 4), ()
 
 
-def execute_plan(plan: Plan, params: torch.Tensor | None = None) -> torch.Tensor:
-    """Leaf boxes (L, 4) as (x0, y0, x1, y1), depth-first like `execute`, differentiable in ``params``."""
+def execute_plan(plan: Plan, params: torch.Tensor | None = None, *, with_overflow: bool = False):
+    """Leaf boxes (L, 4) as (x0, y0, x1, y1), depth-first like `execute`, differentiable in ``params``.
+
+    With ``with_overflow``, also the total length (pixels) by which fixed sizes overflow nodes that have
+    floating children: zero for a procedure whose sizes all take effect."""
     if params is None:
         params = plan.values
     root = torch.tensor([[0.0, 0.0, plan.width, plan.height]], dtype=params.dtype, device=params.device)
     boxes = [root]
+    overflow = torch.zeros((), dtype=params.dtype, device=params.device)
     for lv in plan.levels:
-        boxes.append(_split_level(lv, boxes[-1], params))
+        level_boxes, level_overflow = _split_level(lv, boxes[-1], params)
+        boxes.append(level_boxes)
+        overflow = overflow + level_overflow
     flat = torch.cat(boxes, 0)
     starts = torch.tensor([0] + [b.shape[0] for b in boxes[:-1]], device=flat.device).cumsum(0)
-    return flat[starts[plan.leaf_level] + plan.leaf_index]
+    leaves = flat[starts[plan.leaf_level] + plan.leaf_index]
+    return (leaves, overflow) if with_overflow else leaves
 
 
 def execute_torch(proc: Procedure, params: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
