@@ -4,3 +4,12 @@ The library: labels, segmentations, the split grammar and its executors, the fac
 """
 
 __version__ = "0.1.0"
+
+
+def __getattr__(name):
+    # `facaid.reconstruct` without importing torch and transformers for every `import facaid`
+    if name == "reconstruct":
+        from facaid.pipeline import reconstruct
+
+        return reconstruct
+    raise AttributeError(f"module 'facaid' has no attribute {name!r}")

@@ -138,6 +138,26 @@ def cmd_evaluate(args: argparse.Namespace) -> None:
     _write_json(args.json, result)
 
 
+def cmd_reconstruct(args: argparse.Namespace) -> None:
+    from facaid.grammar.execute import to_segmentation
+    from facaid.model import load_model
+    from facaid.pipeline import reconstruct
+    from facaid.render import render_segmentation
+    from facaid.segmentation import Segmentation
+
+    seg = Segmentation.from_dict(_read_json(args.input), clip=args.clip)
+    model, tokenizer = load_model(args.checkpoint)
+    result = reconstruct(seg, model=model, tokenizer=tokenizer, k=args.k, sizing=not args.no_sizing,
+                         seed=args.seed)
+    Path(args.out).write_text(result.procedure.to_json(indent=1) + "\n")
+    print(f"wrote {args.out}: pixel accuracy {100 * result.accuracy:.2f} % "
+          f"(decoded {100 * result.accuracy_decoded:.2f} %), {1000 * result.timings['total']:.0f} ms")
+    if args.png:
+        render_segmentation(to_segmentation(result.procedure), outline=True).save(args.png)
+        print(f"wrote {args.png}")
+    _write_json(args.json, result.to_dict())
+
+
 def cmd_demo(args: argparse.Namespace) -> None:
     from facaid.generator import generate
     from facaid.render import render_segmentation, side_by_side
@@ -216,6 +236,20 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=cmd_evaluate)
+
+    c = sub.add_parser("reconstruct", help="reconstruct a procedure from a segmentation JSON",
+                       description="Flatten, decode with the grammar-constrained transformer (best of K), fit the "
+                                   "sizes, and write the procedure JSON (and a PNG of its execution).")
+    c.add_argument("input", help="segmentation JSON")
+    c.add_argument("--out", required=True, help="procedure JSON to write")
+    c.add_argument("--png", help="also render the reconstruction to this PNG")
+    c.add_argument("--k", type=int, default=4, help="candidates decoded and reranked (default 4)")
+    c.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    c.add_argument("--no-sizing", action="store_true", help="skip the sizing optimizer")
+    c.add_argument("--clip", action="store_true", help="clip rectangles that reach outside the image")
+    c.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory (default: shipped)")
+    c.add_argument("--json", help="write the figures (accuracy, IoU, timings) to this JSON file")
+    c.set_defaults(func=cmd_reconstruct)
 
     d = sub.add_parser("demo", help="generate one facade per style with pictures",
                        description="Generate one facade per style preset and write procedures, "
