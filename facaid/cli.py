@@ -158,6 +158,24 @@ def cmd_reconstruct(args: argparse.Namespace) -> None:
     _write_json(args.json, result.to_dict())
 
 
+def cmd_vary(args: argparse.Namespace) -> None:
+    from facaid.grammar.execute import to_segmentation
+    from facaid.grammar.procedure import Procedure
+    from facaid.render import render_segmentation, side_by_side
+    from facaid.variation import vary
+
+    proc = Procedure.from_dict(_read_json(args.input))
+    variants = vary(proc, args.n, args.seed)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    for i, v in enumerate(variants):
+        (out / f"variant-{i:02d}.json").write_text(v.to_json(indent=1) + "\n")
+        print(f"variant-{i:02d}.json  {v.meta['variation']:<7} {v.width:g}x{v.height:g}")
+    images = [render_segmentation(to_segmentation(p)) for p in [proc, *variants]]
+    side_by_side(images, height=256).save(out / "variants.png")
+    print(f"wrote {len(variants)} variants and variants.png (the original first) to {out}/")
+
+
 def cmd_demo(args: argparse.Namespace) -> None:
     from facaid.generator import generate
     from facaid.render import render_segmentation, side_by_side
@@ -250,6 +268,15 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory (default: shipped)")
     c.add_argument("--json", help="write the figures (accuracy, IoU, timings) to this JSON file")
     c.set_defaults(func=cmd_reconstruct)
+
+    v = sub.add_parser("vary", help="variations of a procedure",
+                       description="Write N variants of a procedure: floor and tile counts changed, the facade "
+                                   "resized with its repeats adapting, tiles or floors swapped within the style.")
+    v.add_argument("input", help="procedure JSON")
+    v.add_argument("--n", type=int, default=8, help="number of variants (default 8)")
+    v.add_argument("--seed", type=int, default=0)
+    v.add_argument("--out", default="out/variants", help="output directory (default out/variants)")
+    v.set_defaults(func=cmd_vary)
 
     d = sub.add_parser("demo", help="generate one facade per style with pictures",
                        description="Generate one facade per style preset and write procedures, "

@@ -1,0 +1,183 @@
+"""Variations of a procedure: edit one parameter, resize with repeats adapting, change counts, swap tiles.
+
+Every function returns a new, validated procedure and leaves its input untouched. `vary` draws a mix of
+these edits, deterministically by seed.
+"""
+
+from __future__ import annotations
+
+import random
+
+from facaid.generator import STYLE_NAMES, generate_procedure
+from facaid.grammar.execute import expand, layout
+from facaid.grammar.procedure import MAX_COUNT, Node, Procedure, ProcedureError, Size, validate
+
+
+def _copy(proc: Procedure) -> Procedure:
+    return Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
+
+
+def _node(proc: Procedure, path: str) -> Node:
+    for p, node in proc.nodes():
+        if p == path:
+            return node
+    raise ProcedureError(path, "no such node")
+
+
+def with_size(proc: Procedure, path: str, index: int, value: float, mode: str | None = None) -> Procedure:
+    """Set size ``index`` of the node at ``path`` (e.g. ``root/1/0``); the site's parameter editor."""
+    out = _copy(proc)
+    node = _node(out, path)
+    if not 0 <= index < len(node.sizes):
+        raise ProcedureError(path, f"has {len(node.sizes)} sizes, no size {index}")
+    node.sizes[index] = Size(mode or node.sizes[index].mode, value)
+    validate(out)
+    return out
+
+
+def with_count(proc: Procedure, path: str, count: int | str) -> Procedure:
+    out = _copy(proc)
+    node = _node(out, path)
+    if node.rule != "repeat":
+        raise ProcedureError(path, f"is a {node.rule} node, not a repeat")
+    node.count = count
+    validate(out)
+    return out
+
+
+def _regions(proc: Procedure) -> dict[int, float]:
+    """Length along its own axis of the first instance of every inner node, keyed by id(node)."""
+    boxes = _box_sizes(proc)
+    return {id(n): boxes[id(n)][0 if n.axis == "x" else 1] for _, n in proc.nodes()
+            if n.rule != "leaf" and id(n) in boxes}
+
+
+def resize(proc: Procedure, width: float, height: float) -> Procedure:
+    """The facade at a new size: fixed sizes keep their pixels, floating ones stretch, and every repeat
+    lays out as many copies as now fit their nominal size (rounded, at least one)."""
+    if not (1 <= width <= 100_000 and 1 <= height <= 100_000):
+        raise ValueError(f"size must be between 1 and 100000 pixels, got {width}x{height}")
+    old = _regions(proc)
+    units = {}
+    for _, node in proc.nodes():
+        if node.rule == "repeat" and node.count != "fill" and id(node) in old:
+            units[id(node)] = old[id(node)] / node.count
+    out = _copy(proc)
+    out.width, out.height = width, height
+    # match nodes of the copy with the original by position in the walk
+    pairs = list(zip((n for _, n in proc.nodes()), (n for _, n in out.nodes()), strict=True))
+    for orig, new in pairs:  # top-down: a parent's count settles before its children are measured
+        if id(orig) not in units:
+            continue
+        lengths = _regions(out)
+        if id(new) in lengths:
+            new.count = max(1, min(MAX_COUNT, round(lengths[id(new)] / units[id(orig)])))
+    validate(out)
+    return out
+
+
+def change_count(proc: Procedure, path: str, delta: int) -> Procedure:
+    """Add or remove copies of a repeat (floors, tiles); the image grows or shrinks by as many units, so
+    the other parts keep their size."""
+    node = _node(proc, path)
+    if node.rule != "repeat" or node.count == "fill":
+        raise ProcedureError(path, "is not a repeat with a count")
+    new_count = max(1, min(MAX_COUNT, node.count + delta))
+    unit = _regions(proc)[id(node)] / node.count
+    grow = (new_count - node.count) * unit
+    out = with_count(proc, path, new_count)
+    if node.axis == "x":
+        out.width = max(8.0, round(proc.width + grow))
+    else:
+        out.height = max(8.0, round(proc.height + grow))
+    validate(out)
+    return out
+
+
+def _scaled_subtree(node: Node, sx: float, sy: float) -> Node:
+    out = node.copy()
+    for _, n in out.walk():
+        f = sx if n.axis == "x" else sy
+        n.sizes = [s if s.mode == "rel" else Size(s.mode, round(s.value * f, 2)) for s in n.sizes]
+    return out
+
+
+def swap(proc: Procedure, role: str, rng: random.Random, style: str | None = None) -> Procedure:
+    """Replace one node of the given role ("tile" or "floor") by another of that role: from elsewhere in the
+    procedure, or from a facade generated in the same style, scaled to the region it lands in."""
+    targets = [(p, n) for p, n in proc.nodes() if n.role == role]
+    if not targets:
+        raise ValueError(f"the procedure has no node with role {role!r}")
+    path, target = rng.choice(targets)
+    regions = _box_sizes(proc)
+    donors = [(n, regions[id(n)]) for _, n in proc.nodes()
+              if n.role == role and id(n) in regions and n.to_dict() != target.to_dict()]
+    if not donors or rng.random() < 0.5:
+        name = style if style in STYLE_NAMES else rng.choice(STYLE_NAMES)
+        other = generate_procedure(rng.randrange(2**31), name)
+        other_regions = _box_sizes(other)
+        donors = [(n, other_regions[id(n)]) for _, n in other.nodes() if n.role == role and id(n) in other_regions]
+    if not donors:
+        return _copy(proc)
+    donor, (dw, dh) = rng.choice(donors)
+    tw, th = regions[id(target)]
+    replacement = _scaled_subtree(donor, tw / max(dw, 1e-6), th / max(dh, 1e-6))
+    replacement.role = role
+    out = _copy(proc)
+    parent_path, _, index = path.rpartition("/")
+    if not parent_path:
+        out.root = replacement
+    else:
+        _node(out, parent_path).children[int(index)] = replacement
+    validate(out)
+    return out
+
+
+def _box_sizes(proc: Procedure) -> dict[int, tuple[float, float]]:
+    """(width, height) of the first instance of every node, keyed by id(node)."""
+    sizes: dict[int, tuple[float, float]] = {}
+
+    def walk(node: Node, box: tuple[float, float, float, float]) -> None:
+        sizes.setdefault(id(node), (box[2] - box[0], box[3] - box[1]))
+        if node.rule == "leaf":
+            return
+        k = 0 if node.axis == "x" else 1
+        lo, hi = box[k], box[k + 2]
+        items, children, _ = expand(node, hi - lo)
+        pos = lo
+        for child, length in zip(children, layout(items, hi - lo), strict=True):
+            sub = list(box)
+            sub[k], sub[k + 2] = pos, pos + length
+            pos += length
+            if id(child) not in sizes:
+                walk(child, tuple(sub))
+
+    walk(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)))
+    return sizes
+
+
+def vary(proc: Procedure, n: int = 8, seed: int = 0) -> list[Procedure]:
+    """``n`` variants: counts of floors and tiles changed, the facade resized with its repeats adapting,
+    tiles or floors swapped within the style. Deterministic by seed; every variant is valid."""
+    if not 1 <= n <= 64:
+        raise ValueError(f"n must be between 1 and 64, got {n}")
+    rng = random.Random(f"facaid-vary:{seed}")
+    repeats = [p for p, node in proc.nodes() if node.rule == "repeat" and node.count != "fill"]
+    roles = [r for r in ("tile", "floor") if any(node.role == r for _, node in proc.nodes())]
+    style = proc.meta.get("style")
+    out = []
+    for i in range(n):
+        kinds = ["resize"] + (["count"] if repeats else []) + (["swap"] if roles else [])
+        kind = kinds[i % len(kinds)] if i < len(kinds) else rng.choice(kinds)
+        if kind == "count":
+            path = rng.choice(repeats)
+            delta = rng.choice([-2, -1, 1, 2])
+            variant = change_count(proc, path, delta)
+        elif kind == "swap":
+            variant = swap(proc, rng.choice(roles), rng, style)
+        else:
+            variant = resize(proc, round(proc.width * rng.uniform(0.7, 1.5)),
+                             round(proc.height * rng.uniform(0.8, 1.3)))
+        variant.meta = {**proc.meta, "variation": kind, "variation_seed": seed, "variation_index": i}
+        out.append(variant)
+    return out

@@ -1,0 +1,78 @@
+import random
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from facaid.cli import main
+from facaid.generator import STYLE_NAMES, generate_procedure
+from facaid.grammar import Procedure, ProcedureError, execute, validate
+from facaid.labels import LABELS
+from facaid.variation import change_count, resize, swap, vary, with_count, with_size
+
+
+def windows(proc):
+    return sum(1 for lab, *_ in execute(proc) if LABELS[lab] == "window")
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32), st.sampled_from(STYLE_NAMES), st.integers(0, 1000))
+def test_variants_are_valid_and_deterministic(seed, style, vseed):
+    proc = generate_procedure(seed, style)
+    a = vary(proc, 6, vseed)
+    b = vary(proc, 6, vseed)
+    assert [v.to_json() for v in a] == [v.to_json() for v in b]
+    for v in a:
+        validate(v)
+    assert {v.meta["variation"] for v in a} >= {"resize", "count"}
+    assert proc.to_json() == generate_procedure(seed, style).to_json()  # the input is untouched
+
+
+def test_resize_adapts_repeats():
+    proc = generate_procedure(4, "modernist")
+    wider = resize(proc, proc.width * 2, proc.height)
+    assert windows(wider) > 1.6 * windows(proc)
+    with pytest.raises(ValueError, match="between 1 and 100000"):
+        resize(proc, 0, 10)
+
+
+def test_change_count_grows_the_image():
+    proc = generate_procedure(4, "modernist")
+    path = next(p for p, n in proc.nodes() if n.rule == "repeat" and n.axis == "y")
+    taller = change_count(proc, path, 2)
+    assert taller.height > proc.height
+    with pytest.raises(ProcedureError, match="not a repeat"):
+        change_count(proc, "root", 1)
+
+
+def test_swap_replaces_a_tile():
+    proc = generate_procedure(9, "tenement")
+    out = swap(proc, "tile", random.Random(3), "tenement")
+    validate(out)
+    with pytest.raises(ValueError, match="no node with role"):
+        swap(proc, "no-such-role", random.Random(0))
+
+
+def test_parameter_edits():
+    proc = generate_procedure(2)
+    path = next(p for p, n in proc.nodes() if n.sizes and n.sizes[0].mode == "abs")
+    edited = with_size(proc, path, 0, 33.0)
+    assert edited.parameters() != proc.parameters()
+    with pytest.raises(ProcedureError, match="negative"):
+        with_size(proc, path, 0, -1.0)
+    with pytest.raises(ProcedureError, match="no size 99"):
+        with_size(proc, path, 99, 1.0)
+    with pytest.raises(ProcedureError, match="no such node"):
+        with_size(proc, "root/9/9/9", 0, 1.0)
+    rep = next(p for p, n in proc.nodes() if n.rule == "repeat")
+    assert with_count(proc, rep, 3).to_dict() != proc.to_dict()
+
+
+def test_cli_vary(tmp_path, capsys):
+    src = tmp_path / "p.json"
+    src.write_text(generate_procedure(5).to_json())
+    assert main(["vary", str(src), "--n", "4", "--seed", "2", "--out", str(tmp_path / "v")]) == 0
+    assert sorted(p.name for p in (tmp_path / "v").iterdir()) == [
+        "variant-00.json", "variant-01.json", "variant-02.json", "variant-03.json", "variants.png"]
+    for i in range(4):
+        Procedure.from_json((tmp_path / "v" / f"variant-0{i}.json").read_text())
