@@ -176,6 +176,22 @@ def cmd_vary(args: argparse.Namespace) -> None:
     print(f"wrote {len(variants)} variants and variants.png (the original first) to {out}/")
 
 
+def cmd_evaluate_real(args: argparse.Namespace) -> None:
+    from facaid.evaluation.real import evaluate_real, format_summary
+    from facaid.model import load_model
+
+    if not Path(args.data).is_file():
+        raise CliError(f"annotations not found at {args.data} (pass --data PATH)")
+    model, tokenizer = load_model(args.checkpoint)
+    result = evaluate_real(model, tokenizer, args.data, k=args.k, limit=args.limit, gallery=args.gallery,
+                           progress=not args.quiet)
+    result["checkpoint"] = str(args.checkpoint)
+    print(format_summary(result))
+    if args.gallery:
+        print(f"gallery (input | reconstruction): {args.gallery}")
+    _write_json(args.json, result)
+
+
 def cmd_demo(args: argparse.Namespace) -> None:
     from facaid.generator import generate
     from facaid.render import render_segmentation, side_by_side
@@ -277,6 +293,19 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--seed", type=int, default=0)
     v.add_argument("--out", default="out/variants", help="output directory (default out/variants)")
     v.set_defaults(func=cmd_vary)
+
+    r2 = sub.add_parser("evaluate-real", help="reconstruct the CMP facades and compare (evaluation only)",
+                        description="Reconstruct every facade of an annotations.jsonl (CMP format) and report mean "
+                                    "pixel accuracy, per-class IoU and time per facade beside the all-wall "
+                                    "baseline, with a gallery PNG (input | reconstruction).")
+    r2.add_argument("--data", default=str(DEFAULT_CMP), help="annotations.jsonl (default: the shared CMP file)")
+    r2.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory")
+    r2.add_argument("--k", type=int, default=4, help="candidates per facade (default 4)")
+    r2.add_argument("--limit", type=int, help="only the first N facades")
+    r2.add_argument("--gallery", default="out/evaluate-real/gallery.png", help="gallery PNG of the first 20")
+    r2.add_argument("--json", help="write the figures to this JSON file")
+    r2.add_argument("--quiet", action="store_true", help="no progress bar")
+    r2.set_defaults(func=cmd_evaluate_real)
 
     d = sub.add_parser("demo", help="generate one facade per style with pictures",
                        description="Generate one facade per style preset and write procedures, "

@@ -12,14 +12,16 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import torch
 
 from facaid.decoding import best_of_k
 from facaid.grammar.procedure import Procedure
+from facaid.labels import FACADE
 from facaid.metrics import procedure_accuracy
 from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
-from facaid.segmentation import Segmentation, flatten
+from facaid.segmentation import Segmentation, flatten, flatten_array
 from facaid.sizing import fit_sizes
 from facaid.tokenizer import Tokenizer
 
@@ -35,6 +37,20 @@ class Reconstruction:
     def to_dict(self) -> dict[str, Any]:
         return {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
                 "timings": self.timings}
+
+
+def fit_to_model(seg: Segmentation, tokenizer: Tokenizer) -> Segmentation:
+    """The segmentation, or, when it has more rectangles than the model reads, the same with its smallest
+    elements left out until it fits (the sizing still fits against the full segmentation)."""
+    limit = tokenizer.config.max_rects
+    rows = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
+    if len(rows) <= limit:
+        return seg
+    footprint = rows[rows[:, 0] == FACADE]
+    elements = rows[rows[:, 0] != FACADE]
+    area = (elements[:, 3] - elements[:, 1]) * (elements[:, 4] - elements[:, 2])
+    keep = elements[np.argsort(-area, kind="stable")[: max(0, limit - len(footprint))]]
+    return Segmentation.from_array(seg.width, seg.height, np.concatenate([footprint, keep]))
 
 
 @lru_cache(maxsize=4)
@@ -54,7 +70,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     t0 = time.perf_counter()
     flat = flatten(seg)
     t1 = time.perf_counter()
-    best = best_of_k(model, tokenizer, flat, k=k, seed=seed, prefix=prefix)
+    best = best_of_k(model, tokenizer, fit_to_model(flat, tokenizer), k=k, seed=seed, prefix=prefix)
     t2 = time.perf_counter()
     decoded = best.procedure
     before = procedure_accuracy(decoded, flat)

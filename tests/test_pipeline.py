@@ -47,3 +47,30 @@ def test_cli_reconstruct(tiny, tmp_path, capsys):
                         '"y1": 2}]}')
     assert main(["reconstruct", str(seg_path), "--out", str(out), "--checkpoint", str(tmp_path / "ckpt")]) == 2
     assert "0 <= x0 < x1 <= width=5" in capsys.readouterr().err
+
+
+def test_fit_to_model_drops_the_smallest_elements():
+    from facaid.pipeline import fit_to_model
+    from facaid.segmentation import flatten
+
+    seg = generate(6).segmentation
+    small = Tokenizer(TokenizerConfig(max_rects=20))
+    fitted = fit_to_model(seg, small)
+    assert len(flatten(fitted, wall="footprint").rects) <= 20
+    assert fit_to_model(seg, Tokenizer(CONFIG)) is seg
+
+
+def test_evaluate_real_on_cmp_records(tiny, tmp_path, cmp_records, capsys):
+    model, tok = tiny
+    data = tmp_path / "cmp.jsonl"
+    data.write_text("\n".join(json.dumps(r) for r in cmp_records[:2]) + "\n")
+    save_model(model, tok, tmp_path / "ckpt")
+    out = tmp_path / "real.json"
+    assert main(["evaluate-real", "--data", str(data), "--checkpoint", str(tmp_path / "ckpt"), "--k", "1",
+                 "--gallery", str(tmp_path / "g" / "gallery.png"), "--json", str(out), "--quiet"]) == 0
+    figures = json.loads(out.read_text())
+    assert figures["facades"] == 2
+    assert 0 < figures["baseline_all_wall"]["mean"] < 1
+    assert figures["pixel_accuracy"]["mean"] >= 0
+    assert (tmp_path / "g" / "gallery.png").is_file()
+    assert "all-wall baseline" in capsys.readouterr().out
