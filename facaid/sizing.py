@@ -62,8 +62,8 @@ def soft_coverage(boxes: torch.Tensor, labels: torch.Tensor, width: int, height:
     return (per_class.T @ mx).reshape(len(LABELS), height, width)  # (C, H, W)
 
 
-def fit_sizes(proc: Procedure, target: Segmentation, *, geometry_rounds: int = 6, geometry_steps: int = 40,
-              geometry_lr: float = 0.03, polish_steps: int = 60, resolution: int = 192, lr: float = 0.01,
+def fit_sizes(proc: Procedure, target: Segmentation, *, geometry_rounds: int = 4, geometry_steps: int = 30,
+              geometry_lr: float = 1.0, polish_steps: int = 60, resolution: int = 192, lr: float = 0.01,
               patience: int = 15, device: str | torch.device = "cpu") -> SizingResult:
     """Fit the sizes of ``proc`` to ``target`` (same image size); returns the fitted procedure and figures.
 
@@ -174,11 +174,13 @@ def _match(boxes: np.ndarray, labels: np.ndarray, rects: np.ndarray) -> tuple[np
 
 
 def fit_geometry(plan, free: torch.Tensor, is_rel: torch.Tensor, labels: torch.Tensor, target: Segmentation,
-                 rounds: int = 6, steps: int = 40, lr: float = 0.03) -> None:
+                 rounds: int = 4, steps: int = 30, lr: float = 1.0) -> None:
     """Direct fit: move ``free`` (in place) so that matched leaf edges land on their target edges."""
     rects = _target_rects(target)
     side = float(max(target.width, target.height))
-    opt = torch.optim.Adam([free], lr=lr)
+    # L-BFGS, not Adam: Adam's normalized steps move sizes that no matched edge constrains as much as the
+    # ones that are, and such sizes drift; with curvature, an unconstrained size keeps its decoded value
+    opt = torch.optim.LBFGS([free], lr=lr, max_iter=steps, history_size=20, line_search_fn="strong_wolfe")
     lab = labels.cpu().numpy()
     for r in range(rounds):
         with torch.no_grad():
@@ -190,17 +192,19 @@ def fit_geometry(plan, free: torch.Tensor, is_rel: torch.Tensor, labels: torch.T
         # a pillar merged over all floors); the tolerance tightens from round to round
         mine = boxes[idx]
         extent = np.concatenate([mine[:, 2:] - mine[:, :2]] * 2, axis=1)  # (M, 4): w, h, w, h
-        tolerance = np.maximum(0.02 * side, extent * (0.5 if r == 0 else 0.25))
+        tolerance = np.maximum(3.0 if r == 0 else 1.5, extent * (0.35 if r == 0 else 0.1))
         weight = torch.from_numpy((np.abs(mine - goal) <= tolerance).astype(np.float64)).to(free.device)
         idx_t = torch.from_numpy(idx).to(free.device)
         goal_t = torch.from_numpy(goal).to(free.device)
-        for _ in range(steps):
-            all_boxes, overflow = execute_plan(plan, _from_free(free, is_rel).double(), with_overflow=True)
-            err = torch.nn.functional.smooth_l1_loss(all_boxes[idx_t] / side, goal_t / side, beta=0.01,
-                                                     reduction="none")
-            loss = (err * weight).sum() / weight.sum().clamp_min(1.0) + overflow / side
+
+        def closure(idx_t=idx_t, goal_t=goal_t, weight=weight) -> torch.Tensor:
             opt.zero_grad()
+            all_boxes, overflow = execute_plan(plan, _from_free(free, is_rel).double(), with_overflow=True)
+            err = (all_boxes[idx_t] - goal_t) / side
+            loss = (err**2 * weight).sum() / weight.sum().clamp_min(1.0) + overflow / side * 1e-3
             loss.backward()
-            opt.step()
+            return loss
+
+        opt.step(closure)
 
 

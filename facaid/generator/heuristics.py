@@ -173,6 +173,12 @@ class Builder:
                 h = rng.uniform(0.15, 0.3)
                 items.append((self.abs(h), Node.leaf("sill")))
                 used += h
+        fixed = sum(size.value for size, _ in items)
+        room = floor_h - 0.1
+        if fixed > room:  # a tall window unit in a low floor: shrink it so every size takes effect
+            f = room / fixed
+            items = [(self.abs(size.value * f), node) for size, node in items]
+            used, window_h = used * f, window_h * f
         top = ft.top_gap
         bottom = floor_h - top - used - window_h
         if ft.balcony == "band":
