@@ -1,0 +1,74 @@
+"""Reconstruction: sizing accuracy and time, and the whole pipeline with the shipped model.
+
+    .venv/bin/python bench/bench_reconstruct.py [--count 100] [--k 4] [--checkpoint DIR] [--no-model]
+
+Held-out generated facades (dataset seed 1000). Sizing alone starts from the true structure with sizes
+quantized by the tokenizer (what a perfect decoder would give); the pipeline runs `facaid.reconstruct`.
+Targets (issue C): median pixel accuracy >= 99 %, >= 95 % of facades >= 95 %, median <= 1 s on 2 CPU cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+
+from facaid.generator import generate
+from facaid.generator.dataset import sample_seed
+from facaid.paths import DEFAULT_CHECKPOINT
+from facaid.sizing import fit_sizes
+from facaid.tokenizer import Tokenizer, TokenizerConfig
+
+
+def report(name: str, acc: list[float], secs: list[float]) -> None:
+    a = np.array(acc)
+    print(f"{name}: {len(a)} facades, pixel accuracy median {100 * np.median(a):.2f} %, mean {100 * a.mean():.2f} %, "
+          f">= 95 %: {100 * (a >= 0.95).mean():.1f} % of facades; time median {1000 * statistics.median(secs):.0f} ms, "
+          f"p90 {1000 * float(np.percentile(secs, 90)):.0f} ms")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--count", type=int, default=100)
+    parser.add_argument("--k", type=int, default=4)
+    parser.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT))
+    parser.add_argument("--no-model", action="store_true")
+    args = parser.parse_args()
+    samples = [generate(sample_seed(1000, i)) for i in range(args.count)]
+
+    tok = Tokenizer(TokenizerConfig(max_rects=5000, max_out=5000))
+    acc, secs, before = [], [], []
+    for s in samples:
+        q = tok.decode_procedure(tok.encode_procedure(s.procedure)[0], s.procedure.width, s.procedure.height)
+        t0 = time.perf_counter()
+        r = fit_sizes(q, s.segmentation)
+        secs.append(time.perf_counter() - t0)
+        acc.append(r.accuracy)
+        before.append(r.accuracy_before)
+    print(f"quantized sizes before sizing: median {100 * np.median(before):.2f} %")
+    report("sizing from quantized sizes", acc, secs)
+
+    if args.no_model:
+        return
+    from facaid.model import load_model
+    from facaid.pipeline import reconstruct
+
+    model, tokenizer = load_model(args.checkpoint)
+    acc, secs, decoded = [], [], []
+    for s in samples:
+        t0 = time.perf_counter()
+        try:
+            r = reconstruct(s.segmentation, model=model, tokenizer=tokenizer, k=args.k)
+        except ValueError:
+            continue
+        secs.append(time.perf_counter() - t0)
+        acc.append(r.accuracy)
+        decoded.append(r.accuracy_decoded)
+    print(f"decoded (best of {args.k}) before sizing: median {100 * np.median(decoded):.2f} %")
+    report(f"facaid.reconstruct, best of {args.k}", acc, secs)
+
+
+if __name__ == "__main__":
+    main()
