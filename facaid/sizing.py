@@ -20,7 +20,7 @@ import numpy as np
 import torch
 
 from facaid.grammar.differentiable import compile_plan, execute_plan
-from facaid.grammar.procedure import Procedure
+from facaid.grammar.procedure import Procedure, ProcedureError
 from facaid.labels import FACADE, LABELS
 from facaid.metrics import procedure_accuracy, procedure_iou, scaled_label_map
 from facaid.segmentation import Segmentation
@@ -48,7 +48,8 @@ def _to_free(values: torch.Tensor, is_rel: torch.Tensor) -> torch.Tensor:
 
 
 def _from_free(free: torch.Tensor, is_rel: torch.Tensor) -> torch.Tensor:
-    return torch.where(is_rel, torch.sigmoid(free), torch.exp(free))
+    # clamped: a wild optimizer step must not leave the grammar's range (sizes up to 100,000 px)
+    return torch.where(is_rel, torch.sigmoid(free), torch.exp(free.clamp(-12.0, 11.5)))
 
 
 def soft_coverage(boxes: torch.Tensor, labels: torch.Tensor, width: int, height: int, tau: float) -> torch.Tensor:
@@ -86,8 +87,8 @@ def fit_sizes(proc: Procedure, target: Segmentation, *, geometry_rounds: int = 4
     if geometry_rounds:
         fit_geometry(plan, free, is_rel, labels, target, rounds=geometry_rounds, steps=geometry_steps, lr=geometry_lr)
         steps += geometry_rounds * geometry_steps
-        candidate = proc.with_parameters(_from_free(free.detach(), is_rel).double().cpu().tolist())
-        acc = procedure_accuracy(candidate, target)
+        candidate = _candidate(proc, free, is_rel)
+        acc = procedure_accuracy(candidate, target) if candidate is not None else -1.0
         if acc > best_acc:
             best_proc, best_acc = candidate, acc
     loss = 0.0
@@ -96,11 +97,19 @@ def fit_sizes(proc: Procedure, target: Segmentation, *, geometry_rounds: int = 4
         free = free.float().clone().requires_grad_(True)
         loss, done = _polish(plan, free, is_rel, labels, target, polish_steps, resolution, lr, patience)
         steps += done
-        candidate = proc.with_parameters(_from_free(free.detach(), is_rel).double().cpu().tolist())
-        acc = procedure_accuracy(candidate, target)
+        candidate = _candidate(proc, free, is_rel)
+        acc = procedure_accuracy(candidate, target) if candidate is not None else -1.0
         if acc > best_acc:
             best_proc, best_acc = candidate, acc
     return SizingResult(best_proc, steps, loss, before, best_acc, procedure_iou(best_proc, target))
+
+
+def _candidate(proc: Procedure, free: torch.Tensor, is_rel: torch.Tensor) -> Procedure | None:
+    """The procedure with the optimized sizes, or None if the optimizer left the valid range (NaN)."""
+    try:
+        return proc.with_parameters(_from_free(free.detach(), is_rel).double().cpu().tolist())
+    except ProcedureError:
+        return None
 
 
 def _polish(plan, free: torch.Tensor, is_rel: torch.Tensor, labels: torch.Tensor, target: Segmentation,

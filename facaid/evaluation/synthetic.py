@@ -24,6 +24,7 @@ from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.grammar.procedure import Node
 from facaid.model import FacaidModel, batch_inputs, batch_outputs
+from facaid.pipeline import fit_to_model
 from facaid.tokenizer import TokenGrammar, Tokenizer
 
 NOISE_LEVELS = (0.0, 0.05, 0.10, 0.15, 0.20)
@@ -107,7 +108,7 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
             noise_measured[0.0].append(0.0)
             for level in NOISE_LEVELS[1:]:
                 noisy, measured = perturb(s.segmentation, level, seed=i)
-                p = decode(model, tokenizer, noisy)[0]
+                p = decode(model, tokenizer, fit_to_model(noisy, tokenizer))[0]  # noise can add pieces
                 noise_teds[level].append(tree_edit_distance(s.procedure.root, p.procedure.root))
                 noise_measured[level].append(measured)
 
