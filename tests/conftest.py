@@ -13,3 +13,21 @@ def cmp_records():
         pytest.skip(f"CMP annotations not found at {CMP}")
     with open(CMP) as f:
         return [json.loads(next(f)) for _ in range(25)]
+
+
+TINY_TOKENIZER = {"max_rects": 1000, "max_out": 200}
+
+
+@pytest.fixture(scope="session")
+def tiny():
+    """An untrained model of the smallest size, with its tokenizer: for testing code paths, not quality."""
+    import torch
+
+    from facaid.model import FacaidConfig, FacaidModel
+    from facaid.tokenizer import Tokenizer, TokenizerConfig
+
+    config = TokenizerConfig(**TINY_TOKENIZER)
+    torch.manual_seed(0)
+    model = FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32,
+                                     tokenizer=config.to_dict())).eval()
+    return model, Tokenizer(config)

@@ -1,26 +1,14 @@
 import json
 
 import pytest
-import torch
 
 from facaid.cli import main
 from facaid.decoding import decode
 from facaid.evaluation.noise import changed_fraction, perturb
 from facaid.evaluation.synthetic import evaluate_synthetic, nll, write_report
 from facaid.generator import generate
-from facaid.model import FacaidConfig, FacaidModel, save_model
+from facaid.model import save_model
 from facaid.segmentation import flatten
-from facaid.tokenizer import Tokenizer, TokenizerConfig
-
-CONFIG = TokenizerConfig(max_rects=1000, max_out=200)
-
-
-@pytest.fixture(scope="module")
-def tiny():
-    torch.manual_seed(0)
-    model = FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32,
-                                     tokenizer=CONFIG.to_dict())).eval()
-    return model, Tokenizer(CONFIG)
 
 
 @pytest.mark.parametrize("level", [0.05, 0.1, 0.2])
@@ -40,7 +28,7 @@ def test_nullification_never_raises_the_nll(tiny):
     for seed in range(40):
         s = generate(seed)
         tokens = tok.encode_procedure(s.procedure)
-        if len(tokens[0]) <= CONFIG.max_out:
+        if len(tokens[0]) <= tok.config.max_out:
             examples.append({"rows": tok.encode_segmentation(s.segmentation), "tokens": tokens,
                              "width": s.procedure.width, "height": s.procedure.height})
     plain, nullified = nll(model, tok, examples[:4])

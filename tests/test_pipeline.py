@@ -1,25 +1,12 @@
 import json
 
-import pytest
-import torch
-
 import facaid
 from facaid.cli import main
 from facaid.generator import generate
 from facaid.grammar import Procedure, validate
-from facaid.model import FacaidConfig, FacaidModel, save_model
+from facaid.model import save_model
 from facaid.pipeline import reconstruct
 from facaid.tokenizer import Tokenizer, TokenizerConfig
-
-CONFIG = TokenizerConfig(max_rects=1000, max_out=200)
-
-
-@pytest.fixture(scope="module")
-def tiny():
-    torch.manual_seed(0)
-    model = FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32,
-                                     tokenizer=CONFIG.to_dict())).eval()
-    return model, Tokenizer(CONFIG)
 
 
 def test_reconstruct_returns_a_valid_sized_procedure(tiny):
@@ -57,7 +44,7 @@ def test_fit_to_model_drops_the_smallest_elements():
     small = Tokenizer(TokenizerConfig(max_rects=20))
     fitted = fit_to_model(seg, small)
     assert len(flatten(fitted, wall="footprint").rects) <= 20
-    assert fit_to_model(seg, Tokenizer(CONFIG)) is seg
+    assert fit_to_model(seg, Tokenizer(TokenizerConfig(max_rects=1000))) is seg
 
 
 def test_evaluate_real_on_cmp_records(tiny, tmp_path, cmp_records, capsys):
