@@ -9,7 +9,7 @@ from __future__ import annotations
 import random
 
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.grammar.execute import expand, layout
+from facaid.grammar.execute import first_boxes
 from facaid.grammar.procedure import MAX_COUNT, Node, Procedure, ProcedureError, Size, validate
 
 
@@ -135,25 +135,7 @@ def swap(proc: Procedure, role: str, rng: random.Random, style: str | None = Non
 
 def _box_sizes(proc: Procedure) -> dict[int, tuple[float, float]]:
     """(width, height) of the first instance of every node, keyed by id(node)."""
-    sizes: dict[int, tuple[float, float]] = {}
-
-    def walk(node: Node, box: tuple[float, float, float, float]) -> None:
-        sizes.setdefault(id(node), (box[2] - box[0], box[3] - box[1]))
-        if node.rule == "leaf":
-            return
-        k = 0 if node.axis == "x" else 1
-        lo, hi = box[k], box[k + 2]
-        items, children, _ = expand(node, hi - lo)
-        pos = lo
-        for child, length in zip(children, layout(items, hi - lo), strict=True):
-            sub = list(box)
-            sub[k], sub[k + 2] = pos, pos + length
-            pos += length
-            if id(child) not in sizes:
-                walk(child, tuple(sub))
-
-    walk(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)))
-    return sizes
+    return {k: (b[2] - b[0], b[3] - b[1]) for k, b in first_boxes(proc).items()}
 
 
 def vary(proc: Procedure, n: int = 8, seed: int = 0) -> list[Procedure]:

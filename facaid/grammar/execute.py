@@ -89,6 +89,7 @@ class _Executor:
         self.trace = trace
         self.layouts: dict[tuple[int, float], tuple] = {}  # repeated copies share their layout
         self.fill_counts: dict[int, int] = {}
+        self.first_boxes: dict[int, tuple[float, float, float, float]] | None = None  # set to record them
         self.offsets: dict[int, int] = {}
         if trace is not None:
             k = 0
@@ -99,6 +100,8 @@ class _Executor:
     def run(self, node: Node, box: tuple[float, float, float, float], flips: tuple[bool, bool],
             where: tuple, me: int) -> None:
         # ``where`` is (parent's where, child index): the node path, formatted only for an error
+        if self.first_boxes is not None:
+            self.first_boxes.setdefault(id(node), box)
         if node.rule == "leaf":
             self.leaf(node, box, where, me)
             return
@@ -138,7 +141,7 @@ class _Executor:
                 trace.mode.append(sizes[i].mode)
                 trace.axis.append(node.axis)
                 trace.flip.append(flip)
-            if child.rule == "leaf":  # most nodes are leaves: no call
+            if child.rule == "leaf" and self.first_boxes is None:  # most nodes are leaves: no call
                 self.leaf(child, sub, (where, i % n_pattern), child_id)
             else:
                 self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), child_id)
@@ -190,6 +193,14 @@ def fill_counts(proc: Procedure) -> dict[int, int]:
     ex = _Executor(proc, None)
     ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
     return ex.fill_counts
+
+
+def first_boxes(proc: Procedure) -> dict[int, tuple[float, float, float, float]]:
+    """The box of the first instance of every node, keyed by ``id(node)``."""
+    ex = _Executor(proc, None)
+    ex.first_boxes = {}
+    ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
+    return ex.first_boxes
 
 
 def count_leaves(proc: Procedure) -> int:
