@@ -33,7 +33,7 @@ def train_step_times(steps: int, batch_size: int = 32) -> dict[int, float]:
         torch.manual_seed(0)
         model = FacaidModel(FacaidConfig(tokenizer=tc.to_dict()))
         rects, mask = batch_inputs([tok.encode_segmentation(s.segmentation) for s in samples])
-        ids, local, targets = batch_outputs([tok.encode_procedure(s.procedure) for s in samples])
+        ids, local, targets, _ = batch_outputs([tok.encode_procedure(s.procedure) for s in samples])
         setups[rt] = (model, torch.optim.AdamW(model.parameters(), 1e-4), (rects, mask, ids, local, targets))
     for _ in range(steps):
         for rt, (model, opt, batch) in setups.items():

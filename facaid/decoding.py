@@ -118,10 +118,12 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     gen = torch.Generator().manual_seed(seed)
     ids = torch.tensor(seqs, device=device)
     local = torch.tensor([tokenizer.local_indices(s, tokenizer.vocab) for s in seqs], device=device)
+    boxes = torch.as_tensor(tokenizer.node_boxes(start, seg.width, seg.height), device=device).expand(k, -1, -1)
     past = None
     errors: list[str | None] = [None] * k
     while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
-        logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past, use_cache=True)
+        logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past, use_cache=True,
+                                    boxes=boxes)
         scores = logits[:, -1].float() / temperature  # (K, V)
         if constrained:
             scores = scores.masked_fill(~torch.from_numpy(processor.mask()).to(device), float("-inf"))
@@ -131,7 +133,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
         else:
             nxt = logp.argmax(-1).cpu()
         prev_local = local[:, -1].tolist()
-        new_local = []
+        new_local, new_boxes, none = [], [], []
         for b, t in enumerate(nxt.tolist()):
             g = processor.grammars[b]
             if g.done or errors[b]:
@@ -144,9 +146,15 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
                     errors[b] = str(exc)
             seqs[b].append(t)
             new_local.append(tokenizer.vocab.next_local(t, prev_local[b]))
+            box = None if errors[b] else g.next_box()
+            new_boxes.append([0.0, 0.0, seg.width, seg.height] if box is None else box)
+            none.append(box is None)
         processor.seen = [len(s) for s in seqs]
         ids = nxt.view(k, 1).to(device)
         local = torch.tensor(new_local, device=device).view(k, 1)
+        q = tokenizer.quantize_boxes(np.array(new_boxes), seg.width, seg.height)
+        q[none] = 0
+        boxes = torch.as_tensor(q, device=device).view(k, 1, 4)
     out = []
     for b, g in enumerate(processor.grammars):
         if not g.done:

@@ -27,12 +27,13 @@ class FacaidConfig(PretrainedConfig):
     model_type = "facaid"
 
     def __init__(self, d_model: int = 128, encoder_layers: int = 3, decoder_layers: int = 3, heads: int = 4,
-                 ffn: int = 512, dropout: float = 0.0, encoder: str = "bidirectional",
+                 ffn: int = 512, dropout: float = 0.0, encoder: str = "bidirectional", node_boxes: bool = False,
                  tokenizer: dict | None = None, grammar: str = GRAMMAR_VERSION, **kwargs):
         super().__init__(**kwargs)
         if encoder not in ("bidirectional", "causal"):
             raise ValueError(f"encoder must be 'bidirectional' (BERT) or 'causal' (GPT-2), got {encoder!r}")
         self.encoder = encoder
+        self.node_boxes = node_boxes  # the decoder also sees the box of the node it is writing
         self.d_model = d_model
         self.encoder_layers = encoder_layers
         self.decoder_layers = decoder_layers
@@ -110,18 +111,26 @@ class FacaidModel(PreTrainedModel):
         return h, mask
 
     def decode(self, ids: torch.Tensor, local: torch.Tensor, memory: torch.Tensor, memory_mask: torch.Tensor,
-               past=None, use_cache: bool = False):
-        """ids, local (B, T) -> logits (B, T, V) and the cache."""
+               past=None, use_cache: bool = False, boxes: torch.Tensor | None = None):
+        """ids, local (B, T) and, with ``config.node_boxes``, boxes (B, T, 4) -> logits (B, T, V) and the cache.
+
+        ``boxes`` hold at each position the quantized (x, y, w, h) of the node the next token belongs to
+        (`Tokenizer.node_boxes`); they are embedded with the same tables as the input rectangles."""
         x = self.token_embedding(ids) + self.local_embedding(local)  # (B, T, d)
+        if self.config.node_boxes:
+            if boxes is None:
+                raise ValueError("this model reads node boxes: pass boxes (B, T, 4) to decode")
+            x = x + sum(emb(boxes[..., f]) for f, emb in enumerate(self.fields[1:]))
         out = self.decoder(inputs_embeds=x, encoder_hidden_states=memory,
                            encoder_attention_mask=memory_mask.long(), past_key_values=past, use_cache=use_cache)
         return self.lm_head(out.last_hidden_state), out.past_key_values  # (B, T, V)
 
     def forward(self, rects: torch.Tensor, rect_mask: torch.Tensor, ids: torch.Tensor, local: torch.Tensor,
-                targets: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor | None]:
+                targets: torch.Tensor | None = None, boxes: torch.Tensor | None = None
+                ) -> tuple[torch.Tensor, torch.Tensor | None]:
         """Teacher-forced logits (B, T, V) and, given targets (B, T) with -100 for ignored, the mean loss."""
         memory, memory_mask = self.encode(rects, rect_mask)
-        logits, _ = self.decode(ids, local, memory, memory_mask)
+        logits, _ = self.decode(ids, local, memory, memory_mask, boxes=boxes)
         loss = None
         if targets is not None:
             loss = F.cross_entropy(logits.reshape(-1, logits.shape[-1]), targets.reshape(-1), ignore_index=-100)
@@ -163,16 +172,20 @@ def batch_inputs(rows: list, device: str | torch.device = "cpu") -> tuple[torch.
     return rects.to(device), mask.to(device)
 
 
-def batch_outputs(seqs: list[tuple[list[int], list[int]]], device: str | torch.device = "cpu"
-                  ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """Teacher forcing: (ids, local, targets) each (B, T) from (ids, local) pairs with BOS ... EOS."""
-    t = max(len(ids) for ids, _ in seqs) - 1
+def batch_outputs(seqs: list[tuple], device: str | torch.device = "cpu"
+                  ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Teacher forcing: (ids, local, targets) each (B, T) and boxes (B, T, 4) from (ids, local[, boxes])
+    tuples with BOS ... EOS; boxes (`Tokenizer.node_boxes`) are zeros where a tuple has none."""
+    t = max(len(s[0]) for s in seqs) - 1
     ids = torch.full((len(seqs), t), PAD, dtype=torch.long)
     local = torch.zeros(len(seqs), t, dtype=torch.long)
     targets = torch.full((len(seqs), t), -100, dtype=torch.long)
-    for i, (seq, loc) in enumerate(seqs):
+    boxes = torch.zeros(len(seqs), t, 4, dtype=torch.long)
+    for i, (seq, loc, *rest) in enumerate(seqs):
         n = len(seq) - 1
         ids[i, :n] = torch.as_tensor(seq[:-1])
         local[i, :n] = torch.as_tensor(loc[:-1]).clamp(max=MAX_LOCAL - 1)
         targets[i, :n] = torch.as_tensor(seq[1:])
-    return ids.to(device), local.to(device), targets.to(device)
+        if rest:
+            boxes[i, :n] = torch.as_tensor(rest[0][:-1])
+    return ids.to(device), local.to(device), targets.to(device), boxes.to(device)

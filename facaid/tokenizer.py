@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from facaid.grammar.execute import fill_counts
+from facaid.grammar.execute import fill_counts, layout
 from facaid.grammar.procedure import (
     GRAMMAR_VERSION,
     MAX_CHILDREN,
@@ -137,6 +137,8 @@ class _Open:
     depth: int
     mult: int  # copies of this node after expansion
     phase: str  # "role", "extra", "sizes"
+    box: list  # [x0, y0, x1, y1] of the node's first instance, in image coordinates
+    child_boxes: list = field(default_factory=list)  # one list per child, filled in at the node's end
 
 
 class TokenGrammar:
@@ -155,7 +157,9 @@ class TokenGrammar:
         self.length = 1  # BOS
         self.nodes = 0
         self.expanded = 1  # leaves the expansion may have: sum of copies over every created slot
-        self.pending: deque[tuple[Node | None, int, int]] = deque([(None, 0, 1)])  # (parent, depth, copies)
+        # (parent, depth, copies, box): the slots whose nodes come next; a box is filled in when its parent ends
+        self.pending: deque[tuple[Node | None, int, int, list]] = deque([(None, 0, 1, [0.0, 0.0, self.width,
+                                                                                         self.height])])
         self.root: Node | None = None
         self.open: _Open | None = None
         self.done = False
@@ -181,7 +185,7 @@ class TokenGrammar:
         if self.open is None:
             if not self.pending:
                 return self._eos.copy()
-            _, depth, _ = self.pending[0]
+            _, depth, _, _ = self.pending[0]
             out = m["label"].copy()
             if (depth + 1 < MAX_DEPTH and self.nodes + 2 <= MAX_NODES
                     and 1 + self._INNER_MIN + len(self.pending) - 1 <= room):
@@ -219,8 +223,18 @@ class TokenGrammar:
             return o.mult * 2
         return o.mult
 
-    def step(self, token: int) -> None:
-        if not 0 <= token < len(self.vocab) or not self.allowed()[token]:
+    def next_box(self) -> list | None:
+        """The box (x0, y0, x1, y1) of the node the next token belongs to (its first instance), or None when
+        the next token can only be EOS or the sequence is over."""
+        if self.done:
+            return None
+        if self.open is not None:
+            return self.open.box
+        return self.pending[0][3] if self.pending else None
+
+    def step(self, token: int, check: bool = True) -> None:
+        """Consume a token; ``check=False`` skips the mask for sequences known to be valid (training data)."""
+        if check and (not 0 <= token < len(self.vocab) or not self.allowed()[token]):
             name = self.vocab.tokens[token] if 0 <= token < len(self.vocab) else str(token)
             raise TokenError(f"token {self.length} ({name}) is not allowed here")
         self.length += 1
@@ -231,7 +245,7 @@ class TokenGrammar:
             self.done = True
             return
         if self.open is None:
-            parent, depth, copies = self.pending.popleft()
+            parent, depth, copies, box = self.pending.popleft()
             if kind == "label":
                 node = Node.leaf(text.split(":", 1)[1])
             else:
@@ -239,7 +253,7 @@ class TokenGrammar:
                 node = Node(rule, axis=axis)
                 if rule == "repeat":
                     node.count = 1
-                self.open = _Open(node, depth, copies, "role")
+                self.open = _Open(node, depth, copies, "role", box)
             self.nodes += 1
             if parent is None:
                 self.root = node
@@ -267,12 +281,32 @@ class TokenGrammar:
             o.node.sizes.append(Size(kind, value))
             copies = self._child_copies(o)
             self.expanded += copies
-            self.pending.append((o.node, o.depth + 1, copies))
+            o.child_boxes.append([0.0, 0.0, 0.0, 0.0])
+            self.pending.append((o.node, o.depth + 1, copies, o.child_boxes[-1]))
         elif kind == "end":
             o.node.tail = int(text.split(":")[1])
+            self._lay_out_children(o)
             self.open = None
         else:
             raise TokenError(f"token {self.length - 1} ({text}) is not allowed here")
+
+    @staticmethod
+    def _lay_out_children(o: _Open) -> None:
+        """Fill in the first-instance boxes of the children of a node whose sizes are all read."""
+        node = o.node
+        x0, y0, x1, y1 = o.box
+        lo, hi = (x0, x1) if node.axis == "x" else (y0, y1)
+        sizes = node.sizes
+        if node.rule == "repeat":
+            sizes = sizes * node.count + sizes[: node.tail]
+        elif node.rule == "mirror":
+            sizes = sizes + sizes[::-1][(1 if node.center else 0):]
+        lengths = layout(sizes, hi - lo)
+        pos, last = lo, len(sizes) - 1
+        for i, box in enumerate(o.child_boxes):  # the first copy: the executor's layout from the near end
+            end = hi if i == last else pos + lengths[i]
+            box[:] = [pos, y0, end, y1] if node.axis == "x" else [x0, pos, x1, end]
+            pos = end
 
     def procedure(self) -> Procedure:
         if not self.done:
@@ -306,19 +340,43 @@ class Tokenizer:
 
     def encode_rect_array(self, width: int, height: int, arr: np.ndarray) -> np.ndarray:
         c = self.config
-        r = c.coord_bins
-        x = np.minimum(arr[:, 1] * r // width, r - 1)
-        y = np.minimum((height - arr[:, 4]) * r // height, r - 1)  # bottom-left origin
-        w = np.clip(np.rint((arr[:, 3] - arr[:, 1]) * r / width), 1, r)
-        h = np.clip(np.rint((arr[:, 4] - arr[:, 2]) * r / height), 1, r)
-        rows = np.stack([arr[:, 0], x, y, w, h], axis=1).astype(np.int64)
+        rows = np.concatenate([arr[:, :1].astype(np.int64), self.quantize_boxes(arr[:, 1:], width, height)], 1)
         rows = rows[np.lexsort((rows[:, 1], rows[:, 2]))]
         aspect = math.log(width / height)  # in [-log 16, log 16] for sane images
         qa = min(c.aspect_bins - 1, max(0, round((aspect / math.log(16) + 1) / 2 * (c.aspect_bins - 1))))
         meta = np.array([[len(LABELS), qa, 0, 0, 0]], dtype=np.int64)
         return np.concatenate([meta, rows])
 
+    def quantize_boxes(self, boxes: np.ndarray, width: float, height: float) -> np.ndarray:
+        """(N, 4) boxes x0, y0, x1, y1 (y down) -> (N, 4) int64 x, y, w, h at ``coord_bins``, bottom-left origin."""
+        r = self.config.coord_bins
+        b = np.asarray(boxes, dtype=np.float64)
+        x = np.clip(np.floor(b[:, 0] * r / width), 0, r - 1)
+        y = np.clip(np.floor((height - b[:, 3]) * r / height), 0, r - 1)
+        w = np.clip(np.rint((b[:, 2] - b[:, 0]) * r / width), 1, r)
+        h = np.clip(np.rint((b[:, 3] - b[:, 1]) * r / height), 1, r)
+        return np.stack([x, y, w, h], axis=1).astype(np.int64)
+
     # output
+    def node_boxes(self, ids: list[int], width: float, height: float) -> np.ndarray:
+        """(len(ids), 4) int64: at each position, the quantized box of the node the *next* token belongs to
+        (all zeros where the next token is EOS or nothing). The decoder sees it with the token, so it knows
+        which region of the input it is describing. ``ids`` start with BOS and follow the grammar."""
+        grammar = TokenGrammar(self.vocab, width, height, max_len=max(self.config.max_out, len(ids) + 1))
+        boxes, known = np.zeros((len(ids), 4)), np.zeros(len(ids), dtype=bool)
+        for t, token in enumerate(ids):
+            if t > 0 or token != BOS:
+                if token == PAD or grammar.done:
+                    break
+                grammar.step(int(token), check=False)
+            box = grammar.next_box()
+            if box is not None:
+                boxes[t], known[t] = box, True
+        out = np.zeros((len(ids), 4), dtype=np.int64)
+        if known.any():
+            out[known] = self.quantize_boxes(boxes[known], width, height)
+        return out
+
     def encode_procedure(self, proc: Procedure) -> tuple[list[int], list[int]]:
         """(token ids with BOS and EOS, local index of each token within its node group)."""
         v, c = self.vocab, self.config
@@ -351,6 +409,11 @@ class Tokenizer:
         ids.append(EOS)
         local.append(0)
         return ids, local
+
+    def encode_target(self, proc: Procedure) -> tuple[list[int], list[int], np.ndarray]:
+        """What the decoder is trained on: (ids, local indices, node boxes) of a procedure."""
+        ids, local = self.encode_procedure(proc)
+        return ids, local, self.node_boxes(ids, proc.width, proc.height)
 
     def decode_procedure(self, ids: list[int], width: float, height: float) -> Procedure:
         """Parse output tokens (with or without BOS) back into a procedure; raise `TokenError` if invalid."""

@@ -64,7 +64,7 @@ def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainC
     tok = build(TokenizerConfig, "tokenizer")
     train = build(TrainConfig, "train")
     model_values = raw.get("model", {})
-    allowed = {"d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder"}
+    allowed = {"d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder", "node_boxes"}
     bad = set(model_values) - allowed
     if bad:
         raise ValueError(f"{path}: unknown key(s) in [model]: {', '.join(sorted(bad))}")
@@ -72,7 +72,7 @@ def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainC
 
 
 class SampleStream:
-    """Endless (rects, (ids, local)) examples from generated facades, skipping those too long for the model."""
+    """Endless (rects, (ids, local, boxes)) examples from generated facades, skipping those too long for the model."""
 
     def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0):
         self.tokenizer = tokenizer
@@ -83,14 +83,14 @@ class SampleStream:
     def example(self, index: int):
         s = generate(sample_seed(self.seed, index))
         c = self.tokenizer.config
-        out = self.tokenizer.encode_procedure(s.procedure)
-        if len(out[0]) > c.max_out:
+        target = self.tokenizer.encode_target(s.procedure)
+        if len(target[0]) > c.max_out:
             return None
         try:
             rows = self.tokenizer.encode_segmentation(s.segmentation)
         except ValueError:  # too many rectangles
             return None
-        return rows, out
+        return rows, target
 
     def __next__(self):
         while True:
@@ -155,8 +155,8 @@ def validation_loss(model: FacaidModel, examples: list, batch_size: int, device)
     for i in range(0, len(examples), batch_size):
         chunk = examples[i : i + batch_size]
         rects, mask = batch_inputs([ex[0] for ex in chunk], device)
-        ids, local, targets = batch_outputs([ex[1] for ex in chunk], device)
-        _, loss = model(rects, mask, ids, local, targets)
+        ids, local, targets, boxes = batch_outputs([ex[1] for ex in chunk], device)
+        _, loss = model(rects, mask, ids, local, targets, boxes)
         n = int((targets != -100).sum())
         total += float(loss) * n
         count += n
@@ -233,11 +233,11 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
             break
         batch = next(batches)
         rects, mask = batch_inputs([ex[0] for ex in batch], device)
-        ids, local, targets = batch_outputs([ex[1] for ex in batch], device)
+        ids, local, targets, boxes = batch_outputs([ex[1] for ex in batch], device)
         for group in opt.param_groups:
             group["lr"] = lr_at(step, cfg)
         with torch.autocast(device.type, dtype=torch.bfloat16, enabled=use_amp):
-            _, loss = model(rects, mask, ids, local, targets)
+            _, loss = model(rects, mask, ids, local, targets, boxes)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)

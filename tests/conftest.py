@@ -28,6 +28,6 @@ def tiny():
 
     config = TokenizerConfig(**TINY_TOKENIZER)
     torch.manual_seed(0)
-    model = FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32,
+    model = FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32, node_boxes=True,
                                      tokenizer=config.to_dict())).eval()
     return model, Tokenizer(config)

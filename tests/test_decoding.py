@@ -76,7 +76,7 @@ def test_length_budget_closes_deep_trees():
 @pytest.fixture(scope="module")
 def tiny_model():
     torch.manual_seed(0)
-    return FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32,
+    return FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32, node_boxes=True,
                                     tokenizer=CONFIG.to_dict())).eval()
 
 

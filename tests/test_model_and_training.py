@@ -8,7 +8,7 @@ from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs,
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 from facaid.train import load_config, lr_at, train
 
-TINY = {"d_model": 16, "encoder_layers": 1, "decoder_layers": 1, "heads": 2, "ffn": 32}
+TINY = {"d_model": 16, "encoder_layers": 1, "decoder_layers": 1, "heads": 2, "ffn": 32, "node_boxes": True}
 
 
 def tiny(rect_tokens=1, max_out=768, encoder="bidirectional"):
@@ -20,15 +20,15 @@ def tiny(rect_tokens=1, max_out=768, encoder="bidirectional"):
 def batch(tok, seeds):
     samples = [generate(s) for s in seeds]
     rects, mask = batch_inputs([tok.encode_segmentation(s.segmentation) for s in samples])
-    ids, local, targets = batch_outputs([tok.encode_procedure(s.procedure) for s in samples])
-    return rects, mask, ids, local, targets
+    ids, local, targets, boxes = batch_outputs([tok.encode_target(s.procedure) for s in samples])
+    return rects, mask, ids, local, targets, boxes
 
 
 @pytest.mark.parametrize("rect_tokens, encoder", [(1, "bidirectional"), (5, "bidirectional"), (1, "causal")])
 def test_forward_shapes_and_loss(rect_tokens, encoder):
     model, tok = tiny(rect_tokens, encoder=encoder)
-    rects, mask, ids, local, targets = batch(tok, [1, 2, 3])
-    logits, loss = model(rects, mask, ids, local, targets)
+    rects, mask, ids, local, targets, boxes = batch(tok, [1, 2, 3])
+    logits, loss = model(rects, mask, ids, local, targets, boxes)
     assert logits.shape == (*ids.shape, len(tok.vocab))
     assert loss.item() == pytest.approx(torch.log(torch.tensor(float(len(tok.vocab)))).item(), rel=0.1)
     memory, memory_mask = model.encode(rects, mask)
@@ -38,11 +38,11 @@ def test_forward_shapes_and_loss(rect_tokens, encoder):
 def test_padding_does_not_change_a_sequence():
     model, tok = tiny()
     model.eval()
-    rects, mask, ids, local, _ = batch(tok, [7, 8])
+    rects, mask, ids, local, _, boxes = batch(tok, [7, 8])
     alone = batch(tok, [7])
     with torch.no_grad():
-        both = model(rects, mask, ids, local)[0][0]
-        one = model(*alone[:4])[0][0]
+        both = model(rects, mask, ids, local, boxes=boxes)[0][0]
+        one = model(*alone[:4], boxes=alone[5])[0][0]
     n = alone[2].shape[1]
     assert torch.allclose(both[:n], one, atol=1e-5)
 
@@ -50,12 +50,13 @@ def test_padding_does_not_change_a_sequence():
 def test_cached_and_uncached_decoding_agree():
     model, tok = tiny()
     model.eval()
-    rects, mask, ids, local, _ = batch(tok, [9])
+    rects, mask, ids, local, _, boxes = batch(tok, [9])
     with torch.no_grad():
         memory, mmask = model.encode(rects, mask)
-        full, _ = model.decode(ids, local, memory, mmask)
-        first, past = model.decode(ids[:, :10], local[:, :10], memory, mmask, use_cache=True)
-        nxt, _ = model.decode(ids[:, 10:11], local[:, 10:11], memory, mmask, past, use_cache=True)
+        full, _ = model.decode(ids, local, memory, mmask, boxes=boxes)
+        first, past = model.decode(ids[:, :10], local[:, :10], memory, mmask, use_cache=True, boxes=boxes[:, :10])
+        nxt, _ = model.decode(ids[:, 10:11], local[:, 10:11], memory, mmask, past, use_cache=True,
+                              boxes=boxes[:, 10:11])
     assert torch.allclose(full[:, 10], nxt[:, 0], atol=1e-5)
 
 
@@ -64,10 +65,13 @@ def test_save_load_round_trip_and_grammar_check(tmp_path):
     save_model(model, tok, tmp_path / "ckpt")
     loaded, tok2 = load_model(tmp_path / "ckpt")
     assert tok2.vocab.tokens == tok.vocab.tokens
-    rects, mask, ids, local, _ = batch(tok, [3])
+    rects, mask, ids, local, _, boxes = batch(tok, [3])
     model.eval()
     with torch.no_grad():
-        assert torch.equal(model(rects, mask, ids, local)[0], loaded(rects, mask, ids, local)[0])
+        assert torch.equal(model(rects, mask, ids, local, boxes=boxes)[0],
+                           loaded(rects, mask, ids, local, boxes=boxes)[0])
+        with pytest.raises(ValueError, match="reads node boxes"):
+            model(rects, mask, ids, local)
     assert (tmp_path / "ckpt" / "model.safetensors").is_file()
     cfg = json.loads((tmp_path / "ckpt" / "config.json").read_text())
     cfg["grammar"] = "facaid-split-0"
@@ -86,6 +90,7 @@ encoder_layers = 1
 decoder_layers = 1
 heads = 2
 ffn = 32
+node_boxes = true
 [tokenizer]
 max_rects = 400
 max_out = 400

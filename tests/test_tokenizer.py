@@ -1,3 +1,5 @@
+from collections import deque
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -5,6 +7,7 @@ from hypothesis import strategies as st
 
 from facaid.generator import STYLE_NAMES, generate
 from facaid.grammar import Node, Procedure, Size, execute, validate
+from facaid.grammar.execute import first_boxes
 from facaid.tokenizer import BOS, EOS, TokenError, TokenGrammar, Tokenizer, TokenizerConfig
 
 TOK = Tokenizer(TokenizerConfig(max_rects=2000, max_out=2000))
@@ -25,6 +28,27 @@ def test_procedure_tokens_round_trip(seed, style):
     assert [x[0] for x in a] == [x[0] for x in b]
     err = np.abs(np.array([x[1:] for x in a]) - np.array([x[1:] for x in b])).max()
     assert err < 0.05 * max(proc.width, proc.height)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**63), st.sampled_from(STYLE_NAMES))
+def test_node_boxes_are_the_executed_first_instances(seed, style):
+    proc = generate(seed, style).procedure
+    ids, local, boxes = TOK.encode_target(proc)
+    assert boxes.shape == (len(ids), 4)
+    back = TOK.decode_procedure(ids, proc.width, proc.height)  # what the decoder has read: quantized sizes
+    first = first_boxes(back)
+    order, queue = [], deque([back.root])
+    while queue:
+        node = queue.popleft()
+        order.append(node)
+        queue.extend(node.children)
+    starts = [i for i, k in enumerate(local) if k == 0 and 0 < i < len(ids) - 1]  # node groups
+    expected = TOK.quantize_boxes(np.array([first[id(n)] for n in order]), proc.width, proc.height)
+    # the box rides on the token *before* each group (it tells the decoder which node comes next) and on
+    # every token of the group but its last
+    assert (boxes[np.array(starts) - 1] == expected).all()
+    assert (boxes[-2] == 0).all() and boxes[0].tolist() == [0, 0, 128, 128]
 
 
 def test_segmentation_rows_sorted_bottom_up():

@@ -43,8 +43,8 @@ def nll(model: FacaidModel, tokenizer: Tokenizer, examples: list, batch_size: in
     for i in range(0, len(examples), batch_size):
         chunk = examples[i : i + batch_size]
         rects, mask = batch_inputs([ex["rows"] for ex in chunk])
-        ids, local, targets = batch_outputs([ex["tokens"] for ex in chunk])
-        logits, _ = model(rects, mask, ids, local)
+        ids, local, targets, boxes = batch_outputs([ex["tokens"] for ex in chunk])
+        logits, _ = model(rects, mask, ids, local, boxes=boxes)
         logp = torch.log_softmax(logits.float(), -1)
         for b, ex in enumerate(chunk):
             seq = ex["tokens"][0]
@@ -71,7 +71,7 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
     while len(examples) < count:
         s = generate(sample_seed(seed, index))
         index += 1
-        tokens = tokenizer.encode_procedure(s.procedure)
+        tokens = tokenizer.encode_target(s.procedure)
         try:
             rows = tokenizer.encode_segmentation(s.segmentation)
         except ValueError:

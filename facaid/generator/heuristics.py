@@ -124,12 +124,14 @@ class Builder:
         """The window with its blinds or balconette (role window); returns (node, width)."""
         rng = self.rng
         node = Node.leaf("window")
+        # blinds and railings are fractions (rel) of the window's slot, so that a window squeezed into a low
+        # floor or above a balcony keeps its glass
         if ft.roller:
-            blind = height * rng.uniform(0.15, 0.45)
-            node = Node.split("y", [(self.abs(blind), Node.leaf("blind")), (self.flt(height - blind), node)])
+            blind = rng.uniform(0.15, 0.45)
+            node = Node.split("y", [(Size("rel", blind), Node.leaf("blind")), (self.flt(height * (1 - blind)), node)])
         if ft.railing:
-            rail = min(0.9, height * 0.35)
-            node = Node.split("y", [(self.flt(height - rail), node), (self.abs(rail), Node.leaf("balcony"))])
+            rail = min(0.9 / height, 0.35)
+            node = Node.split("y", [(self.flt(height * (1 - rail)), node), (Size("rel", rail), Node.leaf("balcony"))])
         width = ft.window_w
         if ft.surround:
             frame = rng.uniform(0.1, 0.22)
