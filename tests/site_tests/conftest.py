@@ -1,0 +1,48 @@
+"""Fixtures of the site tests: three users (alice owns, bob is another user, charlie is anonymous), photos
+made from generated facades, a media root per test."""
+
+from __future__ import annotations
+
+import pytest
+from site_helpers import client_for, facade_png, upload
+
+
+@pytest.fixture(autouse=True)
+def media_root(settings, tmp_path):
+    settings.MEDIA_ROOT = tmp_path / "media"
+    return settings.MEDIA_ROOT
+
+
+@pytest.fixture
+def alice(django_user_model):
+    return django_user_model.objects.create_user("alice", "alice@example.com", "alice-password-1")
+
+
+@pytest.fixture
+def bob(django_user_model):
+    return django_user_model.objects.create_user("bob", "bob@example.com", "bob-password-1")
+
+
+@pytest.fixture
+def as_alice(alice):
+    return client_for(alice)
+
+
+@pytest.fixture
+def as_bob(bob):
+    return client_for(bob)
+
+
+@pytest.fixture
+def as_charlie(db):
+    return client_for(None)
+
+
+@pytest.fixture
+def facade_photo(as_alice):
+    """Alice's private photo of a generated facade with one segmentation version."""
+    data, seg = facade_png()
+    photo = upload(as_alice, data, title="Generated facade").json()
+    r = as_alice.post(f"/api/v1/photos/{photo['code']}/segmentations/", seg, format="json")
+    assert r.status_code == 201, r.content
+    return photo, r.json()

@@ -1,0 +1,141 @@
+"""The JSON API: segmentations, procedures, jobs, downloads, rectification, and their bad inputs."""
+
+import io
+import json
+
+import pytest
+from PIL import Image
+
+from facaid.generator import generate
+from webapp.facades.models import Job
+
+pytestmark = pytest.mark.django_db
+
+
+def seg_url(photo):
+    return f"/api/v1/photos/{photo['code']}/segmentations/"
+
+
+def test_segmentation_versions(facade_photo, as_alice):
+    photo, seg = facade_photo
+    assert seg["version"] == 1 and seg["rect_count"] > 10
+    again = as_alice.post(seg_url(photo), seg["data"], format="json").json()
+    assert again["version"] == 2
+    versions = as_alice.get(seg_url(photo)).json()["results"]
+    assert [v["version"] for v in versions] == [2, 1]
+    assert as_alice.get(f"/api/v1/photos/{photo['code']}/").json()["segmentation"] == again["code"]
+
+
+@pytest.mark.parametrize("body, message", [
+    ('{"width": 10, "height": ', "JSON parse error"),
+    ('[1, 2, 3]', "must be a JSON object"),
+    ('{"width": "wide", "height": 10, "rects": []}', "width"),
+    ('{"width": NaN, "height": 10, "rects": []}', "NaN"),
+    ('{"width": -5, "height": 10, "rects": []}', "width"),
+    ('{"width": 1e12, "height": 10, "rects": []}', "width"),
+])
+def test_bad_segmentations_are_400_with_a_message(facade_photo, as_alice, body, message):
+    photo, _ = facade_photo
+    r = as_alice.post(seg_url(photo), body, content_type="application/json")
+    assert r.status_code == 400, r.content
+    assert message in json.dumps(r.json()), r.json()
+    assert as_alice.get(seg_url(photo)).json()["count"] == 1  # nothing stored
+
+
+def test_bad_rectangles_and_size_mismatch(facade_photo, as_alice):
+    photo, seg = facade_photo
+    data = json.loads(json.dumps(seg["data"]))
+    data["rects"][0]["x1"] = float("nan")
+    r = as_alice.post(seg_url(photo), json.dumps(data, allow_nan=True), content_type="application/json")
+    assert r.status_code == 400
+    data = json.loads(json.dumps(seg["data"]))
+    data["rects"][0]["label"] = "spaceship"
+    r = as_alice.post(seg_url(photo), data, format="json")
+    assert r.status_code == 400 and "spaceship" in json.dumps(r.json())
+    data = json.loads(json.dumps(seg["data"]))
+    data["width"] += 10
+    r = as_alice.post(seg_url(photo), data, format="json")
+    assert r.status_code == 400 and "but the photo is" in json.dumps(r.json())
+
+
+def test_procedure_edit_validates_and_remeasures(facade_photo, as_alice, alice):
+    from webapp.facades.models import Procedure, Segmentation
+
+    _, seg = facade_photo
+    sample = generate(3)
+    proc = Procedure.objects.create(owner=alice, data=sample.procedure.to_dict(),
+                                    segmentation=Segmentation.objects.get(code=seg["code"]))
+    url = f"/api/v1/procedures/{proc.code}/"
+    r = as_alice.patch(url, {"data": sample.procedure.to_dict()}, format="json")
+    assert r.status_code == 200 and r.json()["accuracy"] == pytest.approx(1.0)
+    bad = sample.procedure.to_dict()
+    bad["root"]["rule"] = "explode"
+    r = as_alice.patch(url, {"data": bad}, format="json")
+    assert r.status_code == 400 and "explode" in json.dumps(r.json())
+    r = as_alice.patch(url, {"visibility": "everyone"}, format="json")
+    assert r.status_code == 400
+    assert as_alice.patch(url, '{"title": ', content_type="application/json").status_code == 400
+    assert Procedure.objects.get(id=proc.id).data == sample.procedure.to_dict()  # nothing lost
+
+
+def test_downloads_render_and_variations(facade_photo, as_alice, alice):
+    from webapp.facades.models import Photo, Procedure
+
+    photo, _ = facade_photo
+    sample = generate(3)
+    proc = Procedure.objects.create(owner=alice, data=sample.procedure.to_dict(),
+                                    photo=Photo.objects.get(code=photo["code"]))
+    base = f"/api/v1/procedures/{proc.code}/download/"
+    r = as_alice.get(base + "procedure.json")
+    assert r.status_code == 200 and "attachment" in r["Content-Disposition"]
+    assert json.loads(r.content)["root"] == sample.procedure.to_dict()["root"]
+    seg = json.loads(as_alice.get(base + "segmentation.json").content)
+    assert seg == sample.segmentation.to_dict() or (seg["width"], seg["height"]) == (photo["width"], photo["height"])
+    for name in ("labels.png", "overlay.png"):
+        img = Image.open(io.BytesIO(as_alice.get(base + name).content))
+        assert img.size == (photo["width"], photo["height"])
+    assert as_alice.get(base + "overlay.png?alpha=7").status_code == 400
+    assert as_alice.get(base + "nothing.txt").status_code == 404
+    r = as_alice.post(f"/api/v1/procedures/{proc.code}/variations", {"n": 3, "seed": 5}, format="json")
+    variants = r.json()["variants"]
+    assert len(variants) == 3
+    assert as_alice.post(f"/api/v1/procedures/{proc.code}/variations", {"n": 3, "seed": 5},
+                         format="json").json()["variants"] == variants  # deterministic
+    assert as_alice.post(f"/api/v1/procedures/{proc.code}/variations", {"n": 1000}, format="json").status_code == 400
+    png = as_alice.post("/api/v1/render", variants[0], format="json")
+    assert png.status_code == 200 and png["Content-Type"] == "image/png"
+    assert as_alice.post("/api/v1/render", {"root": 5}, format="json").status_code == 400
+
+
+def test_rectify_stores_the_rectified_photo(facade_photo, as_alice):
+    photo, _ = facade_photo
+    url = f"/api/v1/photos/{photo['code']}/rectify"
+    w, h = photo["width"], photo["height"]
+    r = as_alice.post(url, {"corners": [[10, 5], [w - 10, 0], [w, h], [0, h - 4]]}, format="json")
+    assert r.status_code == 200, r.content
+    body = r.json()
+    assert body["rectified"] and body["corners"][0] == [10, 5]
+    img = Image.open(io.BytesIO(as_alice.get(body["rectified"]).getvalue()))
+    assert abs(img.width - (w - 10)) <= 2 and abs(img.height - (h - 2)) <= 3
+    for corners in ([[0, 0], [1, 1]], [[0, 0], [w, 0], [0, h], [w, h]], [[0, 0], [w, 0], [w, h], ["a", 1]],
+                    [[0, 0], [1e9, 0], [w, h], [0, h]]):
+        assert as_alice.post(url, {"corners": corners}, format="json").status_code == 400, corners
+
+
+def test_job_submission_and_errors(facade_photo, as_alice, as_bob):
+    _, seg = facade_photo
+    r = as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "k": 2}, format="json")
+    assert r.status_code == 202
+    job = Job.objects.get(code=r.json()["code"])
+    assert job.status == "queued" and job.params == {"k": 2, "seed": 0}
+    assert as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "k": 99}, format="json").status_code == 400
+    assert as_alice.post("/api/v1/jobs/", {"segmentation": "nope"}, format="json").status_code == 400
+    assert as_bob.post("/api/v1/jobs/", {"segmentation": seg["code"]}, format="json").status_code == 404
+
+
+def test_openapi_schema_documents_the_api(as_charlie):
+    r = as_charlie.get("/api/v1/schema", HTTP_ACCEPT="application/json")
+    assert r.status_code == 200
+    schema = json.loads(r.content)
+    for path in ("/api/v1/photos/", "/api/v1/jobs/", "/api/v1/procedures/{code}/fork", "/api/v1/gallery/"):
+        assert path in schema["paths"], path

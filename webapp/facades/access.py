@@ -1,0 +1,65 @@
+"""Who may see and change what. Objects someone may not see are 404 (their existence is not revealed);
+objects they may see but not change are 403."""
+
+from __future__ import annotations
+
+from django.core.exceptions import PermissionDenied, ValidationError
+from django.db.models import Q, QuerySet
+from django.http import Http404
+
+from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+
+READABLE = (Visibility.PUBLIC, Visibility.UNLISTED)  # by link; only public ones are listed
+
+
+def _readable(qs: QuerySet, user, owner_field: str = "owner", visibility_field: str = "visibility") -> QuerySet:
+    q = Q(**{f"{visibility_field}__in": READABLE})
+    if user.is_authenticated:
+        q |= Q(**{owner_field: user})
+    return qs.filter(q)
+
+
+def _get(qs: QuerySet, code):
+    try:
+        return qs.get(code=code)
+    except (qs.model.DoesNotExist, ValidationError, ValueError, TypeError):  # a malformed UUID: not found
+        raise Http404(f"no such {qs.model._meta.verbose_name}") from None
+
+
+def _owned(obj, user, owner):
+    if not (user.is_authenticated and owner == user):
+        raise PermissionDenied("only the owner may change this")
+    return obj
+
+
+def get_photo_for_user(user, code) -> Photo:
+    return _get(_readable(Photo.objects.all(), user), code)
+
+
+def get_rw_photo_for_user(user, code) -> Photo:
+    photo = get_photo_for_user(user, code)
+    return _owned(photo, user, photo.owner)
+
+
+def get_segmentation_for_user(user, code) -> Segmentation:
+    qs = _readable(Segmentation.objects.select_related("photo"), user, "photo__owner", "photo__visibility")
+    return _get(qs, code)
+
+
+def get_procedure_for_user(user, code) -> Procedure:
+    return _get(_readable(Procedure.objects.select_related("owner", "parent"), user), code)
+
+
+def get_rw_procedure_for_user(user, code) -> Procedure:
+    proc = get_procedure_for_user(user, code)
+    return _owned(proc, user, proc.owner)
+
+
+def get_job_for_user(user, code) -> Job:
+    if not user.is_authenticated:
+        raise Http404("no such job")
+    return _get(Job.objects.filter(owner=user).select_related("result", "segmentation__photo"), code)
+
+
+def public_procedures() -> QuerySet:
+    return Procedure.objects.filter(visibility=Visibility.PUBLIC).select_related("owner")

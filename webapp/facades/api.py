@@ -1,0 +1,380 @@
+"""The JSON API (``/api/v1/``): everything the pages do. Documented by the OpenAPI schema at
+``/api/v1/schema``. Private objects of others are 404; others' public objects are read-only (403 to change)."""
+
+from __future__ import annotations
+
+import io
+
+from django.core.files.base import ContentFile
+from django.db import transaction
+from django.db.models import Max
+from django.http import FileResponse, Http404, HttpResponse
+from drf_spectacular.utils import OpenApiParameter, extend_schema
+from PIL import Image
+from rest_framework import status
+from rest_framework.decorators import api_view, parser_classes, permission_classes
+from rest_framework.exceptions import NotAuthenticated, ValidationError
+from rest_framework.pagination import LimitOffsetPagination
+from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
+from rest_framework.permissions import AllowAny, IsAuthenticated
+from rest_framework.response import Response
+
+from facaid.rectify import rectify
+from facaid.variation import vary
+from webapp.facades import access, jobs, rendering
+from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.serializers import (
+    JobCreateSerializer,
+    JobSerializer,
+    PhotoSerializer,
+    PhotoUploadSerializer,
+    ProcedureSerializer,
+    ProcedureSummarySerializer,
+    ProcedureWriteSerializer,
+    RectifySerializer,
+    SegmentationSerializer,
+    VariationsSerializer,
+    parse_procedure,
+    parse_segmentation,
+)
+from webapp.facades.uploads import UploadError, normalize_photo
+
+
+def _page(request, queryset, serializer):
+    pager = LimitOffsetPagination()
+    page = pager.paginate_queryset(queryset, request)
+    return pager.get_paginated_response(serializer(page, many=True).data)
+
+
+# --- photos ----------------------------------------------------------------------------------------------------
+
+def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PRIVATE) -> Photo:
+    try:
+        content, _, _ = normalize_photo(upload)
+    except UploadError as exc:
+        raise ValidationError({"image": str(exc)}) from None
+    photo = Photo(owner=owner, title=title, visibility=visibility)
+    photo.image.save(content.name, content, save=False)
+    photo.save()
+    return photo
+
+
+@extend_schema(methods=["GET"], responses=PhotoSerializer(many=True), summary="Your photos")
+@extend_schema(methods=["POST"], request={"multipart/form-data": PhotoUploadSerializer},
+               responses={201: PhotoSerializer}, summary="Upload a photo (JPEG, PNG or WebP)")
+@api_view(["GET", "POST"])
+@permission_classes([IsAuthenticated])
+@parser_classes([MultiPartParser, FormParser])
+def photos(request):
+    if request.method == "GET":
+        return _page(request, Photo.objects.filter(owner=request.user), PhotoSerializer)
+    form = PhotoUploadSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    photo = create_photo(request.user, form.validated_data["image"], form.validated_data.get("title", ""),
+                         form.validated_data["visibility"])
+    return Response(PhotoSerializer(photo).data, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(methods=["GET"], responses=PhotoSerializer, summary="A photo")
+@extend_schema(methods=["PATCH"], request=PhotoSerializer, responses=PhotoSerializer,
+               summary="Change a photo's title or visibility")
+@extend_schema(methods=["DELETE"], responses={204: None}, summary="Delete a photo with its segmentations")
+@api_view(["GET", "PATCH", "DELETE"])
+@permission_classes([AllowAny])
+def photo_detail(request, code):
+    if request.method == "GET":
+        return Response(PhotoSerializer(access.get_photo_for_user(request.user, code)).data)
+    photo = access.get_rw_photo_for_user(request.user, code)
+    if request.method == "DELETE":
+        photo.image.delete(save=False)
+        if photo.rectified:
+            photo.rectified.delete(save=False)
+        photo.delete()
+        return Response(status=status.HTTP_204_NO_CONTENT)
+    form = PhotoSerializer(photo, data=request.data, partial=True)
+    form.is_valid(raise_exception=True)
+    form.save()
+    return Response(form.data)
+
+
+@extend_schema(parameters=[OpenApiParameter("rectified", bool, description="the rectified image")],
+               responses={(200, "image/*"): bytes}, summary="The photo's image file")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def photo_image(request, code):
+    photo = access.get_photo_for_user(request.user, code)
+    field = photo.rectified if request.query_params.get("rectified") and photo.rectified else photo.image
+    return FileResponse(field.open("rb"))
+
+
+@extend_schema(request=RectifySerializer, responses=PhotoSerializer,
+               summary="Rectify the photo from four corners (a homography); the result is stored")
+@api_view(["POST"])
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def photo_rectify(request, code):
+    photo = access.get_rw_photo_for_user(request.user, code)
+    form = RectifySerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    corners = form.validated_data["corners"]
+    for x, y in corners:
+        if not (-photo.width <= x <= 2 * photo.width and -photo.height <= y <= 2 * photo.height):
+            raise ValidationError({"corners": f"corner ({x}, {y}) lies far outside the {photo.width}x"
+                                              f"{photo.height} photo"})
+    with photo.image.open("rb") as f:
+        try:
+            out = rectify(Image.open(f), corners)
+        except ValueError as exc:
+            raise ValidationError({"corners": str(exc)}) from None
+    buf = io.BytesIO()
+    out.save(buf, "PNG")
+    if photo.rectified:
+        photo.rectified.delete(save=False)
+    photo.rectified.save("rectified.png", ContentFile(buf.getvalue()), save=False)
+    photo.corners = corners
+    photo.save()
+    return Response(PhotoSerializer(photo).data)
+
+
+# --- segmentations ------------------------------------------------------------------------------------------------
+
+def add_segmentation(photo: Photo, data) -> Segmentation:
+    seg = parse_segmentation(data)
+    image = photo.rectified if photo.rectified else photo.image
+    w, h = (image.width, image.height) if photo.rectified else (photo.width, photo.height)
+    if (seg.width, seg.height) != (w, h):
+        raise ValidationError({"segmentation": f"the segmentation is {seg.width}x{seg.height} but the "
+                                               f"{'rectified ' if photo.rectified else ''}photo is {w}x{h}"})
+    with transaction.atomic():
+        last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
+        return Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
+                                           rect_count=len(seg.rects))
+
+
+@extend_schema(methods=["GET"], responses=SegmentationSerializer(many=True), summary="Versions, newest first")
+@extend_schema(methods=["POST"], request={"application/json": dict}, responses={201: SegmentationSerializer},
+               summary="Save a new version (the segmentation JSON contract; sizes must match the photo)")
+@api_view(["GET", "POST"])
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def photo_segmentations(request, code):
+    if request.method == "GET":
+        photo = access.get_photo_for_user(request.user, code)
+        return _page(request, photo.segmentations.order_by("-version"), SegmentationSerializer)
+    if not request.user.is_authenticated:
+        raise NotAuthenticated()
+    photo = access.get_rw_photo_for_user(request.user, code)
+    seg = add_segmentation(photo, request.data)
+    return Response(SegmentationSerializer(seg).data, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(responses=SegmentationSerializer, summary="One segmentation version")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def segmentation_detail(request, code):
+    return Response(SegmentationSerializer(access.get_segmentation_for_user(request.user, code)).data)
+
+
+# --- jobs ---------------------------------------------------------------------------------------------------------
+
+def submit_job(user, segmentation: Segmentation, k=4, seed=0, prefix: Procedure | None = None,
+               prefix_nodes: int = 0) -> Job:
+    params = {"k": k, "seed": seed}
+    if prefix is not None and prefix_nodes > 0:
+        params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id)
+    return jobs.submit(owner=user, segmentation=segmentation, params=params)
+
+
+@extend_schema(methods=["GET"], responses=JobSerializer(many=True), summary="Your jobs, newest first")
+@extend_schema(methods=["POST"], request=JobCreateSerializer, responses={202: JobSerializer},
+               summary="Reconstruct a procedure from a segmentation (optionally continuing a procedure's "
+                       "first nodes)")
+@api_view(["GET", "POST"])
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def job_list(request):
+    if request.method == "GET":
+        return _page(request, Job.objects.filter(owner=request.user).select_related("segmentation", "result"),
+                     JobSerializer)
+    form = JobCreateSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    v = form.validated_data
+    seg = access.get_segmentation_for_user(request.user, v["segmentation"])
+    if seg.photo.owner != request.user:
+        raise ValidationError({"segmentation": "fork the photo's procedure or upload your own photo to "
+                                               "reconstruct it"})
+    prefix = access.get_procedure_for_user(request.user, v["prefix_procedure"]) if v["prefix_procedure"] else None
+    job = submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"])
+    return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
+
+
+@extend_schema(responses=JobSerializer, summary="A job's status and progress")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def job_detail(request, code):
+    return Response(JobSerializer(access.get_job_for_user(request.user, code)).data)
+
+
+# --- procedures ---------------------------------------------------------------------------------------------------
+
+@extend_schema(methods=["GET"], responses=ProcedureSummarySerializer(many=True), summary="Your procedures")
+@extend_schema(methods=["POST"], request=ProcedureWriteSerializer, responses={201: ProcedureSerializer},
+               summary="Store a procedure JSON (imported or edited)")
+@api_view(["GET", "POST"])
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def procedure_list(request):
+    if request.method == "GET":
+        return _page(request, Procedure.objects.filter(owner=request.user), ProcedureSummarySerializer)
+    form = ProcedureWriteSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    if "data" not in form.validated_data:
+        raise ValidationError({"data": "a procedure JSON is required"})
+    proc = Procedure.objects.create(owner=request.user, **form.validated_data)
+    return Response(ProcedureSerializer(proc).data, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(responses=ProcedureSummarySerializer(many=True), summary="Public procedures, newest first")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def gallery(request):
+    return _page(request, access.public_procedures(), ProcedureSummarySerializer)
+
+
+def _remeasure(proc: Procedure) -> None:
+    """Pixel accuracy of an edited procedure against the segmentation it was made from."""
+    if proc.segmentation_id is None:
+        proc.accuracy = None
+        return
+    from facaid.metrics import procedure_accuracy
+    from facaid.segmentation import Segmentation as SegmentationData
+    from facaid.segmentation import flatten
+
+    target = flatten(SegmentationData.from_dict(proc.segmentation.data))
+    tree = parse_procedure(proc.data)
+    if (round(tree.width), round(tree.height)) == (target.width, target.height):
+        proc.accuracy = procedure_accuracy(tree, target)
+    else:
+        proc.accuracy = None  # resized: no longer comparable
+
+
+@extend_schema(methods=["GET"], responses=ProcedureSerializer, summary="A procedure")
+@extend_schema(methods=["PATCH"], request=ProcedureWriteSerializer, responses=ProcedureSerializer,
+               summary="Edit title, visibility or the procedure itself (re-executed and re-measured)")
+@extend_schema(methods=["DELETE"], responses={204: None}, summary="Delete a procedure")
+@api_view(["GET", "PATCH", "DELETE"])
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def procedure_detail(request, code):
+    if request.method == "GET":
+        return Response(ProcedureSerializer(access.get_procedure_for_user(request.user, code)).data)
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    if request.method == "DELETE":
+        proc.delete()
+        return Response(status=status.HTTP_204_NO_CONTENT)
+    form = ProcedureWriteSerializer(data=request.data, partial=True)
+    form.is_valid(raise_exception=True)
+    for key, value in form.validated_data.items():
+        setattr(proc, key, value)
+    if "data" in form.validated_data:
+        _remeasure(proc)
+    proc.save()
+    return Response(ProcedureSerializer(proc).data)
+
+
+def fork_procedure(user, proc: Procedure) -> Procedure:
+    """A private copy owned by ``user`` with ``proc`` as its parent; the photo link is kept for its owner only."""
+    title = proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}"
+    mine = proc.photo is not None and proc.photo.owner == user
+    return Procedure.objects.create(
+        owner=user, title=title[:200], data=proc.data, parent=proc, accuracy=proc.accuracy, metrics=proc.metrics,
+        photo=proc.photo if mine else None, segmentation=proc.segmentation if mine else None)
+
+
+@extend_schema(request=None, responses={201: ProcedureSerializer},
+               summary="Fork: your own private copy, with a link to its parent")
+@api_view(["POST"])
+@permission_classes([IsAuthenticated])
+def procedure_fork(request, code):
+    fork = fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
+    return Response(ProcedureSerializer(fork).data, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(request=VariationsSerializer, responses={200: dict},
+               summary="Variants of a procedure (counts, resizes, swaps), deterministic by seed; not stored")
+@api_view(["POST"])
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def procedure_variations(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    form = VariationsSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    variants = vary(parse_procedure(proc.data), form.validated_data["n"], form.validated_data["seed"])
+    return Response({"variants": [v.to_dict() for v in variants]})
+
+
+@extend_schema(request={"application/json": dict}, responses={(200, "image/png"): bytes},
+               summary="Render a procedure JSON (the live preview of edited parameters)")
+@api_view(["POST"])
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def render_preview(request):
+    seg = rendering.procedure_segmentation(parse_procedure(request.data).to_dict())
+    return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
+
+
+DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "overlay.png")
+
+
+@extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1")],
+               responses={(200, "application/octet-stream"): bytes},
+               summary="Downloads: procedure.json, segmentation.json (executed), labels.png, overlay.png")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def procedure_download(request, code, name):
+    proc = access.get_procedure_for_user(request.user, code)
+    if name not in DOWNLOADS:
+        raise Http404(f"no download named {name!r}; there are {', '.join(DOWNLOADS)}")
+    stem = f"facaid-{str(proc.code)[:8]}"
+    if name == "procedure.json":
+        resp = HttpResponse(parse_procedure(proc.data).to_json(indent=2), content_type="application/json")
+    else:
+        seg = rendering.procedure_segmentation(proc.data)
+        if name == "segmentation.json":
+            resp = HttpResponse(seg.to_json(), content_type="application/json")
+        elif name == "labels.png":
+            resp = HttpResponse(rendering.label_map_png(seg), content_type="image/png")
+        else:
+            if proc.photo is None or not (proc.photo.owner == request.user
+                                          or proc.photo.visibility != Visibility.PRIVATE):
+                raise ValidationError({"name": "this procedure has no photo you may see to overlay"})
+            try:
+                alpha = float(request.query_params.get("alpha", 0.5))
+            except ValueError:
+                raise ValidationError({"alpha": "alpha must be a number between 0 and 1"}) from None
+            if not 0.0 <= alpha <= 1.0:
+                raise ValidationError({"alpha": "alpha must be a number between 0 and 1"})
+            with proc.photo.working_image().open("rb") as f:
+                resp = HttpResponse(rendering.overlay_png(seg, Image.open(f), alpha), content_type="image/png")
+    resp["Content-Disposition"] = f'attachment; filename="{stem}-{name}"'
+    return resp
+
+
+@extend_schema(request={"application/json": dict}, responses={202: JobSerializer},
+               summary="Re-run inference keeping the procedure's first `nodes` nodes (BFS)")
+@api_view(["POST"])
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def procedure_rerun(request, code):
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    if proc.segmentation is None:
+        raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
+    try:
+        nodes = int(request.data.get("nodes", 1))
+        k = int(request.data.get("k", 4))
+    except (TypeError, ValueError, AttributeError):
+        raise ValidationError({"nodes": "nodes and k must be integers"}) from None
+    if not (1 <= nodes <= 8192 and 1 <= k <= 16):
+        raise ValidationError({"nodes": "nodes must be within 1..8192 and k within 1..16"})
+    job = submit_job(request.user, proc.segmentation, k=k, seed=0, prefix=proc, prefix_nodes=nodes)
+    return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)

@@ -1,0 +1,7 @@
+from django.apps import AppConfig
+
+
+class FacadesConfig(AppConfig):
+    name = "webapp.facades"
+    label = "facades"
+    default_auto_field = "django.db.models.BigAutoField"

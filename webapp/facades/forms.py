@@ -1,0 +1,28 @@
+from django import forms
+
+from webapp.facades.models import Visibility
+
+
+class PhotoForm(forms.Form):
+    image = forms.FileField(help_text="JPEG, PNG or WebP; at most 20 MB and 40 megapixels")
+    title = forms.CharField(max_length=200, required=False)
+    visibility = forms.ChoiceField(choices=Visibility.choices, initial=Visibility.PRIVATE)
+
+
+class VisibilityForm(forms.Form):
+    visibility = forms.ChoiceField(choices=Visibility.choices)
+
+
+class SegmentationForm(forms.Form):
+    file = forms.FileField(required=False, help_text="a segmentation JSON file")
+    text = forms.CharField(widget=forms.Textarea(attrs={"rows": 4}), required=False,
+                           help_text="or paste the JSON here")
+
+
+class ReconstructForm(forms.Form):
+    k = forms.IntegerField(min_value=1, max_value=16, initial=4, help_text="candidates decoded and compared")
+    seed = forms.IntegerField(min_value=0, max_value=2**31 - 1, initial=0)
+
+
+class RerunForm(forms.Form):
+    nodes = forms.IntegerField(min_value=1, max_value=8192, initial=1, help_text="nodes kept (breadth first)")

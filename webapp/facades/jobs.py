@@ -1,0 +1,103 @@
+"""The life of a job: submit (the task is sent once the row is committed), claim (a conditional update, so a
+message delivered twice runs once), heartbeat, finish, and recovery of jobs whose message or worker was lost.
+"""
+
+from __future__ import annotations
+
+import logging
+from datetime import timedelta
+
+from django.db import transaction
+from django.db.models import F, Q
+from django.utils import timezone
+
+from webapp.env import env_int
+from webapp.facades.models import Job
+
+log = logging.getLogger(__name__)
+
+MAX_ATTEMPTS = 3
+
+
+def stale_after() -> timedelta:
+    """A running job whose heartbeat is older than this has lost its worker."""
+    return timedelta(seconds=env_int("FACAID_JOB_STALE_SECONDS", 60))
+
+
+def resend_after() -> timedelta:
+    """A queued job not claimed this long after its message was sent is sent again (the message may be lost)."""
+    return timedelta(seconds=env_int("FACAID_JOB_RESEND_SECONDS", 300))
+
+
+def send(job_id: int) -> None:
+    from webapp.facades.tasks import run_job
+
+    Job.objects.filter(id=job_id).update(sent=timezone.now())
+    run_job.apply_async(args=[job_id])
+
+
+def submit(**fields) -> Job:
+    """Create a queued job; its task is sent when the transaction commits."""
+    job = Job.objects.create(**fields)
+    transaction.on_commit(lambda: _send_quietly(job.id))
+    return job
+
+
+def _send_quietly(job_id: int) -> None:
+    try:
+        send(job_id)
+    except Exception:  # the broker is down: the row stays queued and recovery sends it later
+        log.exception("could not send job %s; it will be re-sent", job_id)
+
+
+def claim(job_id: int) -> bool:
+    """Take a queued job for this worker; False if another worker has it or it is finished."""
+    now = timezone.now()
+    return Job.objects.filter(id=job_id, status=Job.Status.QUEUED).update(
+        status=Job.Status.RUNNING, started=now, heartbeat=now, attempts=F("attempts") + 1, progress=0.0,
+        stage="starting") == 1
+
+
+def beat(job_id: int, progress: float | None = None, stage: str | None = None) -> None:
+    fields = {"heartbeat": timezone.now()}
+    if progress is not None:
+        fields["progress"] = max(0.0, min(1.0, progress))
+    if stage is not None:
+        fields["stage"] = stage[:100]
+    Job.objects.filter(id=job_id, status=Job.Status.RUNNING).update(**fields)
+
+
+def fail(job_id: int, message: str) -> None:
+    Job.objects.filter(id=job_id).exclude(status=Job.Status.DONE).update(
+        status=Job.Status.FAILED, message=message[:2000], finished=timezone.now())
+
+
+def release(job_id: int) -> None:
+    """Give a running job back to the queue (a transient error; it will be retried)."""
+    Job.objects.filter(id=job_id, status=Job.Status.RUNNING).update(status=Job.Status.QUEUED, stage="retrying")
+
+
+def recover() -> dict[str, int]:
+    """Re-queue running jobs whose worker stopped beating (failing those out of attempts) and re-send queued
+    jobs whose message seems lost. Safe to run anywhere, any number of times."""
+    now = timezone.now()
+    requeued = failed = resent = 0
+    for job in Job.objects.filter(status=Job.Status.RUNNING, heartbeat__lt=now - stale_after()):
+        if job.attempts >= MAX_ATTEMPTS:
+            failed += Job.objects.filter(id=job.id, status=Job.Status.RUNNING, heartbeat=job.heartbeat).update(
+                status=Job.Status.FAILED, finished=now,
+                message=f"the worker stopped responding {job.attempts} times; giving up")
+        elif Job.objects.filter(id=job.id, status=Job.Status.RUNNING, heartbeat=job.heartbeat).update(
+                status=Job.Status.QUEUED, stage="worker lost; queued again", sent=None):
+            requeued += 1
+    for job_id in Job.objects.filter(status=Job.Status.QUEUED).filter(
+            Q(sent__isnull=True) | Q(sent__lt=now - resend_after())).values_list("id", flat=True):
+        try:
+            send(job_id)
+            resent += 1
+        except Exception:
+            log.exception("could not re-send job %s", job_id)
+            break
+    if requeued or failed or resent:
+        log.warning("job recovery: %d requeued, %d failed, %d re-sent", requeued, failed, resent)
+    return {"requeued": requeued, "failed": failed, "resent": resent}

@@ -1,0 +1,144 @@
+"""Photos, their segmentations (versioned), reconstruction jobs and procedures. Every object is addressed by
+a UUID ``code``; photos and procedures carry a visibility (private, unlisted, public)."""
+
+from __future__ import annotations
+
+import uuid
+
+from django.conf import settings
+from django.db import models
+from django.urls import reverse
+from django.utils import timezone
+
+
+class Visibility(models.TextChoices):
+    PRIVATE = "private", "Private"  # the owner only
+    UNLISTED = "unlisted", "Unlisted"  # anyone with the link
+    PUBLIC = "public", "Public"  # anyone, and listed in the gallery
+
+
+def photo_path(photo: Photo, filename: str) -> str:
+    return f"photos/{photo.code}/original.{filename.rsplit('.', 1)[-1].lower()}"
+
+
+def rectified_path(photo: Photo, filename: str) -> str:
+    return f"photos/{photo.code}/rectified.png"
+
+
+class Photo(models.Model):
+    code = models.UUIDField(default=uuid.uuid4, unique=True, editable=False)
+    owner = models.ForeignKey(settings.AUTH_USER_MODEL, on_delete=models.CASCADE, related_name="photos")
+    title = models.CharField(max_length=200, blank=True)
+    image = models.ImageField(upload_to=photo_path, width_field="width", height_field="height")
+    width = models.PositiveIntegerField(default=0)
+    height = models.PositiveIntegerField(default=0)
+    # rectification: four corners (x, y) in the original image, top-left, top-right, bottom-right, bottom-left
+    corners = models.JSONField(null=True, blank=True)
+    rectified = models.ImageField(upload_to=rectified_path, null=True, blank=True)
+    visibility = models.CharField(max_length=10, choices=Visibility.choices, default=Visibility.PRIVATE)
+    created = models.DateTimeField(default=timezone.now)
+
+    class Meta:
+        ordering = ["-created"]
+
+    def __str__(self) -> str:
+        return self.title or f"photo {self.code}"
+
+    def get_absolute_url(self) -> str:
+        return reverse("photo", args=[self.code])
+
+    def working_image(self):
+        """The image segmentations are drawn on: the rectified one when there is one."""
+        return self.rectified if self.rectified else self.image
+
+    def latest_segmentation(self) -> Segmentation | None:
+        return self.segmentations.order_by("-version").first()
+
+
+class Segmentation(models.Model):
+    """One version of a photo's segmentation (the segmentation JSON contract); saving makes a new version."""
+
+    code = models.UUIDField(default=uuid.uuid4, unique=True, editable=False)
+    photo = models.ForeignKey(Photo, on_delete=models.CASCADE, related_name="segmentations")
+    version = models.PositiveIntegerField()
+    data = models.JSONField()
+    rect_count = models.PositiveIntegerField(default=0)
+    created = models.DateTimeField(default=timezone.now)
+
+    class Meta:
+        ordering = ["photo", "-version"]
+        constraints = [models.UniqueConstraint(fields=["photo", "version"], name="one_segmentation_per_version")]
+
+    def __str__(self) -> str:
+        return f"{self.photo} v{self.version}"
+
+
+class Procedure(models.Model):
+    code = models.UUIDField(default=uuid.uuid4, unique=True, editable=False)
+    owner = models.ForeignKey(settings.AUTH_USER_MODEL, on_delete=models.CASCADE, related_name="procedures")
+    title = models.CharField(max_length=200, blank=True)
+    data = models.JSONField()  # procedure JSON (facaid.grammar)
+    photo = models.ForeignKey(Photo, on_delete=models.SET_NULL, null=True, blank=True, related_name="procedures")
+    segmentation = models.ForeignKey(Segmentation, on_delete=models.SET_NULL, null=True, blank=True,
+                                     related_name="procedures")
+    parent = models.ForeignKey("self", on_delete=models.SET_NULL, null=True, blank=True, related_name="forks")
+    accuracy = models.FloatField(null=True, blank=True)  # pixel accuracy against the segmentation
+    metrics = models.JSONField(default=dict, blank=True)
+    visibility = models.CharField(max_length=10, choices=Visibility.choices, default=Visibility.PRIVATE)
+    created = models.DateTimeField(default=timezone.now)
+    updated = models.DateTimeField(auto_now=True)
+
+    class Meta:
+        ordering = ["-created"]
+
+    def __str__(self) -> str:
+        return self.title or f"procedure {self.code}"
+
+    def get_absolute_url(self) -> str:
+        return reverse("procedure", args=[self.code])
+
+    def lineage(self) -> list[Procedure]:
+        """Ancestors, nearest first (forks of forks), stopping at a cycle or a deleted parent."""
+        out, seen, node = [], {self.pk}, self.parent
+        while node is not None and node.pk not in seen and len(out) < 50:
+            out.append(node)
+            seen.add(node.pk)
+            node = node.parent
+        return out
+
+
+class Job(models.Model):
+    class Status(models.TextChoices):
+        QUEUED = "queued", "Queued"
+        RUNNING = "running", "Running"
+        DONE = "done", "Done"
+        FAILED = "failed", "Failed"
+
+    class Kind(models.TextChoices):
+        RECONSTRUCT = "reconstruct", "Reconstruct"
+
+    code = models.UUIDField(default=uuid.uuid4, unique=True, editable=False)
+    owner = models.ForeignKey(settings.AUTH_USER_MODEL, on_delete=models.CASCADE, related_name="jobs")
+    kind = models.CharField(max_length=20, choices=Kind.choices, default=Kind.RECONSTRUCT)
+    segmentation = models.ForeignKey(Segmentation, on_delete=models.CASCADE, related_name="jobs")
+    params = models.JSONField(default=dict, blank=True)  # k, seed, prefix procedure code and node count
+    status = models.CharField(max_length=10, choices=Status.choices, default=Status.QUEUED, db_index=True)
+    progress = models.FloatField(default=0.0)
+    stage = models.CharField(max_length=100, blank=True)
+    message = models.TextField(blank=True)  # why it failed
+    attempts = models.PositiveIntegerField(default=0)
+    result = models.ForeignKey(Procedure, on_delete=models.SET_NULL, null=True, blank=True, related_name="jobs")
+    created = models.DateTimeField(default=timezone.now)
+    started = models.DateTimeField(null=True, blank=True)
+    heartbeat = models.DateTimeField(null=True, blank=True)  # a running worker touches it every few seconds
+    finished = models.DateTimeField(null=True, blank=True)
+    sent = models.DateTimeField(null=True, blank=True)  # last time the task message was sent
+
+    class Meta:
+        ordering = ["-created"]
+
+    def __str__(self) -> str:
+        return f"{self.kind} job {self.code} ({self.status})"
+
+    def get_absolute_url(self) -> str:
+        return reverse("job", args=[self.code])

@@ -1,0 +1,133 @@
+"""JSON shapes of the API. Segmentations and procedures are validated by the facaid library, whose messages
+name the offending field or grammar node."""
+
+from __future__ import annotations
+
+from rest_framework import serializers
+
+from facaid.grammar import Procedure as ProcedureTree
+from facaid.grammar.procedure import ProcedureError
+from facaid.segmentation import Segmentation as SegmentationData
+from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+
+
+def parse_segmentation(data) -> SegmentationData:
+    try:
+        return SegmentationData.from_dict(data)
+    except (ValueError, TypeError) as exc:
+        raise serializers.ValidationError({"segmentation": str(exc)}) from None
+
+
+def parse_procedure(data) -> ProcedureTree:
+    try:
+        return ProcedureTree.from_dict(data)
+    except (ProcedureError, ValueError, TypeError, KeyError) as exc:
+        raise serializers.ValidationError({"data": str(exc)}) from None
+
+
+class PhotoSerializer(serializers.ModelSerializer):
+    owner = serializers.CharField(source="owner.username", read_only=True)
+    image = serializers.SerializerMethodField()
+    rectified = serializers.SerializerMethodField()
+    segmentation = serializers.SerializerMethodField()
+
+    class Meta:
+        model = Photo
+        fields = ["code", "owner", "title", "width", "height", "visibility", "image", "rectified", "corners",
+                  "segmentation", "created"]
+        read_only_fields = ["code", "owner", "width", "height", "image", "rectified", "corners", "created"]
+
+    def get_image(self, photo: Photo) -> str:
+        return f"/api/v1/photos/{photo.code}/image"
+
+    def get_rectified(self, photo: Photo) -> str | None:
+        return f"/api/v1/photos/{photo.code}/image?rectified=1" if photo.rectified else None
+
+    def get_segmentation(self, photo: Photo) -> str | None:
+        seg = photo.latest_segmentation()
+        return str(seg.code) if seg else None
+
+
+class PhotoUploadSerializer(serializers.Serializer):
+    image = serializers.FileField(allow_empty_file=True)
+    title = serializers.CharField(max_length=200, required=False, allow_blank=True)
+    visibility = serializers.ChoiceField(Visibility.choices, default=Visibility.PRIVATE)
+
+
+class RectifySerializer(serializers.Serializer):
+    corners = serializers.ListField(
+        child=serializers.ListField(child=serializers.FloatField(), min_length=2, max_length=2),
+        min_length=4, max_length=4, help_text="[[x, y] x 4]: top-left, top-right, bottom-right, bottom-left")
+
+
+class SegmentationSerializer(serializers.ModelSerializer):
+    photo = serializers.UUIDField(source="photo.code", read_only=True)
+
+    class Meta:
+        model = Segmentation
+        fields = ["code", "photo", "version", "rect_count", "data", "created"]
+        read_only_fields = fields
+
+
+class ProcedureSerializer(serializers.ModelSerializer):
+    owner = serializers.CharField(source="owner.username", read_only=True)
+    parent = serializers.SerializerMethodField()
+    photo = serializers.SerializerMethodField()
+    segmentation = serializers.SerializerMethodField()
+
+    class Meta:
+        model = Procedure
+        fields = ["code", "owner", "title", "visibility", "accuracy", "metrics", "parent", "photo",
+                  "segmentation", "data", "created", "updated"]
+        read_only_fields = ["code", "owner", "accuracy", "metrics", "parent", "photo", "segmentation", "created",
+                            "updated"]
+
+    def get_parent(self, proc: Procedure) -> str | None:
+        return str(proc.parent.code) if proc.parent_id else None
+
+    def get_photo(self, proc: Procedure) -> str | None:
+        return str(proc.photo.code) if proc.photo_id else None
+
+    def get_segmentation(self, proc: Procedure) -> str | None:
+        return str(proc.segmentation.code) if proc.segmentation_id else None
+
+
+class ProcedureSummarySerializer(ProcedureSerializer):
+    class Meta(ProcedureSerializer.Meta):
+        fields = ["code", "owner", "title", "visibility", "accuracy", "parent", "created"]
+
+
+class ProcedureWriteSerializer(serializers.Serializer):
+    title = serializers.CharField(max_length=200, required=False, allow_blank=True)
+    visibility = serializers.ChoiceField(Visibility.choices, required=False)
+    data = serializers.JSONField(required=False)
+
+    def validate_data(self, value):
+        return parse_procedure(value).to_dict()
+
+
+class JobSerializer(serializers.ModelSerializer):
+    segmentation = serializers.UUIDField(source="segmentation.code", read_only=True)
+    result = serializers.SerializerMethodField()
+
+    class Meta:
+        model = Job
+        fields = ["code", "kind", "status", "progress", "stage", "message", "attempts", "params", "segmentation",
+                  "result", "created", "started", "finished"]
+        read_only_fields = fields
+
+    def get_result(self, job: Job) -> str | None:
+        return str(job.result.code) if job.result_id else None
+
+
+class JobCreateSerializer(serializers.Serializer):
+    segmentation = serializers.UUIDField()
+    k = serializers.IntegerField(min_value=1, max_value=16, default=4)
+    seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
+    prefix_procedure = serializers.UUIDField(required=False, allow_null=True, default=None)
+    prefix_nodes = serializers.IntegerField(min_value=0, max_value=8192, default=0)
+
+
+class VariationsSerializer(serializers.Serializer):
+    n = serializers.IntegerField(min_value=1, max_value=32, default=8)
+    seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)

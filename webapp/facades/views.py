@@ -1,0 +1,166 @@
+"""The pages. They use the same helpers as the JSON API (`webapp.facades.api`) and the same access rules."""
+
+from __future__ import annotations
+
+import json
+
+from django.contrib import messages
+from django.contrib.auth.decorators import login_required
+from django.core.paginator import Paginator
+from django.shortcuts import redirect, render
+from django.views.decorators.http import require_POST
+from rest_framework.exceptions import ValidationError
+
+from webapp.facades import access, api
+from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
+from webapp.facades.models import Job, Photo, Procedure
+
+
+def _error_text(exc: ValidationError) -> str:
+    detail = exc.detail
+    if isinstance(detail, dict):
+        return "; ".join(f"{k}: {' '.join(map(str, v)) if isinstance(v, list) else v}" for k, v in detail.items())
+    return " ".join(map(str, detail)) if isinstance(detail, list) else str(detail)
+
+
+def home(request):
+    gallery = Paginator(access.public_procedures(), 24).get_page(request.GET.get("page"))
+    context = {"gallery": gallery}
+    if request.user.is_authenticated:
+        context.update(photos=Photo.objects.filter(owner=request.user)[:12],
+                       procedures=Procedure.objects.filter(owner=request.user)[:12],
+                       jobs=Job.objects.filter(owner=request.user).select_related("result")[:8])
+    return render(request, "facades/home.html", context)
+
+
+@login_required
+def photo_new(request):
+    form = PhotoForm(request.POST or None, request.FILES or None)
+    if request.method == "POST" and form.is_valid():
+        try:
+            photo = api.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
+                                     form.cleaned_data["visibility"])
+        except ValidationError as exc:
+            form.add_error("image", _error_text(exc).removeprefix("image: "))
+        else:
+            messages.success(request, "Photo uploaded. Rectify it if needed, then add a segmentation.")
+            return redirect(photo)
+    return render(request, "facades/photo_new.html", {"form": form}, status=400 if form.errors else 200)
+
+
+def photo(request, code):
+    photo = access.get_photo_for_user(request.user, code)
+    owner = request.user == photo.owner
+    segmentation = photo.latest_segmentation()
+    context = {"photo": photo, "owner": owner, "segmentation": segmentation,
+               "procedures": photo.procedures.filter(owner=photo.owner) if owner else
+               photo.procedures.filter(visibility="public"),
+               "jobs": photo.segmentations.none() if not owner else
+               Job.objects.filter(segmentation__photo=photo).select_related("result")[:10],
+               "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
+               "visibility_form": VisibilityForm(initial={"visibility": photo.visibility})}
+    return render(request, "facades/photo.html", context)
+
+
+@login_required
+@require_POST
+def photo_visibility(request, code):
+    photo = access.get_rw_photo_for_user(request.user, code)
+    form = VisibilityForm(request.POST)
+    if form.is_valid():
+        photo.visibility = form.cleaned_data["visibility"]
+        photo.save(update_fields=["visibility"])
+        messages.success(request, f"The photo is now {photo.get_visibility_display().lower()}.")
+    return redirect(photo)
+
+
+@login_required
+@require_POST
+def photo_segmentation(request, code):
+    photo = access.get_rw_photo_for_user(request.user, code)
+    form = SegmentationForm(request.POST, request.FILES)
+    if form.is_valid():
+        raw = form.cleaned_data["file"].read() if form.cleaned_data["file"] else form.cleaned_data["text"]
+        try:
+            data = json.loads(raw)
+            seg = api.add_segmentation(photo, data)
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            messages.error(request, f"The segmentation is not valid JSON: {exc}")
+        except ValidationError as exc:
+            messages.error(request, _error_text(exc))
+        else:
+            messages.success(request, f"Segmentation version {seg.version} saved ({seg.rect_count} rectangles).")
+    return redirect(photo)
+
+
+@login_required
+@require_POST
+def photo_reconstruct(request, code):
+    photo = access.get_rw_photo_for_user(request.user, code)
+    seg = photo.latest_segmentation()
+    form = ReconstructForm(request.POST)
+    if seg is None:
+        messages.error(request, "Add a segmentation first.")
+        return redirect(photo)
+    if not form.is_valid():
+        messages.error(request, "Check the reconstruction settings.")
+        return redirect(photo)
+    job = api.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"])
+    return redirect(job)
+
+
+def job(request, code):
+    return render(request, "facades/job.html", {"job": access.get_job_for_user(request.user, code)})
+
+
+def procedure(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    owner = request.user == proc.owner
+    photo_visible = proc.photo is not None and (proc.photo.owner == request.user
+                                                or proc.photo.visibility != "private")
+    return render(request, "facades/procedure.html", {
+        "proc": proc, "owner": owner, "photo_visible": photo_visible, "lineage": proc.lineage(),
+        "data_json": proc.data, "rerun_form": RerunForm(),
+        "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
+        "downloads": api.DOWNLOADS if photo_visible else api.DOWNLOADS[:3]})
+
+
+@login_required
+@require_POST
+def procedure_visibility(request, code):
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    form = VisibilityForm(request.POST)
+    if form.is_valid():
+        proc.visibility = form.cleaned_data["visibility"]
+        proc.save(update_fields=["visibility", "updated"])
+        messages.success(request, f"The procedure is now {proc.get_visibility_display().lower()}.")
+    return redirect(proc)
+
+
+@login_required
+@require_POST
+def procedure_fork(request, code):
+    fork = api.fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
+    messages.success(request, "Forked: this copy is yours to edit.")
+    return redirect(fork)
+
+
+@login_required
+@require_POST
+def procedure_rerun(request, code):
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    form = RerunForm(request.POST)
+    if not form.is_valid() or proc.segmentation is None:
+        messages.error(request, "Re-running needs the procedure's segmentation and a node count of at least 1.")
+        return redirect(proc)
+    job = api.submit_job(request.user, proc.segmentation, prefix=proc, prefix_nodes=form.cleaned_data["nodes"])
+    return redirect(job)
+
+
+@login_required
+@require_POST
+def procedure_delete(request, code):
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    proc.delete()
+    messages.success(request, "Procedure deleted.")
+    return redirect("home")

@@ -1,0 +1,117 @@
+// The procedure page: an editable tree of parameters with live re-rendering, variations, overlay opacity.
+const script = document.currentScript || document.querySelector("script[data-code]");
+const code = script.dataset.code;
+const csrf = document.querySelector("meta[name=csrf-token]").content;
+let proc = JSON.parse(document.getElementById("procedure-data").textContent);
+let renderTimer = null;
+let renderedUrl = null;
+
+function label(node) {
+  if (node.rule === "leaf") return node.label;
+  const extra = node.rule === "repeat" ? "" : node.rule === "mirror" ? (node.center ? " (centre)" : "") : "";
+  return `${node.rule}_${node.axis}${node.role ? " · " + node.role : ""}${extra}`;
+}
+
+function numberInput(value, step, onChange) {
+  const input = document.createElement("input");
+  input.type = "number"; input.step = step; input.value = value; input.min = 0;
+  input.addEventListener("input", () => {
+    const v = Number(input.value);
+    if (input.value !== "" && Number.isFinite(v) && v >= 0) { onChange(v); scheduleRender(); }
+  });
+  return input;
+}
+
+function buildTree(node) {
+  const li = document.createElement("li");
+  li.append(label(node));
+  if (node.rule === "repeat" && node.count !== "fill") {
+    li.append(" × ", numberInput(node.count, 1, (v) => { node.count = Math.max(1, Math.round(v)); }));
+  }
+  if (node.children && node.children.length) {
+    const ul = document.createElement("ul");
+    node.children.forEach((child, i) => {
+      const size = node.sizes[i];
+      const item = buildTree(child);
+      const span = document.createElement("span");
+      span.append(` ${size.mode} `, numberInput(size.value, size.mode === "rel" ? 0.01 : 1, (v) => { size.value = v; }));
+      item.insertBefore(span, item.firstChild.nextSibling);
+      ul.append(item);
+    });
+    li.append(ul);
+  }
+  return li;
+}
+
+function drawTree() {
+  const root = document.createElement("ul");
+  root.append(buildTree(proc.root));
+  document.getElementById("tree").replaceChildren(root);
+}
+
+async function render(data) {
+  const r = await fetch("/api/v1/render", {method: "POST", credentials: "same-origin",
+    headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
+  if (!r.ok) { const e = await r.json().catch(() => ({})); throw new Error(JSON.stringify(e)); }
+  return URL.createObjectURL(await r.blob());
+}
+
+function scheduleRender() {
+  clearTimeout(renderTimer);
+  renderTimer = setTimeout(async () => {
+    try {
+      const url = await render(proc);
+      if (renderedUrl) URL.revokeObjectURL(renderedUrl);
+      renderedUrl = url;
+      document.getElementById("render").src = url;
+      const overlay = document.getElementById("overlay");
+      if (overlay) overlay.src = url;
+      const saved = document.getElementById("saved");
+      if (saved) saved.textContent = "unsaved changes";
+    } catch (err) {
+      const saved = document.getElementById("saved");
+      if (saved) saved.textContent = `not valid: ${err.message}`;
+    }
+  }, 150);
+}
+
+document.getElementById("save")?.addEventListener("click", async () => {
+  const r = await fetch(`/api/v1/procedures/${code}/`, {method: "PATCH", credentials: "same-origin",
+    headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify({data: proc})});
+  const body = await r.json();
+  document.getElementById("saved").textContent = r.ok ? "saved" : `not saved: ${JSON.stringify(body)}`;
+  if (r.ok && body.accuracy !== null && document.getElementById("accuracy")) {
+    document.getElementById("accuracy").textContent = body.accuracy.toFixed(4);
+  }
+});
+
+document.getElementById("opacity")?.addEventListener("input", (e) => {
+  document.getElementById("overlay").style.opacity = e.target.value;
+});
+
+document.getElementById("vary").addEventListener("click", async () => {
+  const seed = Number(document.getElementById("seed").value) || 0;
+  const r = await fetch(`/api/v1/procedures/${code}/variations`, {method: "POST", credentials: "same-origin",
+    headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify({n: 8, seed})});
+  const grid = document.getElementById("variants");
+  if (!r.ok) { grid.textContent = "could not make variations"; return; }
+  const {variants} = await r.json();
+  grid.replaceChildren();
+  for (const v of variants) {
+    const card = document.createElement("div");
+    card.className = "card";
+    const img = document.createElement("img");
+    img.src = await render(v);
+    img.alt = v.meta?.variation || "variant";
+    const caption = document.createElement("div");
+    caption.className = "meta";
+    caption.textContent = `${v.meta?.variation || "variant"} · ${Math.round(v.width)}×${Math.round(v.height)}`;
+    const use = document.createElement("button");
+    use.textContent = "Edit this one";
+    use.addEventListener("click", () => { proc = v; drawTree(); scheduleRender(); });
+    card.append(img, caption, use);
+    grid.append(card);
+  }
+});
+
+drawTree();

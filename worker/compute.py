@@ -1,0 +1,40 @@
+"""What a job computes, on plain JSON-ready data. The model is loaded once per process (CUDA when present)
+by `facaid.pipeline.default_model`."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from facaid.grammar import Procedure
+from facaid.segmentation import Segmentation
+
+Progress = Callable[[float, str], None]
+
+
+def reconstruct(segmentation: dict, checkpoint: str, *, k: int = 4, seed: int = 0,
+                prefix: dict | None = None, prefix_nodes: int = 0, progress: Progress | None = None
+                ) -> dict[str, Any]:
+    """Segmentation JSON -> {"procedure": JSON, "accuracy", "accuracy_decoded", "iou", "timings"}.
+
+    ``prefix`` (a procedure JSON) with ``prefix_nodes`` > 0 keeps that procedure's first nodes (BFS) and lets
+    the model continue from them."""
+    from facaid.decoding import prefix_from_procedure
+    from facaid.pipeline import default_model
+    from facaid.pipeline import reconstruct as run
+
+    seg = Segmentation.from_dict(segmentation)
+    if progress:
+        progress(0.05, "loading the model")
+    model, tokenizer = default_model(checkpoint)
+    prefix_ids = None
+    if prefix is not None and prefix_nodes > 0:
+        prefix_ids = prefix_from_procedure(tokenizer, Procedure.from_dict(prefix), prefix_nodes)
+    if progress:
+        progress(0.2, "decoding and sizing")
+    result = run(seg, model=model, tokenizer=tokenizer, k=k, seed=seed, prefix=prefix_ids)
+    out = result.to_dict()
+    out["procedure"] = result.procedure.to_dict()
+    if progress:
+        progress(1.0, "done")
+    return out
