@@ -12,7 +12,7 @@ from django.db import OperationalError, close_old_connections, transaction
 
 from webapp.env import env_int
 from webapp.facades import jobs
-from webapp.facades.models import Job, Procedure
+from webapp.facades.models import Job, Procedure, Visibility
 from worker import compute
 from worker.app import app
 
@@ -85,7 +85,8 @@ def _store(job: Job, result: dict) -> None:
             owner=job.owner, title=photo.title or "", data=result["procedure"], photo=photo,
             segmentation=job.segmentation, accuracy=result["accuracy"],
             metrics={k: result[k] for k in ("accuracy_decoded", "iou", "timings")},
-            parent_id=(job.params or {}).get("parent_id"))
+            parent_id=(job.params or {}).get("parent_id"),
+            visibility=(job.params or {}).get("visibility", Visibility.PRIVATE))
         Job.objects.filter(id=job.id).update(status=Job.Status.DONE, progress=1.0, stage="done", result=proc,
                                              finished=proc.created)
 

@@ -7,7 +7,7 @@ import io
 import warnings
 
 from django.conf import settings
-from django.core.files.base import ContentFile
+from django.core.files.images import ImageFile
 from PIL import Image, ImageOps, UnidentifiedImageError
 
 FORMATS = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
@@ -17,7 +17,7 @@ class UploadError(ValueError):
     """An upload we refuse; the message is shown to the user."""
 
 
-def normalize_photo(upload) -> tuple[ContentFile, int, int]:
+def normalize_photo(upload) -> tuple[ImageFile, int, int]:
     """Validate an uploaded file and return (file to store, width, height), oriented upright.
 
     Raise `UploadError` with a message for the user for anything else."""
@@ -59,4 +59,5 @@ def normalize_photo(upload) -> tuple[ContentFile, int, int]:
     out = io.BytesIO()
     save = {"JPEG": {"quality": 92}, "PNG": {"optimize": False}, "WEBP": {"quality": 92}}[fmt]
     img.save(out, fmt, **save)
-    return ContentFile(out.getvalue(), name=f"photo.{FORMATS[fmt]}"), img.width, img.height
+    out.seek(0)
+    return ImageFile(out, name=f"photo.{FORMATS[fmt]}"), img.width, img.height

@@ -7,9 +7,10 @@ let renderTimer = null;
 let renderedUrl = null;
 
 function label(node) {
-  if (node.rule === "leaf") return node.label;
-  const extra = node.rule === "repeat" ? "" : node.rule === "mirror" ? (node.center ? " (centre)" : "") : "";
-  return `${node.rule}_${node.axis}${node.role ? " · " + node.role : ""}${extra}`;
+  const role = node.role ? ` · ${node.role}` : "";
+  if (node.rule === "leaf") return `${node.label}${role}`;
+  const extra = node.rule === "mirror" && node.center ? " (centre)" : "";
+  return `${node.rule}_${node.axis}${role}${extra}`;
 }
 
 function numberInput(value, step, onChange) {
@@ -31,10 +32,10 @@ function buildTree(node) {
   if (node.children && node.children.length) {
     const ul = document.createElement("ul");
     node.children.forEach((child, i) => {
-      const size = node.sizes[i];
+      const size = node.sizes[i];  // [mode, value]
       const item = buildTree(child);
       const span = document.createElement("span");
-      span.append(` ${size.mode} `, numberInput(size.value, size.mode === "rel" ? 0.01 : 1, (v) => { size.value = v; }));
+      span.append(` ${size[0]} `, numberInput(size[1], size[0] === "rel" ? 0.01 : 1, (v) => { size[1] = v; }));
       item.insertBefore(span, item.firstChild.nextSibling);
       ul.append(item);
     });

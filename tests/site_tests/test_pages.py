@@ -1,0 +1,69 @@
+"""The pages: sign up, log in, upload, photo, job, procedure; and the demo command."""
+
+import pytest
+from django.core.files.uploadedfile import SimpleUploadedFile
+from django.core.management import call_command
+from django.test import Client
+from site_helpers import facade_png
+
+from webapp.facades.models import Job, Photo, Procedure
+
+pytestmark = pytest.mark.django_db
+
+
+def test_signup_login_logout():
+    c = Client()
+    r = c.post("/accounts/signup/", {"username": "dora", "email": "d@example.com", "password1": "a-long-secret-9",
+                                     "password2": "a-long-secret-9"})
+    assert r.status_code == 302
+    assert "dora" in c.get("/").content.decode()
+    c.post("/accounts/logout/")
+    assert "Log in" in c.get("/").content.decode()
+    r = c.post("/accounts/login/", {"username": "dora", "password": "wrong"})
+    assert r.status_code == 200 and "correct" in r.content.decode()
+    assert c.post("/accounts/login/", {"username": "dora", "password": "a-long-secret-9"}).status_code == 302
+
+
+def test_upload_page_and_photo_page_flow(alice):
+    c = Client()
+    c.force_login(alice)
+    r = c.post("/photos/new", {"image": SimpleUploadedFile("x.txt", b"hello"), "visibility": "private"})
+    assert r.status_code == 400 and "not an image" in r.content.decode()
+    data, seg = facade_png()
+    r = c.post("/photos/new", {"image": SimpleUploadedFile("f.png", data), "title": "Mine", "visibility": "public"})
+    photo = Photo.objects.get(title="Mine")
+    assert r.status_code == 302 and r["Location"] == f"/photos/{photo.code}"
+    import json
+
+    r = c.post(f"/photos/{photo.code}/segmentation", {"text": "{bad json"}, follow=True)
+    assert "not valid JSON" in r.content.decode()
+    r = c.post(f"/photos/{photo.code}/segmentation", {"text": json.dumps(seg)}, follow=True)
+    assert "version 1 saved" in r.content.decode()
+    r = c.post(f"/photos/{photo.code}/reconstruct", {"k": 2, "seed": 0})
+    job = Job.objects.get()
+    assert r["Location"] == f"/jobs/{job.code}"
+    assert "queued" in c.get(r["Location"]).content.decode()
+    assert Client().get(f"/photos/{photo.code}").status_code == 200  # public
+    assert c.post(f"/photos/{photo.code}/visibility", {"visibility": "private"}).status_code == 302
+    assert Client().get(f"/photos/{photo.code}").status_code == 404
+
+
+def test_demo_command_is_idempotent(capsys):
+    call_command("demo")
+    call_command("demo")
+    assert Photo.objects.count() == 1 and Job.objects.count() == 1
+    photo = Photo.objects.get()
+    assert photo.visibility == "public" and photo.width > 0 and photo.latest_segmentation().rect_count > 10
+    assert "demo / demo-facade" in capsys.readouterr().out
+
+
+def test_procedure_page_for_owner_and_visitor(alice):
+    from facaid.generator import generate
+
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="public")
+    owner = Client()
+    owner.force_login(alice)
+    page = owner.get(f"/procedures/{proc.code}").content.decode()
+    assert "Save changes" in page and "procedure-data" in page
+    visitor = Client().get(f"/procedures/{proc.code}").content.decode()
+    assert "Save changes" not in visitor and "to fork this procedure" in visitor

@@ -1,0 +1,42 @@
+"""``python manage.py demo``: a demo account with a demo facade photo, its segmentation and a queued
+reconstruction (the worker turns it into a public procedure). Does nothing if the account exists."""
+
+from __future__ import annotations
+
+import io
+
+from django.contrib.auth import get_user_model
+from django.core.files.images import ImageFile
+from django.core.management.base import BaseCommand
+
+from facaid.generator import generate
+from facaid.render import render_segmentation
+from webapp.facades import jobs
+from webapp.facades.models import Photo, Segmentation, Visibility
+
+USERNAME, PASSWORD = "demo", "demo-facade"
+
+
+class Command(BaseCommand):
+    help = "Create the demo account (demo / demo-facade) with a demo facade and queue its reconstruction."
+
+    def add_arguments(self, parser):
+        parser.add_argument("--seed", type=int, default=3, help="generator seed of the demo facade")
+
+    def handle(self, *args, seed: int, **options):
+        users = get_user_model()
+        if users.objects.filter(username=USERNAME).exists():
+            self.stdout.write(f"demo account exists: log in as {USERNAME} / {PASSWORD}")
+            return
+        user = users.objects.create_user(USERNAME, "demo@example.com", PASSWORD)
+        sample = generate(seed)
+        buf = io.BytesIO()
+        render_segmentation(sample.segmentation).save(buf, "PNG")
+        photo = Photo(owner=user, title=f"Demo facade ({sample.style})", visibility=Visibility.PUBLIC)
+        buf.seek(0)
+        photo.image.save("photo.png", ImageFile(buf, name="photo.png"), save=False)
+        photo.save()
+        seg = Segmentation.objects.create(photo=photo, version=1, data=sample.segmentation.to_dict(),
+                                          rect_count=len(sample.segmentation.rects))
+        jobs.submit(owner=user, segmentation=seg, params={"k": 4, "seed": 0, "visibility": Visibility.PUBLIC})
+        self.stdout.write(f"demo account created: log in as {USERNAME} / {PASSWORD}; its facade is queued")
