@@ -6,6 +6,7 @@ urlpatterns = [
     path("", views.home, name="home"),
     path("photos/new", views.photo_new, name="photo-new"),
     path("photos/<str:code>", views.photo, name="photo"),
+    path("photos/<str:code>/edit", views.photo_editor, name="photo-editor"),
     path("photos/<str:code>/visibility", views.photo_visibility, name="photo-visibility"),
     path("photos/<str:code>/segmentation", views.photo_segmentation, name="photo-segmentation"),
     path("photos/<str:code>/reconstruct", views.photo_reconstruct, name="photo-reconstruct"),

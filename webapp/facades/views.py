@@ -109,6 +109,13 @@ def photo_reconstruct(request, code):
     return redirect(job)
 
 
+@login_required
+def photo_editor(request, code):
+    photo = access.get_rw_photo_for_user(request.user, code)
+    segmentation = photo.latest_segmentation()
+    return render(request, "facades/editor.html", {"photo": photo, "segmentation": segmentation})
+
+
 def job(request, code):
     return render(request, "facades/job.html", {"job": access.get_job_for_user(request.user, code)})
 

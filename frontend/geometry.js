@@ -1,0 +1,102 @@
+// Rectangles in image pixels: {x0, y0, x1, y1}, half-open, origin top-left. No DOM.
+
+export function normalize(r) {
+  return {x0: Math.min(r.x0, r.x1), y0: Math.min(r.y0, r.y1), x1: Math.max(r.x0, r.x1), y1: Math.max(r.y0, r.y1)};
+}
+
+/** Round to whole pixels and clip to the image; null when nothing of at least 1x1 is left. */
+export function clampToImage(r, width, height) {
+  const n = normalize(r);
+  const x0 = Math.max(0, Math.min(width, Math.round(n.x0)));
+  const y0 = Math.max(0, Math.min(height, Math.round(n.y0)));
+  const x1 = Math.max(0, Math.min(width, Math.round(n.x1)));
+  const y1 = Math.max(0, Math.min(height, Math.round(n.y1)));
+  return x1 - x0 >= 1 && y1 - y0 >= 1 ? {x0, y0, x1, y1} : null;
+}
+
+export function contains(r, x, y) {
+  return x >= r.x0 && x < r.x1 && y >= r.y0 && y < r.y1;
+}
+
+export function intersects(a, b) {
+  return a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1;
+}
+
+export function translate(r, dx, dy) {
+  return {x0: r.x0 + dx, y0: r.y0 + dy, x1: r.x1 + dx, y1: r.y1 + dy};
+}
+
+/** Move by (dx, dy) but keep the rectangle inside the image, size unchanged. */
+export function moveWithin(r, dx, dy, width, height) {
+  const w = r.x1 - r.x0, h = r.y1 - r.y0;
+  const x0 = Math.max(0, Math.min(width - w, r.x0 + dx));
+  const y0 = Math.max(0, Math.min(height - h, r.y0 + dy));
+  return {x0, y0, x1: x0 + w, y1: y0 + h};
+}
+
+export const HANDLES = ["nw", "n", "ne", "e", "se", "s", "sw", "w"];
+
+/** The rectangle with the edges named by a handle ("nw", "e", ...) moved to (x, y). */
+export function resize(r, handle, x, y) {
+  const out = {...r};
+  if (handle.includes("n")) out.y0 = y;
+  if (handle.includes("s")) out.y1 = y;
+  if (handle.includes("w")) out.x0 = x;
+  if (handle.includes("e")) out.x1 = x;
+  return normalize(out);
+}
+
+/** Handle positions of a rectangle: {name: [x, y]}. */
+export function handlePoints(r) {
+  const mx = (r.x0 + r.x1) / 2, my = (r.y0 + r.y1) / 2;
+  return {nw: [r.x0, r.y0], n: [mx, r.y0], ne: [r.x1, r.y0], e: [r.x1, my], se: [r.x1, r.y1], s: [mx, r.y1],
+    sw: [r.x0, r.y1], w: [r.x0, my]};
+}
+
+/** The handle within `tolerance` (image pixels) of (x, y), or null. */
+export function handleAt(r, x, y, tolerance) {
+  for (const [name, [hx, hy]] of Object.entries(handlePoints(r))) {
+    if (Math.abs(hx - x) <= tolerance && Math.abs(hy - y) <= tolerance) return name;
+  }
+  return null;
+}
+
+/**
+ * Snap the moving edges of `r` to the edges of `others` (and the image border) within `threshold` pixels.
+ * `edges` names the edges that move ("x0", "x1", "y0", "y1"); when both edges of an axis move (a drag), the
+ * rectangle keeps its size. Returns {rect, guides}: guides are {axis: "x"|"y", at} lines to draw.
+ */
+export function snap(r, others, threshold, edges = ["x0", "x1", "y0", "y1"], bounds = null) {
+  const xs = [], ys = [];
+  for (const o of others) { xs.push(o.x0, o.x1); ys.push(o.y0, o.y1); }
+  if (bounds) { xs.push(0, bounds.width); ys.push(0, bounds.height); }
+  const out = {...r};
+  const guides = [];
+  for (const [axis, lo, hi, targets] of [["x", "x0", "x1", xs], ["y", "y0", "y1", ys]]) {
+    const moving = [lo, hi].filter((e) => edges.includes(e));
+    let best = null;
+    for (const e of moving) {
+      for (const t of targets) {
+        const d = t - r[e];
+        if (Math.abs(d) <= threshold && (best === null || Math.abs(d) < Math.abs(best.d))) best = {d, at: t};
+      }
+    }
+    if (best === null) continue;
+    if (moving.length === 2) { out[lo] += best.d; out[hi] += best.d; } else { out[moving[0]] += best.d; }
+    guides.push({axis, at: best.at});
+  }
+  return {rect: out, guides};
+}
+
+/** Copies of `r` along a row, a column or on a grid: `cols` x `rows` with steps dx, dy (the original first). */
+export function repeatRect(r, {cols = 1, rows = 1, dx = 0, dy = 0}) {
+  if (!(Number.isInteger(cols) && Number.isInteger(rows) && cols >= 1 && rows >= 1)) {
+    throw new Error("counts must be whole numbers of at least 1");
+  }
+  if (cols * rows > 2000) throw new Error("at most 2000 copies at once");
+  const out = [];
+  for (let j = 0; j < rows; j++) {
+    for (let i = 0; i < cols; i++) out.push(translate(r, i * dx, j * dy));
+  }
+  return out;
+}

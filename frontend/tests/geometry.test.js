@@ -1,0 +1,43 @@
+import assert from "node:assert/strict";
+import {test} from "node:test";
+
+import {clampToImage, handleAt, moveWithin, normalize, repeatRect, resize, snap} from "../geometry.js";
+
+test("normalize and clamp", () => {
+  assert.deepEqual(normalize({x0: 5, y0: 9, x1: 1, y1: 2}), {x0: 1, y0: 2, x1: 5, y1: 9});
+  assert.deepEqual(clampToImage({x0: -3, y0: 2.4, x1: 12.6, y1: 50}, 10, 20), {x0: 0, y0: 2, x1: 10, y1: 20});
+  assert.equal(clampToImage({x0: 4, y0: 4, x1: 4.2, y1: 9}, 10, 10), null);
+  assert.equal(clampToImage({x0: 20, y0: 0, x1: 30, y1: 5}, 10, 10), null);
+});
+
+test("move stays within the image and resize by handles", () => {
+  assert.deepEqual(moveWithin({x0: 2, y0: 2, x1: 6, y1: 4}, 100, -9, 10, 10), {x0: 6, y0: 0, x1: 10, y1: 2});
+  assert.deepEqual(resize({x0: 2, y0: 2, x1: 6, y1: 4}, "se", 8, 9), {x0: 2, y0: 2, x1: 8, y1: 9});
+  assert.deepEqual(resize({x0: 2, y0: 2, x1: 6, y1: 4}, "w", 9, 0), {x0: 6, y0: 2, x1: 9, y1: 4});  // flipped
+  assert.equal(handleAt({x0: 0, y0: 0, x1: 10, y1: 10}, 10.5, 5, 1), "e");
+  assert.equal(handleAt({x0: 0, y0: 0, x1: 10, y1: 10}, 5, 5, 1), null);
+});
+
+test("snap moves edges to neighbours and reports guides", () => {
+  const others = [{x0: 20, y0: 0, x1: 30, y1: 10}];
+  const {rect, guides} = snap({x0: 0, y0: 3, x1: 18, y1: 8}, others, 3, ["x1"]);
+  assert.deepEqual(rect, {x0: 0, y0: 3, x1: 20, y1: 8});
+  assert.deepEqual(guides, [{axis: "x", at: 20}]);
+  // a drag moves both edges: the size is kept
+  const drag = snap({x0: 31, y0: 1, x1: 35, y1: 9}, others, 2);
+  assert.deepEqual(drag.rect, {x0: 30, y0: 0, x1: 34, y1: 8});
+  assert.equal(drag.guides.length, 2);
+  assert.deepEqual(snap({x0: 0, y0: 0, x1: 5, y1: 5}, others, 2, ["x1"]).guides, []);
+  assert.deepEqual(snap({x0: 1, y0: 0, x1: 5, y1: 5}, [], 2, ["x0"], {width: 50, height: 50}).rect.x0, 0);
+});
+
+test("repeat on a row, a column and a grid", () => {
+  const r = {x0: 0, y0: 0, x1: 4, y1: 6};
+  assert.equal(repeatRect(r, {cols: 5, dx: 10}).length, 5);
+  assert.deepEqual(repeatRect(r, {rows: 3, dy: 8})[2], {x0: 0, y0: 16, x1: 4, y1: 22});
+  const grid = repeatRect(r, {cols: 3, rows: 2, dx: 10, dy: 20});
+  assert.equal(grid.length, 6);
+  assert.deepEqual(grid[5], {x0: 20, y0: 20, x1: 24, y1: 26});
+  assert.throws(() => repeatRect(r, {cols: 0}), /at least 1/);
+  assert.throws(() => repeatRect(r, {cols: 100, rows: 100}), /2000/);
+});

@@ -1,0 +1,112 @@
+"""The canvas editor in Debian's Chromium through Playwright: draw with mouse and keys, undo and redo, repeat,
+delete, save a version, export JSON, the warning before leaving with unsaved changes."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from webapp.facades.models import Segmentation
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync"]
+pytestmark = [pytest.mark.django_db(transaction=True),
+              pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
+
+
+@pytest.fixture
+def browser(monkeypatch):
+    from playwright.sync_api import sync_playwright
+
+    # Playwright's sync API keeps an event loop in this thread; the ORM calls of the test are still synchronous
+    monkeypatch.setenv("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+def login(page, base, username, password):
+    page.goto(f"{base}/accounts/login/")
+    page.fill("#id_username", username)
+    page.fill("#id_password", password)
+    page.click("button[type=submit]")
+    page.wait_for_url(f"{base}/")
+
+
+E = "window.facaidEditor"
+
+
+def test_editor_draw_undo_repeat_save_export(live_server, facade_photo, browser, tmp_path):
+    photo, seg = facade_photo
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
+    page.wait_for_function(f"{E}?.seg?.size > 0")
+    n0 = page.evaluate(f"{E}.seg.size")
+    assert n0 == seg["rect_count"]
+    view = page.evaluate(f"({{s: {E}.view.scale, ox: {E}.view.ox, oy: {E}.view.oy}})")
+    box = page.locator("#canvas").bounding_box()
+
+    def at(x, y):
+        return box["x"] + view["ox"] + x * view["s"], box["y"] + view["oy"] + y * view["s"]
+
+    # draw a door with the mouse after picking the class by its hotkey
+    page.keyboard.press("4")
+    page.mouse.move(*at(20, 40))
+    page.mouse.down()
+    page.mouse.move(*at(60, 100), steps=6)
+    page.mouse.up()
+    assert page.evaluate(f"{E}.seg.size") == n0 + 1
+    door = page.evaluate(f"[...{E}.ui.selection].map(id => {E}.seg.get(id))")[0]
+    assert door["label"] == "door" and abs(door["x1"] - door["x0"] - 40) <= 7 and abs(door["y1"] - door["y0"] - 60) <= 7
+    # undo and redo with keys, then with the buttons
+    page.keyboard.press("Control+z")
+    assert page.evaluate(f"{E}.seg.size") == n0
+    page.keyboard.press("Control+Shift+z")
+    assert page.evaluate(f"{E}.seg.size") == n0 + 1
+    page.click("#undo")
+    page.click("#redo")
+    assert page.evaluate(f"{E}.seg.size") == n0 + 1
+    # select it again, nudge it with the arrow keys, relabel it with a key
+    page.keyboard.press("v")
+    page.evaluate(f"{E}.ui.selection = new Set([{door['id']}])")
+    page.keyboard.press("Shift+ArrowRight")
+    assert page.evaluate(f"{E}.seg.get({door['id']}).x0") == door["x0"] + 10
+    page.keyboard.press("3")
+    assert page.evaluate(f"{E}.seg.get({door['id']}).label") == "window"
+    # the repeat tool: three columns
+    page.fill("#rep-cols", "3")
+    page.fill("#rep-rows", "1")
+    page.fill("#rep-gapx", "5")
+    page.click("#repeat")
+    assert page.evaluate(f"{E}.seg.size") == n0 + 3
+    page.keyboard.press("Delete")
+    assert page.evaluate(f"{E}.seg.size") == n0 + 2
+    assert page.text_content("#dirty") == "unsaved changes"
+    # save: a new version on the server
+    page.click("#save")
+    page.wait_for_function("document.querySelector('#dirty').textContent === 'saved'")
+    latest = Segmentation.objects.filter(photo__code=photo["code"]).order_by("-version").first()
+    assert latest.version == 2 and latest.rect_count == n0 + 2
+    # export: the JSON the editor holds
+    with page.expect_download() as download:
+        page.click("#export")
+    path = tmp_path / "export.json"
+    download.value.save_as(path)
+    exported = json.loads(path.read_text())
+    assert (exported["width"], exported["height"]) == (photo["width"], photo["height"])
+    assert len(exported["rects"]) == n0 + 2
+    # leaving with unsaved changes asks first
+    page.keyboard.press("Control+z")
+    dialogs = []
+    page.on("dialog", lambda d: (dialogs.append(d.type), d.dismiss()))
+    page.evaluate("location.reload()")
+    page.wait_for_timeout(300)
+    assert "beforeunload" in dialogs
+    assert errors == []
