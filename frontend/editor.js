@@ -6,6 +6,7 @@ import {clampToImage, handleAt, handlePoints, intersects, moveWithin, normalize,
 import {History} from "./history.js";
 import {HOTKEYS, LABELS, cssColor} from "./labels.js";
 import {findSimilar, toGray} from "./match.js";
+import {RectifyMode} from "./rectify-mode.js";
 import {Segmentation} from "./state.js";
 
 const $ = (sel) => document.querySelector(sel);
@@ -24,6 +25,8 @@ let photo = null;  // HTMLImageElement
 let seg = null;
 let history = null;
 let gray = null;
+let info = null;  // the photo's API record
+let rectifying = null;  // a RectifyMode while the rectification step is open
 
 // --- loading --------------------------------------------------------------------------------------------------
 async function api(path, options = {}) {
@@ -42,7 +45,7 @@ function status(text, kind = "") {
 }
 
 async function load() {
-  const info = await api(`/api/v1/photos/${photoCode}/`);
+  info = await api(`/api/v1/photos/${photoCode}/`);
   photo = new Image();
   photo.src = info.rectified || info.image;
   await photo.decode();
@@ -50,9 +53,15 @@ async function load() {
   history = new History(seg);
   if (info.segmentation) {
     const saved = await api(`/api/v1/segmentations/${info.segmentation}/`);
-    history.execute(new ReplaceAll(Segmentation.fromJSON(saved.data).toJSON().rects));
-    history.done = [];  // the loaded version is the starting point, not an undoable step
-    history.markSaved();
+    if (saved.data.width === seg.width && saved.data.height === seg.height) {
+      history.execute(new ReplaceAll(Segmentation.fromJSON(saved.data).toJSON().rects));
+      history.done = [];  // the loaded version is the starting point, not an undoable step
+      history.markSaved();
+    } else {
+      root.dataset.segmentation = "";
+      status(`The saved segmentation (${saved.data.width}x${saved.data.height}) was drawn before rectification; ` +
+        "start a new one on the rectified photo.");
+    }
   }
   const draft = localStorage.getItem(draftKey());
   if (draft) {
@@ -117,6 +126,7 @@ function strokeRect(r, color, width = 1, dash = []) {
 }
 
 function draw() {
+  if (rectifying) return rectifying.draw();
   if (!seg) return;
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.fillStyle = "#2a2f36";
@@ -181,7 +191,8 @@ function buildPalette() {
 function pickLabel(label) {
   ui.label = label;
   for (const b of document.querySelectorAll("#palette button")) b.classList.toggle("active", b.dataset.label === label);
-  if (ui.selection.size) run(setLabel([...ui.selection], label));
+  // with the select tool the class goes to the selection; with the draw tool it is the class of the next one
+  if (ui.tool === "select" && ui.selection.size) run(setLabel([...ui.selection], label));
 }
 
 function setTool(tool) {
@@ -202,6 +213,7 @@ function snapped(rect, ids, edges, event) {
 
 canvas.addEventListener("pointerdown", (e) => {
   canvas.setPointerCapture(e.pointerId);
+  if (rectifying) return rectifying.pointerdown(e);
   const [x, y] = toImage(e.offsetX, e.offsetY);
   if (ui.space || e.button === 1) {
     ui.drag = {kind: "pan", sx: e.offsetX, sy: e.offsetY, ox: view.ox, oy: view.oy};
@@ -234,6 +246,7 @@ canvas.addEventListener("pointerdown", (e) => {
 });
 
 canvas.addEventListener("pointermove", (e) => {
+  if (rectifying) return rectifying.pointermove(e);
   const d = ui.drag;
   if (!d) return;
   const [x, y] = toImage(e.offsetX, e.offsetY);
@@ -277,6 +290,7 @@ canvas.addEventListener("pointermove", (e) => {
 });
 
 canvas.addEventListener("pointerup", () => {
+  if (rectifying) return rectifying.pointerup();
   const d = ui.drag;
   ui.drag = null;
   ui.guides = [];
@@ -454,6 +468,36 @@ async function poll(code) {
   draw();
 }
 
+// --- rectification ------------------------------------------------------------------------------------------------
+async function openRectify() {
+  const original = new Image();
+  original.src = info.image;
+  await original.decode();
+  rectifying = new RectifyMode({canvas, preview: $("#rectify-preview"), image: original, corners: info.corners});
+  $("#rectify-panel").hidden = false;
+  rectifying.draw();
+  rectifying.renderPreview();
+  status("Drag the four corners onto the facade's corners; the preview shows the result.");
+}
+
+function closeRectify() {
+  rectifying = null;
+  $("#rectify-panel").hidden = true;
+  draw();
+}
+
+async function applyRectify() {
+  if (seg.size && !confirm("Rectifying changes the image: the rectangles drawn so far do not carry over. Go on?")) return;
+  try {
+    await api(`/api/v1/photos/${photoCode}/rectify`, {method: "POST", body: JSON.stringify({corners: rectifying.corners})});
+    history.markSaved();
+    localStorage.removeItem(draftKey());
+    location.reload();
+  } catch (err) {
+    status(`Not rectified: ${err.message}`, "error");
+  }
+}
+
 // --- wiring -----------------------------------------------------------------------------------------------------
 for (const b of document.querySelectorAll("[data-tool]")) b.addEventListener("click", () => setTool(b.dataset.tool));
 $("#undo").addEventListener("click", () => history.undo());
@@ -469,6 +513,9 @@ $("#save").addEventListener("click", () => save().catch((err) => status(`Not sav
 $("#submit").addEventListener("click", submit);
 $("#fill").addEventListener("input", draw);
 $("#overlay-alpha").addEventListener("input", (e) => { ui.overlayAlpha = Number(e.target.value); draw(); });
+$("#rectify").addEventListener("click", openRectify);
+$("#rectify-apply").addEventListener("click", applyRectify);
+$("#rectify-cancel").addEventListener("click", closeRectify);
 window.addEventListener("resize", fit);
 window.addEventListener("beforeunload", (e) => {
   if (history?.dirty) { e.preventDefault(); e.returnValue = ""; }
@@ -477,4 +524,5 @@ setTool("draw");
 load().catch((err) => status(`Could not load the photo: ${err.message}`, "error"));
 
 // for tests and the console
-window.facaidEditor = {get seg() { return seg; }, get history() { return history; }, ui, view};
+window.facaidEditor = {get seg() { return seg; }, get history() { return history; }, get rectifying() { return rectifying; },
+  ui, view};

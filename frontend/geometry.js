@@ -100,3 +100,55 @@ export function repeatRect(r, {cols = 1, rows = 1, dx = 0, dy = 0}) {
   }
   return out;
 }
+
+/** The 3x3 homography (row-major array of 9) mapping four points src[i] -> dst[i]. */
+export function homography(src, dst) {
+  const a = [], b = [];
+  for (let i = 0; i < 4; i++) {
+    const [x, y] = src[i], [u, v] = dst[i];
+    a.push([x, y, 1, 0, 0, 0, -u * x, -u * y]);
+    a.push([0, 0, 0, x, y, 1, -v * x, -v * y]);
+    b.push(u, v);
+  }
+  // Gaussian elimination with partial pivoting on the 8x8 system
+  const n = 8;
+  for (let c = 0; c < n; c++) {
+    let p = c;
+    for (let r = c + 1; r < n; r++) if (Math.abs(a[r][c]) > Math.abs(a[p][c])) p = r;
+    if (Math.abs(a[p][c]) < 1e-12) throw new Error("the four points do not define a homography");
+    [a[c], a[p]] = [a[p], a[c]];
+    [b[c], b[p]] = [b[p], b[c]];
+    for (let r = 0; r < n; r++) {
+      if (r === c) continue;
+      const f = a[r][c] / a[c][c];
+      for (let k = c; k < n; k++) a[r][k] -= f * a[c][k];
+      b[r] -= f * b[c];
+    }
+  }
+  return [...b.map((v, i) => v / a[i][i]), 1];
+}
+
+export function applyHomography(h, x, y) {
+  const w = h[6] * x + h[7] * y + h[8];
+  return [(h[0] * x + h[1] * y + h[2]) / w, (h[3] * x + h[4] * y + h[5]) / w];
+}
+
+/** Width and height of the rectified image: the mean lengths of opposite edges (as facaid/rectify.py). */
+export function rectifiedSize(corners) {
+  const d = (p, q) => Math.hypot(p[0] - q[0], p[1] - q[1]);
+  const [tl, tr, br, bl] = corners;
+  return [Math.max(1, Math.round((d(tl, tr) + d(bl, br)) / 2)), Math.max(1, Math.round((d(tl, bl) + d(tr, br)) / 2))];
+}
+
+/** Is the quadrilateral (TL, TR, BR, BL) convex and in order? */
+export function isConvexQuad(corners) {
+  let sign = 0;
+  for (let i = 0; i < 4; i++) {
+    const [a, b, c] = [corners[i], corners[(i + 1) % 4], corners[(i + 2) % 4]];
+    const cross = (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]);
+    if (Math.abs(cross) < 1e-9) return false;
+    if (sign === 0) sign = Math.sign(cross);
+    else if (Math.sign(cross) !== sign) return false;
+  }
+  return true;
+}

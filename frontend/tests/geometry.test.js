@@ -41,3 +41,20 @@ test("repeat on a row, a column and a grid", () => {
   assert.throws(() => repeatRect(r, {cols: 0}), /at least 1/);
   assert.throws(() => repeatRect(r, {cols: 100, rows: 100}), /2000/);
 });
+
+test("homography maps the four corners and is projective in between", async () => {
+  const {applyHomography, homography, isConvexQuad, rectifiedSize} = await import("../geometry.js");
+  const src = [[10, 20], [110, 10], [120, 90], [5, 100]];
+  const dst = [[0, 0], [100, 0], [100, 80], [0, 80]];
+  const h = homography(dst, src);  // output -> source, as the preview samples
+  for (let i = 0; i < 4; i++) {
+    const [x, y] = applyHomography(h, ...dst[i]);
+    assert.ok(Math.abs(x - src[i][0]) < 1e-6 && Math.abs(y - src[i][1]) < 1e-6);
+  }
+  const id = homography(dst, dst);
+  assert.deepEqual(applyHomography(id, 37, 12).map((v) => Math.round(v * 1e6) / 1e6), [37, 12]);
+  assert.deepEqual(rectifiedSize([[0, 0], [100, 0], [100, 50], [0, 50]]), [100, 50]);
+  assert.equal(isConvexQuad(src), true);
+  assert.equal(isConvexQuad([[0, 0], [10, 0], [0, 10], [10, 10]]), false);  // crossed
+  assert.throws(() => homography([[0, 0], [0, 0], [0, 0], [0, 0]], dst), /homography/);
+});

@@ -4,7 +4,7 @@ made from generated facades, a media root per test."""
 from __future__ import annotations
 
 import pytest
-from site_helpers import client_for, facade_png, upload
+from site_helpers import Redis, Worker, client_for, facade_png, upload
 
 
 @pytest.fixture(autouse=True)
@@ -46,3 +46,29 @@ def facade_photo(as_alice):
     r = as_alice.post(f"/api/v1/photos/{photo['code']}/segmentations/", seg, format="json")
     assert r.status_code == 201, r.content
     return photo, r.json()
+
+
+@pytest.fixture
+def redis(tmp_path):
+    server = Redis(tmp_path)
+    server.start()
+    from worker.app import app
+
+    def use(url):  # point the sending side at this server, with fresh connection pools
+        app.conf.broker_url = url
+        if app._pool is not None:
+            app._pool.force_close_all()
+        app._pool = None
+        app.amqp._producer_pool = None
+
+    use(server.url)
+    yield server
+    server.stop()
+    use(server.url)
+
+
+@pytest.fixture
+def worker(redis, tmp_path):
+    w = Worker(redis, tmp_path / "worker.log")
+    yield w
+    w.kill()
