@@ -67,3 +67,36 @@ def test_a_redis_restart_loses_no_job(alice, redis, worker):
     redis.start()
     worker.start()
     check_done(wait_for(job, {"done", "failed"}), attempts=1)
+
+
+def test_rerun_from_a_prefix_and_a_failure_is_recorded(alice, worker):
+    from facaid.decoding import prefix_from_procedure
+    from facaid.grammar import Procedure as Tree
+    from facaid.pipeline import default_model
+    from webapp.facades.models import Procedure
+
+    worker.start()
+    first = wait_for(submit(alice), {"done", "failed"})
+    check_done(first, attempts=1)
+    client = client_for(alice)
+    r = client.post(f"/api/v1/procedures/{first.result.code}/rerun", {"nodes": 3, "k": 2}, format="json")
+    assert r.status_code == 202
+    rerun = wait_for(Job.objects.get(code=r.json()["code"]), {"done", "failed"})
+    check_done(rerun, attempts=1)
+    assert rerun.result.parent_id == first.result.id  # lineage
+    _, tok = default_model()
+
+    def structure(data):  # the first three nodes without their sizes (the sizing refits those)
+        ids = prefix_from_procedure(tok, Tree.from_dict(data), 3)
+        return [t for t in ids if tok.vocab.kinds[t] not in ("abs", "flt", "rel")]
+
+    assert structure(rerun.result.data) == structure(first.result.data)
+    # a job whose prefix procedure was deleted before it ran fails with a message; the worker goes on
+    worker.kill()
+    r = client.post(f"/api/v1/procedures/{first.result.code}/rerun", {"nodes": 2}, format="json")
+    doomed = Job.objects.get(code=r.json()["code"])
+    Procedure.objects.filter(id=first.result.id).delete()
+    worker.start()
+    doomed = wait_for(doomed, {"done", "failed"})
+    assert doomed.status == "failed" and "DoesNotExist" in doomed.message
+    check_done(wait_for(submit(alice), {"done", "failed"}), attempts=1)
