@@ -88,6 +88,7 @@ USE_TZ = True
 
 STATIC_URL = "static/"
 STATIC_ROOT = VAR_DIR / "static"
+STATIC_ROOT.mkdir(parents=True, exist_ok=True)  # WhiteNoise warns about a missing one before collectstatic
 WHITENOISE_AUTOREFRESH = env_bool("WHITENOISE_AUTOREFRESH", DEBUG)  # re-read changed files (development)
 STATICFILES_DIRS = [BASE_DIR / "webapp" / "static", ("editor", BASE_DIR / "frontend")]
 MEDIA_URL = "media/"
