@@ -41,6 +41,12 @@ def get_rw_photo_for_user(user, code) -> Photo:
     return _owned(photo, user, photo.owner)
 
 
+def photo_visible_to(user, photo: Photo | None) -> bool:
+    """May ``user`` see this photo (for example under a procedure made from it)?"""
+    return photo is not None and ((user.is_authenticated and photo.owner_id == user.id)
+                                  or photo.visibility in READABLE)
+
+
 def get_segmentation_for_user(user, code) -> Segmentation:
     qs = _readable(Segmentation.objects.select_related("photo"), user, "photo__owner", "photo__visibility")
     return _get(qs, code)

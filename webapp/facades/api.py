@@ -345,8 +345,7 @@ def procedure_download(request, code, name):
         elif name == "labels.png":
             resp = HttpResponse(rendering.label_map_png(seg), content_type="image/png")
         else:
-            if proc.photo is None or not (proc.photo.owner == request.user
-                                          or proc.photo.visibility != Visibility.PRIVATE):
+            if not access.photo_visible_to(request.user, proc.photo):
                 raise ValidationError({"name": "this procedure has no photo you may see to overlay"})
             try:
                 alpha = float(request.query_params.get("alpha", 0.5))

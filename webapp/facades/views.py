@@ -23,6 +23,15 @@ def _error_text(exc: ValidationError) -> str:
     return " ".join(map(str, detail)) if isinstance(detail, list) else str(detail)
 
 
+def _set_visibility(request, obj, noun: str):
+    form = VisibilityForm(request.POST)
+    if form.is_valid():
+        obj.visibility = form.cleaned_data["visibility"]
+        obj.save()
+        messages.success(request, f"The {noun} is now {obj.get_visibility_display().lower()}.")
+    return redirect(obj)
+
+
 def home(request):
     gallery = Paginator(access.public_procedures(), 24).get_page(request.GET.get("page"))
     context = {"gallery": gallery}
@@ -55,8 +64,8 @@ def photo(request, code):
     context = {"photo": photo, "owner": owner, "segmentation": segmentation,
                "procedures": photo.procedures.filter(owner=photo.owner) if owner else
                photo.procedures.filter(visibility="public"),
-               "jobs": photo.segmentations.none() if not owner else
-               Job.objects.filter(segmentation__photo=photo).select_related("result")[:10],
+               "jobs": Job.objects.filter(segmentation__photo=photo).select_related("result")[:10] if owner
+               else Job.objects.none(),
                "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
                "visibility_form": VisibilityForm(initial={"visibility": photo.visibility})}
     return render(request, "facades/photo.html", context)
@@ -65,13 +74,7 @@ def photo(request, code):
 @login_required
 @require_POST
 def photo_visibility(request, code):
-    photo = access.get_rw_photo_for_user(request.user, code)
-    form = VisibilityForm(request.POST)
-    if form.is_valid():
-        photo.visibility = form.cleaned_data["visibility"]
-        photo.save(update_fields=["visibility"])
-        messages.success(request, f"The photo is now {photo.get_visibility_display().lower()}.")
-    return redirect(photo)
+    return _set_visibility(request, access.get_rw_photo_for_user(request.user, code), "photo")
 
 
 @login_required
@@ -123,8 +126,7 @@ def job(request, code):
 def procedure(request, code):
     proc = access.get_procedure_for_user(request.user, code)
     owner = request.user == proc.owner
-    photo_visible = proc.photo is not None and (proc.photo.owner == request.user
-                                                or proc.photo.visibility != "private")
+    photo_visible = access.photo_visible_to(request.user, proc.photo)
     return render(request, "facades/procedure.html", {
         "proc": proc, "owner": owner, "photo_visible": photo_visible, "lineage": proc.lineage(),
         "data_json": proc.data, "rerun_form": RerunForm(),
@@ -135,13 +137,7 @@ def procedure(request, code):
 @login_required
 @require_POST
 def procedure_visibility(request, code):
-    proc = access.get_rw_procedure_for_user(request.user, code)
-    form = VisibilityForm(request.POST)
-    if form.is_valid():
-        proc.visibility = form.cleaned_data["visibility"]
-        proc.save(update_fields=["visibility", "updated"])
-        messages.success(request, f"The procedure is now {proc.get_visibility_display().lower()}.")
-    return redirect(proc)
+    return _set_visibility(request, access.get_rw_procedure_for_user(request.user, code), "procedure")
 
 
 @login_required
