@@ -5,6 +5,7 @@ import json
 
 import pytest
 from PIL import Image
+from site_helpers import image_bytes, upload
 
 from facaid.generator import generate
 from webapp.facades.models import Job
@@ -139,3 +140,14 @@ def test_openapi_schema_documents_the_api(as_charlie):
     schema = json.loads(r.content)
     for path in ("/api/v1/photos/", "/api/v1/jobs/", "/api/v1/procedures/{code}/fork", "/api/v1/gallery/"):
         assert path in schema["paths"], path
+
+
+def test_photo_list_names_each_latest_segmentation_in_one_query(facade_photo, as_alice, django_assert_max_num_queries):
+    photo, seg = facade_photo
+    newer = as_alice.post(seg_url(photo), seg["data"], format="json").json()
+    for _ in range(4):
+        upload(as_alice, image_bytes())
+    with django_assert_max_num_queries(6):  # session, user, count, page: not one per photo
+        listed = as_alice.get("/api/v1/photos/").json()["results"]
+    assert len(listed) == 5 and listed[-1]["segmentation"] == newer["code"]
+    assert [p["segmentation"] for p in listed[:4]] == [None] * 4

@@ -68,4 +68,4 @@ def get_job_for_user(user, code) -> Job:
 
 
 def public_procedures() -> QuerySet:
-    return Procedure.objects.filter(visibility=Visibility.PUBLIC).select_related("owner")
+    return Procedure.objects.filter(visibility=Visibility.PUBLIC).select_related("owner", "parent")

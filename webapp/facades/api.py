@@ -7,7 +7,7 @@ import io
 
 from django.core.files.base import ContentFile
 from django.db import transaction
-from django.db.models import Max
+from django.db.models import Max, OuterRef, Subquery
 from django.http import FileResponse, Http404, HttpResponse
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from PIL import Image
@@ -67,7 +67,10 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
 @parser_classes([MultiPartParser, FormParser])
 def photos(request):
     if request.method == "GET":
-        return _page(request, Photo.objects.filter(owner=request.user), PhotoSerializer)
+        latest = Segmentation.objects.filter(photo=OuterRef("pk")).order_by("-version").values("code")[:1]
+        photos = Photo.objects.filter(owner=request.user).select_related("owner").annotate(
+            latest_segmentation_code=Subquery(latest))
+        return _page(request, photos, PhotoSerializer)
     form = PhotoUploadSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     photo = create_photo(request.user, form.validated_data["image"], form.validated_data.get("title", ""),
@@ -225,7 +228,8 @@ def job_detail(request, code):
 @parser_classes([JSONParser])
 def procedure_list(request):
     if request.method == "GET":
-        return _page(request, Procedure.objects.filter(owner=request.user), ProcedureSummarySerializer)
+        return _page(request, Procedure.objects.filter(owner=request.user).select_related("owner", "parent"),
+                     ProcedureSummarySerializer)
     form = ProcedureWriteSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     if "data" not in form.validated_data:

@@ -44,6 +44,9 @@ class PhotoSerializer(serializers.ModelSerializer):
         return f"/api/v1/photos/{photo.code}/image?rectified=1" if photo.rectified else None
 
     def get_segmentation(self, photo: Photo) -> str | None:
+        if hasattr(photo, "latest_segmentation_code"):  # annotated by lists: no query per photo
+            code = photo.latest_segmentation_code
+            return str(code) if code else None
         seg = photo.latest_segmentation()
         return str(seg.code) if seg else None
 
