@@ -72,7 +72,8 @@ def test_a_redis_restart_loses_no_job(alice, redis, worker):
 def test_rerun_from_a_prefix_and_a_failure_is_recorded(alice, worker):
     from facaid.decoding import prefix_from_procedure
     from facaid.grammar import Procedure as Tree
-    from facaid.pipeline import default_model
+    from facaid.paths import DEFAULT_CHECKPOINT
+    from facaid.tokenizer import Tokenizer
     from webapp.facades.models import Procedure
 
     worker.start()
@@ -84,7 +85,7 @@ def test_rerun_from_a_prefix_and_a_failure_is_recorded(alice, worker):
     rerun = wait_for(Job.objects.get(code=r.json()["code"]), {"done", "failed"})
     check_done(rerun, attempts=1)
     assert rerun.result.parent_id == first.result.id  # lineage
-    _, tok = default_model()
+    tok = Tokenizer.load(DEFAULT_CHECKPOINT / "tokenizer.json")  # the tokenizer alone, not the model
 
     def structure(data):  # the first three nodes without their sizes (the sizing refits those)
         ids = prefix_from_procedure(tok, Tree.from_dict(data), 3)

@@ -19,6 +19,7 @@ from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
+from facaid.grammar import to_segmentation
 from facaid.rectify import rectify
 from facaid.variation import vary
 from webapp.facades import access, jobs, rendering
@@ -143,8 +144,7 @@ def photo_rectify(request, code):
 
 def add_segmentation(photo: Photo, data) -> Segmentation:
     seg = parse_segmentation(data)
-    image = photo.rectified if photo.rectified else photo.image
-    w, h = (image.width, image.height) if photo.rectified else (photo.width, photo.height)
+    w, h = (photo.rectified.width, photo.rectified.height) if photo.rectified else (photo.width, photo.height)
     if (seg.width, seg.height) != (w, h):
         raise ValidationError({"segmentation": f"the segmentation is {seg.width}x{seg.height} but the "
                                                f"{'rectified ' if photo.rectified else ''}photo is {w}x{h}"})
@@ -323,7 +323,7 @@ def procedure_variations(request, code):
 @permission_classes([AllowAny])
 @parser_classes([JSONParser])
 def render_preview(request):
-    seg = rendering.procedure_segmentation(parse_procedure(request.data).to_dict())
+    seg = to_segmentation(parse_procedure(request.data))
     return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
 
 
@@ -340,10 +340,11 @@ def procedure_download(request, code, name):
     if name not in DOWNLOADS:
         raise Http404(f"no download named {name!r}; there are {', '.join(DOWNLOADS)}")
     stem = f"facaid-{str(proc.code)[:8]}"
+    tree = parse_procedure(proc.data)
     if name == "procedure.json":
-        resp = HttpResponse(parse_procedure(proc.data).to_json(indent=2), content_type="application/json")
+        resp = HttpResponse(tree.to_json(indent=2), content_type="application/json")
     else:
-        seg = rendering.procedure_segmentation(proc.data)
+        seg = to_segmentation(tree)
         if name == "segmentation.json":
             resp = HttpResponse(seg.to_json(), content_type="application/json")
         elif name == "labels.png":

@@ -6,8 +6,6 @@ import io
 
 from PIL import Image
 
-from facaid.grammar import Procedure as ProcedureTree
-from facaid.grammar import to_segmentation
 from facaid.render import overlay, render_segmentation
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import rasterize
@@ -27,10 +25,6 @@ def _fit(image: Image.Image, max_side: int) -> Image.Image:
         return image
     size = (max(1, round(image.width * scale)), max(1, round(image.height * scale)))
     return image.resize(size, Image.Resampling.NEAREST)
-
-
-def procedure_segmentation(data: dict) -> SegmentationData:
-    return to_segmentation(ProcedureTree.from_dict(data))
 
 
 def label_map_png(seg: SegmentationData, max_side: int = MAX_RENDER_SIDE) -> bytes:
