@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import multiprocessing
 import random
 import time
 import tomllib
@@ -44,6 +45,7 @@ class TrainConfig:
     save_every: int = 500
     grad_clip: float = 1.0
     threads: int = 0  # torch threads on CPU; 0: all cores
+    workers: int = 0  # processes generating samples; 0: in the training process (results are identical)
 
 
 def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
@@ -71,26 +73,52 @@ def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainC
     return FacaidConfig(tokenizer=tok.to_dict(), **model_values), tok, train
 
 
-class SampleStream:
-    """Endless (rects, (ids, local, boxes)) examples from generated facades, skipping those too long for the model."""
+_worker_tokenizer: Tokenizer | None = None
 
-    def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0):
+
+def _init_worker(tok_config: dict) -> None:
+    global _worker_tokenizer
+    torch.set_num_threads(1)
+    _worker_tokenizer = Tokenizer(TokenizerConfig(**tok_config))
+
+
+def make_example(tokenizer: Tokenizer, seed: int, index: int):
+    """The training example of sample ``index`` of dataset ``seed``: (rows, (ids, local, boxes)), or None when
+    the facade is too long for the model."""
+    s = generate(sample_seed(seed, index))
+    c = tokenizer.config
+    target = tokenizer.encode_target(s.procedure)
+    if len(target[0]) > c.max_out:
+        return None
+    try:
+        rows = tokenizer.encode_segmentation(s.segmentation)
+    except ValueError:  # too many rectangles
+        return None
+    return rows, target
+
+
+def _worker_example(args: tuple[int, int]):
+    return make_example(_worker_tokenizer, *args)
+
+
+class SampleStream:
+    """Endless (rects, (ids, local, boxes)) examples from generated facades, skipping those too long for the model.
+
+    With ``workers`` > 0, ``take`` generates in that many processes; the examples are the same, in the same
+    order, as in one process."""
+
+    def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0, workers: int = 0):
         self.tokenizer = tokenizer
         self.seed = seed
         self.index = start
         self.skipped = 0
+        self.pool = None
+        if workers > 0:
+            ctx = multiprocessing.get_context("spawn")  # no fork after CUDA or torch threads have started
+            self.pool = ctx.Pool(workers, initializer=_init_worker, initargs=(tokenizer.config.to_dict(),))
 
     def example(self, index: int):
-        s = generate(sample_seed(self.seed, index))
-        c = self.tokenizer.config
-        target = self.tokenizer.encode_target(s.procedure)
-        if len(target[0]) > c.max_out:
-            return None
-        try:
-            rows = self.tokenizer.encode_segmentation(s.segmentation)
-        except ValueError:  # too many rectangles
-            return None
-        return rows, target
+        return make_example(self.tokenizer, self.seed, index)
 
     def __next__(self):
         while True:
@@ -99,6 +127,30 @@ class SampleStream:
             if ex is not None:
                 return ex
             self.skipped += 1
+
+    def take(self, n: int) -> list:
+        """The next ``n`` examples."""
+        if self.pool is None:
+            return [next(self) for _ in range(n)]
+        out: list = []
+        while len(out) < n:
+            want = n - len(out)
+            indices = range(self.index, self.index + want + max(4, want // 20))  # a few spare for skips
+            chunk = max(1, len(indices) // (4 * self.pool._processes))
+            for ex in self.pool.imap(_worker_example, [(self.seed, i) for i in indices], chunksize=chunk):
+                if len(out) == n:
+                    break
+                self.index += 1
+                if ex is None:
+                    self.skipped += 1
+                else:
+                    out.append(ex)
+        return out
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.terminate()
+            self.pool = None
 
 
 class PooledBatches:
@@ -120,7 +172,7 @@ class PooledBatches:
 
     def _fill(self) -> None:
         self.pool_start = self.stream.index
-        pool = [next(self.stream) for _ in range(self.batch_size * self.pool_batches)]
+        pool = self.stream.take(self.batch_size * self.pool_batches)
         pool.sort(key=lambda ex: (len(ex[1][0]), len(ex[0])))
         self.batches = [pool[i : i + self.batch_size] for i in range(0, len(pool), self.batch_size)]
         random.Random(f"{self.seed}:{self.pool_number}").shuffle(self.batches)
@@ -165,7 +217,7 @@ def validation_loss(model: FacaidModel, examples: list, batch_size: int, device)
 
 
 def train(config_path: str | Path, out: str | None = None, resume: bool = False, steps: int | None = None,
-          until: int | None = None, progress: bool = True) -> Path:
+          until: int | None = None, max_hours: float | None = None, progress: bool = True) -> Path:
     """Train per the config; returns the checkpoint directory (OUT/last).
 
     ``steps`` overrides the schedule's length; ``until`` stops (and saves) after that step without changing
@@ -175,6 +227,8 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         cfg.out = out
     if steps is not None:
         cfg.steps = steps
+    if max_hours is not None:
+        cfg.max_hours = max_hours
     out_dir = Path(cfg.out)
     last = out_dir / "last"
     device = torch.device("cuda" if torch.cuda.is_available() else "cpu")
@@ -203,9 +257,11 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     (out_dir / "config.toml").write_text(Path(config_path).read_text())
     log_path = out_dir / "log.jsonl"
 
+    stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"], workers=cfg.workers)
     val_stream = SampleStream(tokenizer, cfg.val_seed)
-    val = [next(val_stream) for _ in range(cfg.val_count)]
-    stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"])
+    val_stream.pool = stream.pool  # share the processes
+    val = val_stream.take(cfg.val_count)
+    val_stream.pool = None
     stream.skipped = state["skipped"]
     batches = PooledBatches(stream, cfg.batch_size, cfg.pool_batches, cfg.seed, state["batches"])
     stop = min(cfg.steps, until) if until is not None else cfg.steps
@@ -228,34 +284,37 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
             last.rmdir()
         tmp.rename(last)
 
-    while step < stop:
-        if time.perf_counter() - started > cfg.max_hours * 3600:
-            break
-        batch = next(batches)
-        rects, mask = batch_inputs([ex[0] for ex in batch], device)
-        ids, local, targets, boxes = batch_outputs([ex[1] for ex in batch], device)
-        for group in opt.param_groups:
-            group["lr"] = lr_at(step, cfg)
-        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=use_amp):
-            _, loss = model(rects, mask, ids, local, targets, boxes)
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)
-        opt.step()
-        step += 1
-        loss_value = loss.item()
-        loss_avg = loss_value if loss_avg is None else 0.98 * loss_avg + 0.02 * loss_value
-        bar.update(1)
-        bar.set_postfix(loss=f"{loss_avg:.3f}", lr=f"{lr_at(step, cfg):.1e}")
-        if step % cfg.eval_every == 0 or step == cfg.steps:
-            val_loss = validation_loss(model, val, cfg.batch_size, device)
-            record = {"step": step, "train_loss": loss_avg, "val_loss": val_loss, "samples": stream.index,
-                      "skipped": stream.skipped, "hours": (elapsed0 + time.perf_counter() - started) / 3600}
-            with open(log_path, "a") as f:
-                f.write(json.dumps(record) + "\n")
-            bar.write(json.dumps(record))
-        if step % cfg.save_every == 0:
-            checkpoint()
-    bar.close()
-    checkpoint()
+    try:
+        while step < stop:
+            if time.perf_counter() - started > cfg.max_hours * 3600:
+                break
+            batch = next(batches)
+            rects, mask = batch_inputs([ex[0] for ex in batch], device)
+            ids, local, targets, boxes = batch_outputs([ex[1] for ex in batch], device)
+            for group in opt.param_groups:
+                group["lr"] = lr_at(step, cfg)
+            with torch.autocast(device.type, dtype=torch.bfloat16, enabled=use_amp):
+                _, loss = model(rects, mask, ids, local, targets, boxes)
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(model.parameters(), cfg.grad_clip)
+            opt.step()
+            step += 1
+            loss_value = loss.item()
+            loss_avg = loss_value if loss_avg is None else 0.98 * loss_avg + 0.02 * loss_value
+            bar.update(1)
+            bar.set_postfix(loss=f"{loss_avg:.3f}", lr=f"{lr_at(step, cfg):.1e}")
+            if step % cfg.eval_every == 0 or step == cfg.steps:
+                val_loss = validation_loss(model, val, cfg.batch_size, device)
+                record = {"step": step, "train_loss": loss_avg, "val_loss": val_loss, "samples": stream.index,
+                          "skipped": stream.skipped, "hours": (elapsed0 + time.perf_counter() - started) / 3600}
+                with open(log_path, "a") as f:
+                    f.write(json.dumps(record) + "\n")
+                bar.write(json.dumps(record))
+            if step % cfg.save_every == 0:
+                checkpoint()
+        bar.close()
+        checkpoint()
+    finally:
+        stream.close()
     return last

@@ -146,3 +146,19 @@ def test_learning_rate_schedule():
     assert lr_at(9, cfg) == pytest.approx(1e-3)
     assert lr_at(110, cfg) == pytest.approx(1e-4)
     assert lr_at(60, cfg) == pytest.approx(5.5e-4)
+
+
+def test_sample_processes_give_the_same_examples_in_the_same_order():
+    from facaid.train import SampleStream
+
+    tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=160))  # short: some facades are skipped
+    one = SampleStream(tok, seed=5)
+    many = SampleStream(tok, seed=5, workers=2)
+    try:
+        for n in (7, 13):
+            a, b = one.take(n), many.take(n)
+            assert len(b) == n and repr(a) == repr(b)
+            assert (one.index, one.skipped) == (many.index, many.skipped)
+        assert one.skipped > 0
+    finally:
+        many.close()
