@@ -211,9 +211,36 @@ function snapped(rect, ids, edges, event) {
   return snap(rect, others(ids), SNAP_PX / view.scale, edges, seg);
 }
 
+// two fingers (or any two pointers) pinch to zoom and drag to pan; a gesture started by the first finger is dropped
+const pointers = new Map();  // pointerId -> [offsetX, offsetY] while down
+const clampScale = (s) => Math.max(0.05, Math.min(40, s));
+
+function pinch() {
+  const [[ax, ay], [bx, by]] = [...pointers.values()];
+  return {mx: (ax + bx) / 2, my: (ay + by) / 2, dist: Math.hypot(bx - ax, by - ay) || 1};
+}
+
+function pinchStart() {
+  const p = pinch();
+  ui.drag = {kind: "pinch", dist: p.dist, scale: view.scale, anchor: toImage(p.mx, p.my)};
+  ui.guides = [];
+  draw();
+}
+
+function pinchMove(d) {
+  const p = pinch();
+  view.scale = clampScale(d.scale * p.dist / d.dist);
+  view.ox = p.mx - d.anchor[0] * view.scale;
+  view.oy = p.my - d.anchor[1] * view.scale;
+  draw();
+}
+
 canvas.addEventListener("pointerdown", (e) => {
   canvas.setPointerCapture(e.pointerId);
   if (rectifying) return rectifying.pointerdown(e);
+  pointers.set(e.pointerId, [e.offsetX, e.offsetY]);
+  if (pointers.size === 2) return pinchStart();
+  if (pointers.size > 2) return;
   const [x, y] = toImage(e.offsetX, e.offsetY);
   if (ui.space || e.button === 1) {
     ui.drag = {kind: "pan", sx: e.offsetX, sy: e.offsetY, ox: view.ox, oy: view.oy};
@@ -247,8 +274,10 @@ canvas.addEventListener("pointerdown", (e) => {
 
 canvas.addEventListener("pointermove", (e) => {
   if (rectifying) return rectifying.pointermove(e);
+  if (pointers.has(e.pointerId)) pointers.set(e.pointerId, [e.offsetX, e.offsetY]);
   const d = ui.drag;
   if (!d) return;
+  if (d.kind === "pinch") return pointers.size >= 2 && pinchMove(d);
   const [x, y] = toImage(e.offsetX, e.offsetY);
   ui.guides = [];
   if (d.kind === "pan") {
@@ -289,12 +318,21 @@ canvas.addEventListener("pointermove", (e) => {
   draw();
 });
 
-canvas.addEventListener("pointerup", () => {
+canvas.addEventListener("pointercancel", (e) => {
+  pointers.delete(e.pointerId);
+  if (rectifying) return;
+  ui.drag = null;  // the browser took the gesture: nothing is committed
+  ui.guides = [];
+  draw();
+});
+
+canvas.addEventListener("pointerup", (e) => {
+  pointers.delete(e.pointerId);
   if (rectifying) return rectifying.pointerup();
   const d = ui.drag;
   ui.drag = null;
   ui.guides = [];
-  if (!d) return;
+  if (!d || d.kind === "pinch") return draw();
   if (d.kind === "draw" && d.rect) {
     const box = clampToImage(d.rect, seg.width, seg.height);
     if (box && box.x1 - box.x0 >= 2 && box.y1 - box.y0 >= 2) {
@@ -317,7 +355,7 @@ canvas.addEventListener("pointerup", () => {
 canvas.addEventListener("wheel", (e) => {
   e.preventDefault();
   const [x, y] = toImage(e.offsetX, e.offsetY);
-  view.scale = Math.max(0.05, Math.min(40, view.scale * Math.exp(-e.deltaY * 0.0015)));
+  view.scale = clampScale(view.scale * Math.exp(-e.deltaY * 0.0015));
   view.ox = e.offsetX - x * view.scale;
   view.oy = e.offsetY - y * view.scale;
   draw();

@@ -4,7 +4,7 @@ made from generated facades, a media root per test."""
 from __future__ import annotations
 
 import pytest
-from site_helpers import Redis, Worker, client_for, facade_png, upload
+from site_helpers import CHROMIUM, CHROMIUM_ARGS, Redis, Worker, client_for, facade_png, upload
 
 
 @pytest.fixture(autouse=True)
@@ -72,3 +72,16 @@ def worker(redis, tmp_path):
     w = Worker(redis, tmp_path / "worker.log")
     yield w
     w.kill()
+
+
+@pytest.fixture
+def browser(monkeypatch):
+    """Debian's Chromium through Playwright."""
+    from playwright.sync_api import sync_playwright
+
+    # Playwright's sync API keeps an event loop in this thread; the ORM calls of the test are still synchronous
+    monkeypatch.setenv("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()

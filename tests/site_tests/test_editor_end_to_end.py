@@ -10,6 +10,7 @@ import shutil
 
 import pytest
 from PIL import Image, ImageOps
+from site_helpers import login
 
 from facaid.generator import generate
 from facaid.render import render_segmentation
@@ -17,25 +18,17 @@ from facaid.render import render_segmentation
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None or shutil.which("redis-server") is None,
                                  reason="needs Debian's chromium and redis-server")]
-ARGS = ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync"]
 E = "window.facaidEditor"
 PAD = 40  # the facade sits inside a border that rectification crops away
 
 
 @pytest.fixture
-def page(monkeypatch):
-    from playwright.sync_api import sync_playwright
-
-    monkeypatch.setenv("DJANGO_ALLOW_ASYNC_UNSAFE", "true")
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=ARGS)
-        page = browser.new_page(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
-        page.errors = []
-        page.on("pageerror", lambda e: page.errors.append(str(e)))
-        page.on("dialog", lambda d: d.accept())
-        yield page
-        browser.close()
+def page(browser):
+    page = browser.new_page(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
+    page.errors = []
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    page.on("dialog", lambda d: d.accept())
+    return page
 
 
 def photo_file(tmp_path):
@@ -56,11 +49,7 @@ def drag(page, start, end):
 def test_editor_from_upload_to_downloads(live_server, alice, worker, page, tmp_path):
     worker.start()
     base = live_server.url
-    page.goto(f"{base}/accounts/login/")
-    page.fill("#id_username", "alice")
-    page.fill("#id_password", "alice-password-1")
-    page.click("button[type=submit]")
-    page.wait_for_url(f"{base}/")
+    login(page, base, "alice", "alice-password-1")
     # upload
     path, fw, fh = photo_file(tmp_path)
     page.goto(f"{base}/photos/new")

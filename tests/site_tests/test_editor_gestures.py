@@ -1,0 +1,176 @@
+"""The editor's view and helpers in Debian's Chromium: wheel zoom about the cursor, space-drag pan, two-finger
+pinch and one-finger drawing on a touch screen, snapping to edges (and Alt to draw without it), find similar on
+a photo with repeated windows."""
+
+from __future__ import annotations
+
+import io
+import shutil
+
+import numpy as np
+import pytest
+from PIL import Image
+from site_helpers import login, upload
+
+pytestmark = [pytest.mark.django_db(transaction=True),
+              pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
+
+E = "window.facaidEditor"
+WINDOWS = [(x, y) for y in (60, 210) for x in (60, 200, 340)]  # top-left corners of six equal windows
+WIN_W, WIN_H = 60, 90
+
+
+def windows_photo() -> bytes:
+    """A 480x360 'photo': a noisy wall with six copies of one textured window."""
+    rng = np.random.default_rng(4)
+    img = rng.integers(150, 200, size=(360, 480, 3), dtype=np.uint8)
+    win = np.zeros((WIN_H, WIN_W, 3), dtype=np.uint8)
+    yy, xx = np.mgrid[0:WIN_H, 0:WIN_W]
+    win[...] = (40 + 2 * xx + yy)[..., None].clip(0, 255).astype(np.uint8)  # glass: a gradient
+    win[:5], win[-5:], win[:, :5], win[:, -5:] = 20, 20, 20, 20  # frame
+    win[WIN_H // 2 - 2 : WIN_H // 2 + 2], win[:, WIN_W // 2 - 2 : WIN_W // 2 + 2] = 230, 230  # cross bars
+    for x, y in WINDOWS:
+        img[y : y + WIN_H, x : x + WIN_W] = win
+    out = io.BytesIO()
+    Image.fromarray(img).save(out, "PNG")
+    return out.getvalue()
+
+
+@pytest.fixture
+def editor(live_server, as_alice, browser):
+    """The editor open on Alice's windows photo with one segmentation: the wall and the first window."""
+    photo = upload(as_alice, windows_photo(), title="Six windows").json()
+    x, y = WINDOWS[0]
+    seg = {"width": 480, "height": 360, "rects": [
+        {"label": "facade", "x0": 0, "y0": 0, "x1": 480, "y1": 360},
+        {"label": "window", "x0": x, "y0": y, "x1": x + WIN_W, "y1": y + WIN_H}]}
+    r = as_alice.post(f"/api/v1/photos/{photo['code']}/segmentations/", seg, format="json")
+    assert r.status_code == 201, r.content
+    context = browser.new_context(viewport={"width": 1400, "height": 1000}, has_touch=True)
+    page = context.new_page()
+    page.errors = []
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
+    page.wait_for_function(f"{E}?.seg?.size === 2")
+    yield page
+    assert page.errors == []
+    context.close()
+
+
+def view(page) -> dict:
+    return page.evaluate(f"({{s: {E}.view.scale, ox: {E}.view.ox, oy: {E}.view.oy}})")
+
+
+def screen(page, x: float, y: float) -> tuple[float, float]:
+    """Page coordinates of image point (x, y) in the current view."""
+    v = view(page)
+    box = page.locator("#canvas").bounding_box()
+    return box["x"] + v["ox"] + x * v["s"], box["y"] + v["oy"] + y * v["s"]
+
+
+def rects(page) -> list[dict]:
+    return page.evaluate(f"[...{E}.seg.rects.values()]")
+
+
+def test_wheel_zoom_space_pan_and_touch(editor):
+    page = editor
+    v0 = view(page)
+    # the wheel zooms about the cursor: the image point under it stays put
+    x, y = screen(page, 230, 255)
+    page.mouse.move(x, y)
+    page.mouse.wheel(0, -400)
+    page.wait_for_function(f"{E}.view.scale > {v0['s']} * 1.5")
+    assert screen(page, 230, 255) == pytest.approx((x, y), abs=1.0)
+    page.mouse.wheel(0, 400)
+    page.wait_for_function(f"{E}.view.scale < {v0['s']} * 1.01")
+    # space-drag pans by the drag, draws nothing and leaves no undo step
+    v1 = view(page)
+    page.keyboard.down(" ")
+    page.mouse.down()
+    page.mouse.move(x + 50, y + 30, steps=5)
+    page.mouse.up()
+    page.keyboard.up(" ")
+    v2 = view(page)
+    assert (v2["ox"] - v1["ox"], v2["oy"] - v1["oy"]) == pytest.approx((50, 30), abs=0.5)
+    assert len(rects(page)) == 2 and not page.evaluate(f"{E}.history.canUndo")
+    # two fingers spreading apart zoom about their midpoint; the first finger's draw is dropped
+    cdp = page.context.new_cdp_session(page)
+    mx, my = screen(page, 240, 180)
+
+    def touch(kind, *points):
+        cdp.send("Input.dispatchTouchEvent", {"type": kind, "touchPoints": [
+            {"x": px, "y": py, "id": i} for i, (px, py) in enumerate(points)]})
+
+    s0 = view(page)["s"]
+    touch("touchStart", (mx - 40, my))
+    touch("touchStart", (mx - 40, my), (mx + 40, my))
+    for spread in (50, 60, 70, 80):
+        touch("touchMove", (mx - spread, my), (mx + spread, my))
+    touch("touchEnd")
+    assert view(page)["s"] == pytest.approx(2 * s0, rel=0.02)
+    assert screen(page, 240, 180) == pytest.approx((mx, my), abs=1.5)
+    assert len(rects(page)) == 2 and not page.evaluate(f"{E}.history.canUndo")
+    # one finger draws with the draw tool, as the mouse does (between the rows, near the zoom's centre)
+    page.keyboard.press("r")
+    a, b = screen(page, 215, 160), screen(page, 275, 170)
+    touch("touchStart", a)
+    for t in np.linspace(0, 1, 5):
+        touch("touchMove", (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])))
+    touch("touchEnd")
+    drawn = [r for r in rects(page) if 155 <= r["y0"] <= 165 and r["label"] == "window"]
+    assert len(drawn) == 1 and abs(drawn[0]["x1"] - drawn[0]["x0"] - 60) <= 2
+    assert page.evaluate(f"{E}.history.canUndo")
+
+
+def test_snapping_to_edges_and_alt_without(editor):
+    page = editor
+    wx, wy = WINDOWS[0]
+    page.keyboard.press("4")  # door
+    off = 3 / view(page)["s"]  # 3 screen pixels: inside the 6-pixel snapping distance
+
+    def draw(start, end, alt=False):
+        if alt:
+            page.keyboard.down("Alt")
+        page.mouse.move(*screen(page, *start))
+        page.mouse.down()
+        page.mouse.move(*screen(page, *end), steps=6)
+        guides = page.evaluate(f"{E}.ui.guides.length")
+        page.mouse.up()
+        if alt:
+            page.keyboard.up("Alt")
+        return page.evaluate(f"[...{E}.ui.selection].map(id => {E}.seg.get(id))")[0], guides
+
+    # the moving corner lands 3 screen pixels right of the window's right edge: it snaps onto it, with a guide
+    snapped, guides = draw((wx + WIN_W + 40, wy + 150), (wx + WIN_W + off, wy + 120))
+    assert snapped["x0"] == wx + WIN_W and guides > 0
+    page.keyboard.press("Control+z")
+    # Alt held: no snapping, the rectangle ends where the pointer did
+    free, guides = draw((wx + WIN_W + 40, wy + 150), (wx + WIN_W + off, wy + 120), alt=True)
+    assert free["x0"] == pytest.approx(wx + WIN_W + off, abs=1.01) and free["x0"] != wx + WIN_W and guides == 0
+    # the snap checkbox off: likewise
+    page.keyboard.press("Control+z")
+    page.uncheck("#snap")
+    free, guides = draw((wx + WIN_W + 40, wy + 150), (wx + WIN_W + off, wy + 120))
+    assert free["x0"] != wx + WIN_W and guides == 0
+
+
+def test_find_similar_proposes_the_other_windows(editor):
+    page = editor
+    page.keyboard.press("v")
+    page.mouse.click(*screen(page, WINDOWS[0][0] + 10, WINDOWS[0][1] + 10))
+    assert page.evaluate(f"{E}.seg.get([...{E}.ui.selection][0]).label") == "window"
+    page.click("#similar")
+    proposals = page.evaluate(f"{E}.ui.proposals")
+    found = [v for p in sorted(proposals, key=lambda p: (p["x0"], p["y0"])) for v in (p["x0"], p["y0"])]
+    assert found == pytest.approx([v for w in sorted(WINDOWS[1:]) for v in w], abs=1)
+    # click one to reject it, then accept the rest with Enter: one undo step adds four windows
+    rejected = proposals[0]
+    page.mouse.click(*screen(page, rejected["x0"] + 20, rejected["y0"] + 20))
+    page.keyboard.press("Enter")
+    windows = [r for r in rects(page) if r["label"] == "window"]
+    assert len(windows) == 5
+    assert all(abs(r["x1"] - r["x0"] - WIN_W) <= 1 and abs(r["y1"] - r["y0"] - WIN_H) <= 1 for r in windows)
+    assert not any(abs(r["x0"] - rejected["x0"]) <= 1 and abs(r["y0"] - rejected["y0"]) <= 1 for r in windows)
+    page.keyboard.press("Control+z")
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 1
