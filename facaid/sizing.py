@@ -52,15 +52,26 @@ def _from_free(free: torch.Tensor, is_rel: torch.Tensor) -> torch.Tensor:
     return torch.where(is_rel, torch.sigmoid(free), torch.exp(free.clamp(-12.0, 11.5)))
 
 
-def soft_coverage(boxes: torch.Tensor, labels: torch.Tensor, width: int, height: int, tau: float) -> torch.Tensor:
-    """Per-class soft coverage (C, H, W) of leaf boxes (L, 4) given in raster pixels."""
+def class_groups(labels: torch.Tensor) -> list[tuple[int, torch.Tensor]]:
+    """(class, indices of the leaves with that label) for each class that has leaves."""
+    return [(c, (labels == c).nonzero().squeeze(1)) for c in range(len(LABELS)) if bool((labels == c).any())]
+
+
+def soft_coverage(boxes: torch.Tensor, labels: torch.Tensor, width: int, height: int, tau: float,
+                  groups: list[tuple[int, torch.Tensor]] | None = None) -> torch.Tensor:
+    """Per-class soft coverage (C, H, W) of leaf boxes (L, 4) given in raster pixels.
+
+    One (H, L_c) @ (L_c, W) product per class present: H*L*W work in all, not C times that."""
     u = torch.arange(width, dtype=boxes.dtype, device=boxes.device) + 0.5
     v = torch.arange(height, dtype=boxes.dtype, device=boxes.device) + 0.5
     mx = torch.sigmoid((u - boxes[:, :1]) / tau) * torch.sigmoid((boxes[:, 2:3] - u) / tau)  # (L, W)
     my = torch.sigmoid((v - boxes[:, 1:2]) / tau) * torch.sigmoid((boxes[:, 3:4] - v) / tau)  # (L, H)
-    onehot = torch.nn.functional.one_hot(labels, len(LABELS)).to(boxes.dtype)  # (L, C)
-    per_class = (onehot[:, :, None] * my[:, None, :]).reshape(len(labels), -1)  # (L, C*H)
-    return (per_class.T @ mx).reshape(len(LABELS), height, width)  # (C, H, W)
+    groups = class_groups(labels) if groups is None else groups
+    out = boxes.new_zeros(len(LABELS), height, width)
+    if not groups:
+        return out
+    planes = torch.stack([my[idx].T @ mx[idx] for _, idx in groups])
+    return out.index_copy(0, torch.tensor([c for c, _ in groups], device=boxes.device), planes)
 
 
 def fit_sizes(proc: Procedure, target: Segmentation, *, geometry_rounds: int = 4, geometry_steps: int = 30,
@@ -122,13 +133,14 @@ def _polish(plan, free: torch.Tensor, is_rel: torch.Tensor, labels: torch.Tensor
     goal = torch.nn.functional.one_hot(goal, len(LABELS)).permute(2, 0, 1).to(torch.float32)  # (C, H, W)
     to_raster = torch.tensor([w / target.width, h / target.height] * 2, device=device)
     side = max(target.width, target.height)
+    groups = class_groups(labels)
     opt = torch.optim.Adam([free], lr=lr)
     best = (float("inf"), free.detach().clone())
     stale = step = 0
     for step in range(1, steps + 1):
         tau = max(0.25, 0.75 * (1 - step / steps))  # raster pixels: soft at first, nearly hard at the end
         boxes, overflow = execute_plan(plan, _from_free(free, is_rel).double(), with_overflow=True)
-        cover = soft_coverage(boxes.float() * to_raster, labels, w, h, tau)
+        cover = soft_coverage(boxes.float() * to_raster, labels, w, h, tau, groups)
         loss = ((cover - goal) ** 2).mean() + 0.1 * overflow.float() / side
         opt.zero_grad()
         loss.backward()

@@ -90,6 +90,8 @@ def test_decode_greedy_sampling_and_prefix(tiny_model):
         assert c.ids[0] == BOS and c.ids[-1] == EOS and len(c.ids) <= CONFIG.max_out
         assert c.logprob <= 0
     assert decode(tiny_model, TOK, seg, k=3, sample=True, seed=1)[0].ids == samples[0].ids
+    mixed = decode(tiny_model, TOK, seg, k=3, sample=True, seed=1, greedy=1)  # row 0 greedy, in the same batch
+    assert mixed[0].ids == greedy[0].ids and mixed[0].logprob == pytest.approx(greedy[0].logprob)
     target = generate(4).procedure
     prefix = prefix_from_procedure(TOK, target, nodes=2)
     cont = decode(tiny_model, TOK, seg, prefix=prefix, max_len=400)[0]

@@ -69,3 +69,22 @@ def test_size_mismatch_is_an_error():
     small = Segmentation(10, 10, ())
     with pytest.raises(ValueError, match="but the target is 10x10"):
         fit_sizes(q, small)
+
+
+def test_soft_coverage_per_class_products_equal_the_one_hot_formulation():
+    s = generate(5)
+    plan = compile_plan(s.procedure)
+    boxes = (execute_plan(plan).float() * 0.1).requires_grad_(True)
+    w, h = round(s.procedure.width * 0.1), round(s.procedure.height * 0.1)
+    cover = soft_coverage(boxes, plan.labels, w, h, tau=0.5)
+    u, v = torch.arange(w) + 0.5, torch.arange(h) + 0.5
+    ref_boxes = boxes.detach().clone().requires_grad_(True)
+    mx = torch.sigmoid((u - ref_boxes[:, :1]) / 0.5) * torch.sigmoid((ref_boxes[:, 2:3] - u) / 0.5)
+    my = torch.sigmoid((v - ref_boxes[:, 1:2]) / 0.5) * torch.sigmoid((ref_boxes[:, 3:4] - v) / 0.5)
+    onehot = torch.nn.functional.one_hot(plan.labels, len(LABELS)).float()
+    ref = torch.einsum("lc,lh,lw->chw", onehot, my, mx)
+    assert torch.allclose(cover, ref, atol=1e-5)
+    weights = torch.rand_like(ref)
+    (cover * weights).sum().backward()
+    (ref * weights).sum().backward()
+    assert torch.allclose(boxes.grad, ref_boxes.grad, atol=1e-4)
