@@ -5,6 +5,7 @@ COPY pyproject.toml README.md ./
 COPY facaid facaid
 COPY webapp webapp
 COPY worker worker
+COPY frontend frontend
 RUN pip install "torch==2.13.0" && pip install ".[postgres]"
 COPY manage.py ./
 COPY checkpoints checkpoints

@@ -1,0 +1,53 @@
+"""The container setup, read without a Docker engine (none on the test machine): docker-compose.yml runs
+PostgreSQL, Redis with an append-only file, the site under gunicorn and a GPU worker, each with a healthcheck, on
+named volumes, configured by DATABASE_URL and REDIS_URL; the Dockerfile copies everything the settings and the
+worker read."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import yaml
+
+from webapp import settings
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def compose() -> dict:
+    return yaml.safe_load((ROOT / "docker-compose.yml").read_text())
+
+
+def test_compose_services_healthchecks_volumes_and_gpu():
+    c = compose()
+    services = c["services"]
+    assert set(services) == {"postgres", "redis", "web", "worker"}
+    for name, service in services.items():
+        assert service["healthcheck"]["test"], name
+    assert "--appendonly" in services["redis"]["command"]
+    assert "gunicorn webapp.wsgi" in services["web"]["command"]
+    assert services["worker"]["command"][:3] == ["celery", "-A", "webapp.celery"]
+    assert "gpu" in services["worker"]["command"][services["worker"]["command"].index("-Q") + 1].split(",")
+    devices = services["worker"]["deploy"]["resources"]["reservations"]["devices"]
+    assert devices[0]["capabilities"] == ["gpu"] and devices[0]["driver"] == "nvidia"
+    for name in ("web", "worker"):
+        env = services[name]["environment"]
+        assert env["DATABASE_URL"].startswith("postgres://") and "@postgres:5432/" in env["DATABASE_URL"]
+        assert env["REDIS_URL"] == "redis://redis:6379/0"
+        for dep in ("postgres", "redis"):
+            assert services[name]["depends_on"][dep]["condition"] == "service_healthy"
+    used = {v.split(":")[0] for s in services.values() for v in s.get("volumes", [])}
+    assert used <= set(c["volumes"]) and {"postgres", "redis", "media"} <= used
+
+
+def test_dockerfile_copies_what_the_site_and_worker_read():
+    text = (ROOT / "Dockerfile").read_text()
+    copied = set(re.findall(r"^COPY (\S+)", text, flags=re.M))
+    static_dirs = [d[1] if isinstance(d, tuple) else d for d in settings.STATICFILES_DIRS]
+    needed = {Path(d).relative_to(settings.BASE_DIR).parts[0] for d in static_dirs}
+    needed |= {"facaid", "webapp", "worker", "checkpoints", "manage.py", "pyproject.toml"}
+    assert needed <= copied, f"the Dockerfile does not copy {sorted(needed - copied)}"
+    assert 'torch==2.13.0' in text
+    ignored = (ROOT / ".dockerignore").read_text().split()
+    assert not any(n in ignored for n in needed)
