@@ -18,9 +18,11 @@ import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
+import numpy as np
 import torch
 from tqdm import tqdm
 
+from facaid.evaluation.noise import jitter
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model, save_model
@@ -46,6 +48,8 @@ class TrainConfig:
     grad_clip: float = 1.0
     threads: int = 0  # torch threads on CPU; 0: all cores
     workers: int = 0  # processes generating samples; 0: in the training process (results are identical)
+    noise: float = 0.0  # share of examples whose input edges are jittered (the target stays the clean procedure)
+    noise_sigma: float = 0.006  # the jitter's standard deviation is uniform in [0, this] x the long side
 
 
 def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
@@ -73,32 +77,38 @@ def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainC
     return FacaidConfig(tokenizer=tok.to_dict(), **model_values), tok, train
 
 
-_worker_tokenizer: Tokenizer | None = None
+_worker: dict = {}
 
 
-def _init_worker(tok_config: dict) -> None:
-    global _worker_tokenizer
+def _init_worker(tok_config: dict, noise: tuple[float, float]) -> None:
     torch.set_num_threads(1)
-    _worker_tokenizer = Tokenizer(TokenizerConfig(**tok_config))
+    _worker.update(tokenizer=Tokenizer(TokenizerConfig(**tok_config)), noise=noise)
 
 
-def make_example(tokenizer: Tokenizer, seed: int, index: int):
+def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float, float] = (0.0, 0.0)):
     """The training example of sample ``index`` of dataset ``seed``: (rows, (ids, local, boxes)), or None when
-    the facade is too long for the model."""
+    the facade is too long for the model. ``noise`` = (share, sigma): that share of the inputs get their edges
+    jittered (`facaid.evaluation.noise.jitter`, sigma uniform in [0, sigma]), seeded by the sample."""
     s = generate(sample_seed(seed, index))
     c = tokenizer.config
     target = tokenizer.encode_target(s.procedure)
     if len(target[0]) > c.max_out:
         return None
+    seg = s.segmentation
+    share, sigma = noise
+    if share > 0:
+        rng = np.random.default_rng([seed, index, 1])
+        if rng.random() < share:
+            seg = jitter(seg, rng.uniform(0.0, sigma), rng)
     try:
-        rows = tokenizer.encode_segmentation(s.segmentation)
+        rows = tokenizer.encode_segmentation(seg)
     except ValueError:  # too many rectangles
         return None
     return rows, target
 
 
 def _worker_example(args: tuple[int, int]):
-    return make_example(_worker_tokenizer, *args)
+    return make_example(_worker["tokenizer"], *args, noise=_worker["noise"])
 
 
 class SampleStream:
@@ -107,18 +117,20 @@ class SampleStream:
     With ``workers`` > 0, ``take`` generates in that many processes; the examples are the same, in the same
     order, as in one process."""
 
-    def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0, workers: int = 0):
+    def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0, workers: int = 0,
+                 noise: tuple[float, float] = (0.0, 0.0)):
         self.tokenizer = tokenizer
         self.seed = seed
         self.index = start
         self.skipped = 0
+        self.noise = noise
         self.pool = None
         if workers > 0:
             ctx = multiprocessing.get_context("spawn")  # no fork after CUDA or torch threads have started
-            self.pool = ctx.Pool(workers, initializer=_init_worker, initargs=(tokenizer.config.to_dict(),))
+            self.pool = ctx.Pool(workers, initializer=_init_worker, initargs=(tokenizer.config.to_dict(), noise))
 
     def example(self, index: int):
-        return make_example(self.tokenizer, self.seed, index)
+        return make_example(self.tokenizer, self.seed, index, self.noise)
 
     def __next__(self):
         while True:
@@ -257,9 +269,11 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     (out_dir / "config.toml").write_text(Path(config_path).read_text())
     log_path = out_dir / "log.jsonl"
 
-    stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"], workers=cfg.workers)
-    val_stream = SampleStream(tokenizer, cfg.val_seed)
-    val_stream.pool = stream.pool  # share the processes
+    stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"], workers=cfg.workers,
+                          noise=(cfg.noise, cfg.noise_sigma))
+    val_stream = SampleStream(tokenizer, cfg.val_seed)  # clean inputs: the loss stays comparable across runs
+    if stream.pool is None or cfg.noise == 0:
+        val_stream.pool = stream.pool  # share the processes
     val = val_stream.take(cfg.val_count)
     val_stream.pool = None
     stream.skipped = state["skipped"]

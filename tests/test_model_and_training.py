@@ -152,8 +152,8 @@ def test_sample_processes_give_the_same_examples_in_the_same_order():
     from facaid.train import SampleStream
 
     tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=160))  # short: some facades are skipped
-    one = SampleStream(tok, seed=5)
-    many = SampleStream(tok, seed=5, workers=2)
+    one = SampleStream(tok, seed=5, noise=(0.5, 0.006))
+    many = SampleStream(tok, seed=5, workers=2, noise=(0.5, 0.006))
     try:
         for n in (7, 13):
             a, b = one.take(n), many.take(n)
@@ -162,3 +162,19 @@ def test_sample_processes_give_the_same_examples_in_the_same_order():
         assert one.skipped > 0
     finally:
         many.close()
+
+
+def test_noisy_inputs_keep_the_clean_target_and_are_seeded():
+    from facaid.train import make_example
+
+    tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=768))
+    for index in range(4):
+        clean = make_example(tok, 3, index)
+        noisy = make_example(tok, 3, index, noise=(1.0, 0.006))
+        again = make_example(tok, 3, index, noise=(1.0, 0.006))
+        if clean is None:
+            continue
+        assert repr(noisy) == repr(again)
+        assert repr(noisy[1]) == repr(clean[1])  # the target: the clean procedure
+        assert repr(noisy[0]) != repr(clean[0])  # the input: edges moved
+        assert repr(make_example(tok, 3, index, noise=(0.0, 0.006))) == repr(clean)

@@ -27,6 +27,11 @@ def _jitter(seg: Segmentation, sigma: float, rng: np.random.Generator) -> Segmen
     return Segmentation(seg.width, seg.height, tuple(rects))
 
 
+def jitter(seg: Segmentation, sigma: float, rng: np.random.Generator) -> Segmentation:
+    """The flattened segmentation with its element edges moved by N(0, sigma * long side) each."""
+    return flatten(_jitter(flatten(seg, wall="footprint"), sigma, rng), wall="footprint")
+
+
 def changed_fraction(a: Segmentation, b: Segmentation) -> float:
     return float((scaled_label_map(a, _SCALE) != scaled_label_map(b, _SCALE)).mean())
 
