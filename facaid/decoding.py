@@ -14,6 +14,7 @@ import numpy as np
 import torch
 
 from facaid.grammar.procedure import Procedure
+from facaid.incremental import IncrementalDecoder
 from facaid.metrics import pixel_accuracy, scaled_label_map, scaled_procedure_map
 from facaid.model import MAX_LOCAL, FacaidModel, batch_inputs
 from facaid.segmentation import Segmentation
@@ -95,10 +96,12 @@ def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> 
 @torch.no_grad()
 def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: int = 1, sample: bool = False,
            temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None,
-           max_len: int | None = None, constrained: bool = True, greedy: int = 0) -> list[Candidate]:
+           max_len: int | None = None, constrained: bool = True, greedy: int = 0,
+           incremental: bool = True) -> list[Candidate]:
     """K candidate procedures for a segmentation (greedy when ``sample`` is False; then K copies are equal).
 
     With ``sample``, the first ``greedy`` rows are still decoded greedily, in the same batch as the samples.
+    ``incremental`` (in eval mode) steps with `IncrementalDecoder`; False runs the Hugging Face modules.
 
     ``constrained=False`` decodes without the grammar mask, to measure what nullification buys: a sequence
     that breaks the grammar stops there and comes back with ``procedure=None`` and the error."""
@@ -122,11 +125,18 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     local = torch.tensor([tokenizer.local_indices(s, tokenizer.vocab) for s in seqs], device=device)
     boxes = torch.as_tensor(tokenizer.node_boxes(start, seg.width, seg.height), device=device).expand(k, -1, -1)
     past = None
+    fast = IncrementalDecoder(model, memory, memory_mask, max_len) if incremental and not model.training else None
     errors: list[str | None] = [None] * k
     while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
-        logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past, use_cache=True,
-                                    boxes=boxes)
-        scores = logits[:, -1].float() / temperature  # (K, V)
+        if fast is not None:  # the same logits without the Hugging Face modules' per-call overhead
+            x = model.embed_outputs(ids, local.clamp(max=MAX_LOCAL - 1), boxes)
+            for i in range(x.shape[1]):
+                last = fast.step(x[:, i])
+        else:
+            logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past,
+                                        use_cache=True, boxes=boxes)
+            last = logits[:, -1]
+        scores = last.float() / temperature  # (K, V)
         if constrained:
             scores = scores.masked_fill(~torch.from_numpy(processor.mask()).to(device), float("-inf"))
         logp = torch.log_softmax(scores, dim=-1)

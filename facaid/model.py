@@ -110,17 +110,22 @@ class FacaidModel(PreTrainedModel):
         h = self.encoder(inputs_embeds=x, attention_mask=mask.long()).last_hidden_state  # (B, M, d)
         return h, mask
 
+    def embed_outputs(self, ids: torch.Tensor, local: torch.Tensor, boxes: torch.Tensor | None = None) -> torch.Tensor:
+        """The decoder's input embeddings (B, T, d) of output tokens, their local indices and node boxes."""
+        x = self.token_embedding(ids) + self.local_embedding(local)  # (B, T, d)
+        if self.config.node_boxes:
+            if boxes is None:
+                raise ValueError("this model reads node boxes: pass boxes (B, T, 4) to decode")
+            x = x + sum(emb(boxes[..., f]) for f, emb in enumerate(self.fields[1:]))
+        return x
+
     def decode(self, ids: torch.Tensor, local: torch.Tensor, memory: torch.Tensor, memory_mask: torch.Tensor,
                past=None, use_cache: bool = False, boxes: torch.Tensor | None = None):
         """ids, local (B, T) and, with ``config.node_boxes``, boxes (B, T, 4) -> logits (B, T, V) and the cache.
 
         ``boxes`` hold at each position the quantized (x, y, w, h) of the node the next token belongs to
         (`Tokenizer.node_boxes`); they are embedded with the same tables as the input rectangles."""
-        x = self.token_embedding(ids) + self.local_embedding(local)  # (B, T, d)
-        if self.config.node_boxes:
-            if boxes is None:
-                raise ValueError("this model reads node boxes: pass boxes (B, T, 4) to decode")
-            x = x + sum(emb(boxes[..., f]) for f, emb in enumerate(self.fields[1:]))
+        x = self.embed_outputs(ids, local, boxes)
         out = self.decoder(inputs_embeds=x, encoder_hidden_states=memory,
                            encoder_attention_mask=memory_mask.long(), past_key_values=past, use_cache=use_cache)
         return self.lm_head(out.last_hidden_state), out.past_key_values  # (B, T, V)

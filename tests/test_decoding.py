@@ -98,3 +98,30 @@ def test_decode_greedy_sampling_and_prefix(tiny_model):
     assert cont.ids[: len(prefix)] == prefix
     best = best_of_k(tiny_model, TOK, seg, k=3)
     assert 0.0 <= best.accuracy <= 1.0
+
+
+@pytest.mark.parametrize("k, padded", [(1, False), (3, False), (2, True)])
+def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k, padded):
+    from facaid.incremental import IncrementalDecoder
+    from facaid.model import batch_inputs, batch_outputs
+
+    samples = [generate(s) for s in (4, 5)[: 2 if padded else 1]]
+    rows = [TOK.encode_segmentation(s.segmentation) for s in samples]
+    rects, mask = batch_inputs(rows * (1 if padded else k))
+    ids, local, _, boxes = batch_outputs([TOK.encode_target(s.procedure) for s in samples] * (1 if padded else k))
+    ids, local, boxes = ids[:, :40], local[:, :40], boxes[:, :40]
+    with torch.no_grad():
+        memory, memory_mask = tiny_model.encode(rects, mask)
+        assert bool(memory_mask.all()) != padded
+        full, _ = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
+        fast = IncrementalDecoder(tiny_model, memory, memory_mask, max_len=64)
+        x = tiny_model.embed_outputs(ids, local, boxes)
+        steps = torch.stack([fast.step(x[:, i]) for i in range(x.shape[1])], 1)
+    assert torch.allclose(steps, full, atol=1e-5)
+
+
+def test_incremental_and_module_decoding_agree(tiny_model):
+    seg = generate(6).segmentation
+    a = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1)
+    b = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1, incremental=False)
+    assert [c.ids for c in a] == [c.ids for c in b]
