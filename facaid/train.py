@@ -124,6 +124,7 @@ class SampleStream:
         self.index = start
         self.skipped = 0
         self.noise = noise
+        self.workers = workers
         self.pool = None
         if workers > 0:
             ctx = multiprocessing.get_context("spawn")  # no fork after CUDA or torch threads have started
@@ -148,7 +149,7 @@ class SampleStream:
         while len(out) < n:
             want = n - len(out)
             indices = range(self.index, self.index + want + max(4, want // 20))  # a few spare for skips
-            chunk = max(1, len(indices) // (4 * self.pool._processes))
+            chunk = max(1, len(indices) // (4 * self.workers))
             for ex in self.pool.imap(_worker_example, [(self.seed, i) for i in indices], chunksize=chunk):
                 if len(out) == n:
                     break
@@ -269,13 +270,10 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     (out_dir / "config.toml").write_text(Path(config_path).read_text())
     log_path = out_dir / "log.jsonl"
 
+    # clean inputs, in this process (a second or two): the loss stays comparable across runs
+    val = SampleStream(tokenizer, cfg.val_seed).take(cfg.val_count)
     stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"], workers=cfg.workers,
                           noise=(cfg.noise, cfg.noise_sigma))
-    val_stream = SampleStream(tokenizer, cfg.val_seed)  # clean inputs: the loss stays comparable across runs
-    if stream.pool is None or cfg.noise == 0:
-        val_stream.pool = stream.pool  # share the processes
-    val = val_stream.take(cfg.val_count)
-    val_stream.pool = None
     stream.skipped = state["skipped"]
     batches = PooledBatches(stream, cfg.batch_size, cfg.pool_batches, cfg.seed, state["batches"])
     stop = min(cfg.steps, until) if until is not None else cfg.steps
