@@ -50,6 +50,7 @@ class TrainConfig:
     workers: int = 0  # processes generating samples; 0: in the training process (results are identical)
     noise: float = 0.0  # share of examples whose input edges are jittered (the target stays the clean procedure)
     noise_sigma: float = 0.006  # the jitter's standard deviation is uniform in [0, this] x the long side
+    init: str = ""  # a checkpoint directory whose weights start the run (fine-tuning); fresh optimizer and schedule
 
 
 def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
@@ -229,6 +230,21 @@ def validation_loss(model: FacaidModel, examples: list, batch_size: int, device)
     return total / count
 
 
+_ARCHITECTURE = ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder", "node_boxes")
+
+
+def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig, device) -> FacaidModel:
+    """The weights of checkpoint ``path`` for a fine-tuning run; its architecture and tokenizer must be the
+    config's."""
+    model, tokenizer = load_model(path, device)
+    if tokenizer.config != tok_cfg:
+        raise ValueError(f"train.init {path} was trained with another tokenizer config")
+    differ = [k for k in _ARCHITECTURE if getattr(model.config, k) != getattr(model_cfg, k)]
+    if differ:
+        raise ValueError(f"train.init {path} has another architecture ({', '.join(differ)} differ from [model])")
+    return model
+
+
 def train(config_path: str | Path, out: str | None = None, resume: bool = False, steps: int | None = None,
           until: int | None = None, max_hours: float | None = None, progress: bool = True) -> Path:
     """Train per the config; returns the checkpoint directory (OUT/last).
@@ -256,6 +272,9 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
             raise ValueError(f"{last} was trained with another tokenizer config than {config_path}")
         saved = torch.load(last / "state.pt", map_location=device, weights_only=False)
         state.update(saved["state"])
+    elif cfg.init:
+        model = _initial_model(cfg.init, model_cfg, tok_cfg, device)
+        saved = None
     else:
         model = FacaidModel(model_cfg).to(device)
         saved = None

@@ -178,3 +178,22 @@ def test_noisy_inputs_keep_the_clean_target_and_are_seeded():
         assert repr(noisy[1]) == repr(clean[1])  # the target: the clean procedure
         assert repr(noisy[0]) != repr(clean[0])  # the input: edges moved
         assert repr(make_example(tok, 3, index, noise=(0.0, 0.006))) == repr(clean)
+
+
+def test_fine_tuning_starts_from_a_checkpoint(tmp_path):
+    cfg = tmp_path / "c.toml"
+    write_config(cfg, tmp_path / "base", steps=3, extra="lr = 3e-3")
+    base = train(cfg, progress=False)
+    # zero steps from init: the weights are the checkpoint's, exactly
+    write_config(cfg, tmp_path / "tuned", steps=0, extra=f'noise = 0.5\ninit = "{base}"')
+    tuned = train(cfg, progress=False)
+    a, _ = load_model(base)
+    b, _ = load_model(tuned)
+    for (name, p), (_, q) in zip(a.named_parameters(), b.named_parameters(), strict=True):
+        assert torch.equal(p, q), name
+    state = torch.load(tuned / "state.pt", weights_only=False)["state"]
+    assert state["step"] == 0
+    text = cfg.read_text()
+    cfg.write_text(text.replace("d_model = 16", "d_model = 8"))
+    with pytest.raises(ValueError, match="another architecture .d_model"):
+        train(cfg, progress=False)
