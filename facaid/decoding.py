@@ -191,12 +191,19 @@ def score(candidate: Candidate, seg: Segmentation, target: np.ndarray | None = N
     return candidate.accuracy
 
 
-def best_of_k(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, k: int = 8, *,
-              temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None) -> Candidate:
-    """The greedy candidate and K-1 samples, executed and reranked by pixel accuracy (then likelihood)."""
+def ranked_candidates(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, k: int = 8, *,
+                      temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None) -> list[Candidate]:
+    """The greedy candidate and K-1 samples, executed and ranked by pixel accuracy (then likelihood), best
+    first."""
     candidates = decode(model, tokenizer, seg, k=k, sample=k > 1, greedy=1, temperature=temperature, seed=seed,
                         prefix=prefix)  # one batch: a step costs about the same for 1 row as for K
     target = scaled_label_map(seg, 0.25)
     for c in candidates:
         score(c, seg, target)
-    return max(candidates, key=lambda c: (c.accuracy, c.logprob))
+    return sorted(candidates, key=lambda c: (c.accuracy, c.logprob), reverse=True)
+
+
+def best_of_k(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, k: int = 8, *,
+              temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None) -> Candidate:
+    """The candidate of `ranked_candidates` that reproduces the input best."""
+    return ranked_candidates(model, tokenizer, seg, k, temperature=temperature, seed=seed, prefix=prefix)[0]

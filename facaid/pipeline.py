@@ -2,6 +2,10 @@
 
 flatten -> tokenize -> grammar-constrained best-of-K decoding -> sizing -> metrics. The shipped model is
 loaded once per process on first use (CUDA when present) unless a model is passed in.
+
+A second chance: when the sized best candidate reproduces less than ``retry_below`` of the pixels, its
+structure is likely wrong (sizing cannot change counts or labels), so ``retry_k`` more samples are decoded and
+every candidate gets a short sizing; the best of those is sized fully and kept if it does better.
 """
 
 from __future__ import annotations
@@ -15,7 +19,7 @@ from typing import Any
 import numpy as np
 import torch
 
-from facaid.decoding import best_of_k
+from facaid.decoding import Candidate, decode, ranked_candidates
 from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE
 from facaid.metrics import procedure_accuracy
@@ -33,10 +37,11 @@ class Reconstruction:
     accuracy: float  # after sizing, exact at full resolution
     iou: dict[str, float]
     timings: dict[str, float] = field(default_factory=dict)  # seconds per stage
+    retried: bool = False  # the second chance ran (the first sized candidate was below retry_below)
 
     def to_dict(self) -> dict[str, Any]:
         return {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
-                "timings": self.timings}
+                "timings": self.timings, "retried": self.retried}
 
 
 def fit_to_model(seg: Segmentation, tokenizer: Tokenizer) -> Segmentation:
@@ -61,7 +66,7 @@ def default_model(path: str = str(DEFAULT_CHECKPOINT)) -> tuple[FacaidModel, Tok
 
 def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None = None,
                 tokenizer: Tokenizer | None = None, k: int = 4, sizing: bool = True, seed: int = 0,
-                prefix: list[int] | None = None) -> Reconstruction:
+                prefix: list[int] | None = None, retry_below: float = 0.97, retry_k: int = 8) -> Reconstruction:
     """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object)."""
     seg = segmentation if isinstance(segmentation, Segmentation) else Segmentation.from_dict(segmentation)
     if model is None or tokenizer is None:
@@ -69,13 +74,21 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     timings = {}
     t0 = time.perf_counter()
     flat = flatten(seg)
+    readable = fit_to_model(flat, tokenizer)
     t1 = time.perf_counter()
-    best = best_of_k(model, tokenizer, fit_to_model(flat, tokenizer), k=k, seed=seed, prefix=prefix)
+    ranked = ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix)
     t2 = time.perf_counter()
-    decoded = best.procedure
+    decoded = ranked[0].procedure
     before = procedure_accuracy(decoded, flat)
+    retried = False
     if sizing:
         fitted = fit_sizes(decoded, flat)
+        if fitted.accuracy < retry_below and retry_k:
+            retried = True
+            more = decode(model, tokenizer, readable, k=retry_k, sample=True, greedy=0, seed=seed + 1, prefix=prefix)
+            other = _second_chance(ranked[1:] + more, ranked[0], flat)
+            if other is not None and other.accuracy > fitted.accuracy:
+                fitted, before = other, procedure_accuracy(other.procedure, flat)  # before: of that candidate
         proc, accuracy, iou = fitted.procedure, fitted.accuracy, fitted.iou
     else:
         from facaid.metrics import procedure_iou
@@ -84,4 +97,18 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     t3 = time.perf_counter()
     timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, total=t3 - t0)
     proc.meta = {"source": "facaid.reconstruct", "k": k, "accuracy": round(accuracy, 6)}
-    return Reconstruction(proc, before, accuracy, iou, timings)
+    return Reconstruction(proc, before, accuracy, iou, timings, retried)
+
+
+def _second_chance(candidates: list[Candidate], first: Candidate, flat: Segmentation):
+    """Screen the other distinct candidates with a short sizing; fully size the best one (None if none)."""
+    seen = {tuple(first.ids)}
+    best = None
+    for c in candidates:
+        if tuple(c.ids) in seen:
+            continue
+        seen.add(tuple(c.ids))
+        quick = fit_sizes(c.procedure, flat, polish_steps=40, patience=5)
+        if best is None or quick.accuracy > best[0]:
+            best = (quick.accuracy, c)
+    return None if best is None else fit_sizes(best[1].procedure, flat)

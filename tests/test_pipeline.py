@@ -4,8 +4,10 @@ import facaid
 from facaid.cli import main
 from facaid.generator import generate
 from facaid.grammar import Procedure, validate
+from facaid.metrics import procedure_accuracy
 from facaid.model import save_model
 from facaid.pipeline import reconstruct
+from facaid.segmentation import flatten
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
 
@@ -61,3 +63,17 @@ def test_evaluate_real_on_cmp_records(tiny, tmp_path, cmp_records, capsys):
     assert figures["pixel_accuracy"]["mean"] >= 0
     assert (tmp_path / "g" / "gallery.png").is_file()
     assert "all-wall baseline" in capsys.readouterr().out
+
+
+def test_second_chance_sizes_more_candidates_when_the_first_fits_badly(tiny):
+    model, tok = tiny  # untrained: its structures fit badly, so the second chance runs
+    seg = generate(6).segmentation
+    first = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=0)
+    assert not first.retried and first.accuracy < 0.97
+    again = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2)
+    assert again.retried and again.to_dict()["retried"]
+    assert again.accuracy >= first.accuracy
+    validate(again.procedure)
+    assert again.accuracy == procedure_accuracy(again.procedure, flatten(seg))
+    never = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_below=0.0)
+    assert not never.retried and never.accuracy == first.accuracy

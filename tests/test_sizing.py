@@ -2,12 +2,12 @@ import pytest
 import torch
 
 from facaid.generator import generate
-from facaid.grammar import Node, Procedure, Size
+from facaid.grammar import Node, Procedure, Size, to_segmentation
 from facaid.grammar.differentiable import compile_plan, execute_plan
 from facaid.labels import LABELS
 from facaid.metrics import procedure_accuracy, scaled_label_map
 from facaid.segmentation import Segmentation
-from facaid.sizing import fit_sizes, soft_coverage
+from facaid.sizing import box_integrals, fit_sizes, smoothed_integrals
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
 TOK = Tokenizer(TokenizerConfig(max_rects=2000, max_out=2000))
@@ -51,19 +51,6 @@ def test_overflow_is_measured_and_pulled_back():
     assert result.accuracy > 0.97
 
 
-def test_soft_coverage_agrees_with_the_hard_label_map():
-    s = generate(2)
-    plan = compile_plan(s.procedure)
-    scale = 64 / max(s.procedure.width, s.procedure.height)
-    w, h = round(s.procedure.width * scale), round(s.procedure.height * scale)
-    boxes = execute_plan(plan).float() * torch.tensor([w / s.procedure.width, h / s.procedure.height] * 2)
-    cover = soft_coverage(boxes, plan.labels, w, h, tau=0.05)
-    assert cover.shape == (len(LABELS), h, w)
-    hard = torch.from_numpy(scaled_label_map(s.segmentation, scale).astype("int64"))
-    assert float((cover.argmax(0) == hard).float().mean()) > 0.97
-    assert float((cover.sum(0) - 1).abs().median()) < 0.01  # the leaves partition the image
-
-
 def test_size_mismatch_is_an_error():
     s, q = quantized(1)
     small = Segmentation(10, 10, ())
@@ -71,20 +58,67 @@ def test_size_mismatch_is_an_error():
         fit_sizes(q, small)
 
 
-def test_soft_coverage_per_class_products_equal_the_one_hot_formulation():
-    s = generate(5)
-    plan = compile_plan(s.procedure)
-    boxes = (execute_plan(plan).float() * 0.1).requires_grad_(True)
-    w, h = round(s.procedure.width * 0.1), round(s.procedure.height * 0.1)
-    cover = soft_coverage(boxes, plan.labels, w, h, tau=0.5)
-    u, v = torch.arange(w) + 0.5, torch.arange(h) + 0.5
-    ref_boxes = boxes.detach().clone().requires_grad_(True)
-    mx = torch.sigmoid((u - ref_boxes[:, :1]) / 0.5) * torch.sigmoid((ref_boxes[:, 2:3] - u) / 0.5)
-    my = torch.sigmoid((v - ref_boxes[:, 1:2]) / 0.5) * torch.sigmoid((ref_boxes[:, 3:4] - v) / 0.5)
-    onehot = torch.nn.functional.one_hot(plan.labels, len(LABELS)).float()
-    ref = torch.einsum("lc,lh,lw->chw", onehot, my, mx)
-    assert torch.allclose(cover, ref, atol=1e-5)
-    weights = torch.rand_like(ref)
-    (cover * weights).sum().backward()
-    (ref * weights).sum().backward()
-    assert torch.allclose(boxes.grad, ref_boxes.grad, atol=1e-4)
+def _sigmoid_coverage(boxes, labels, w, h, tau):
+    """Reference soft rasterizer: per-class coverage (C, H, W), every leaf an outer product of sigmoid edges."""
+    u, v = torch.arange(w, dtype=boxes.dtype) + 0.5, torch.arange(h, dtype=boxes.dtype) + 0.5
+    mx = torch.sigmoid((u - boxes[:, :1]) / tau) * torch.sigmoid((boxes[:, 2:3] - u) / tau)
+    my = torch.sigmoid((v - boxes[:, 1:2]) / tau) * torch.sigmoid((boxes[:, 3:4] - v) / tau)
+    onehot = torch.nn.functional.one_hot(labels, len(LABELS)).to(boxes.dtype)
+    return torch.einsum("lc,lh,lw->chw", onehot, my, mx)
+
+
+def _tables_for(seg, scale, labels, tau):
+    label_map = scaled_label_map(seg, scale)
+    classes = sorted(set(labels.tolist()))
+    index = torch.zeros(len(LABELS), dtype=torch.long)
+    index[classes] = torch.arange(len(classes))
+    return label_map, smoothed_integrals(label_map, classes, tau), index[labels]
+
+
+def _grid_facade() -> Procedure:
+    """198 x 120: a band, then two floors of three windows (30 x 40 px) between walls, integer sizes."""
+    tile = Node.split("x", [(Size("abs", 18), Node.leaf("facade")), (Size("abs", 30), Node.leaf("window")),
+                            (Size("abs", 18), Node.leaf("facade"))])
+    floor = Node.split("y", [(Size("abs", 10), Node.leaf("facade")), (Size("abs", 40), Node.repeat(
+        "x", 3, [(Size("abs", 66), tile)])), (Size("flt", 1), Node.leaf("facade"))])
+    root = Node.split("y", [(Size("abs", 14), Node.leaf("cornice")), (Size("flt", 1), floor), (Size("flt", 1), floor)])
+    return Procedure(198, 120, root)
+
+
+def test_box_integrals_count_the_pixels_of_each_class_exactly():
+    proc = _grid_facade()
+    plan = compile_plan(proc)
+    label_map, tables, index = _tables_for(to_segmentation(proc), 1.0, plan.labels, 0.0)
+    overlap = box_integrals(tables, index, execute_plan(plan))
+    assert float(overlap.sum()) == pytest.approx(label_map.size, rel=1e-9)  # every pixel is its leaf's class
+    # a box over whole pixels counts the class's pixels in it; a half-pixel edge counts half a column
+    boxes = torch.tensor([[10.0, 20.0, 30.0, 60.0], [10.0, 20.0, 30.5, 60.0], [10.0, 20.0, 30.0, 60.25]],
+                         dtype=torch.float64)
+    window = LABELS.index("window")
+    got = box_integrals(tables, torch.full((3,), int(index[plan.labels == window][0])), boxes)
+    inside = (label_map[20:60, 10:30] == window).sum()
+    column, row = (label_map[20:60, 30] == window).sum(), (label_map[60, 10:30] == window).sum()
+    assert min(inside, column, row) > 0
+    assert float(got[0]) == pytest.approx(inside)
+    assert float(got[1]) == pytest.approx(inside + column / 2)
+    assert float(got[2]) == pytest.approx(inside + row / 4)
+
+
+def test_smoothed_integrals_give_the_sigmoid_rasterizers_overlap_and_gradient():
+    proc = _grid_facade()
+    plan = compile_plan(proc)
+    label_map, tables, index = _tables_for(to_segmentation(proc), 1.0, plan.labels, 1.0)
+    h, w = label_map.shape
+    target = torch.nn.functional.one_hot(torch.from_numpy(label_map.astype("int64")), len(LABELS))
+    target = target.permute(2, 0, 1).double()
+    jitter = torch.randn(len(plan.labels), 4, generator=torch.Generator().manual_seed(0), dtype=torch.float64)
+    boxes = execute_plan(plan) + 2.0 * jitter  # near, not on, the target's edges
+    a = boxes.clone().requires_grad_(True)
+    b = boxes.clone().requires_grad_(True)
+    closed = box_integrals(tables, index, a).sum()
+    reference = (_sigmoid_coverage(b, plan.labels, w, h, 1.0) * target).sum()
+    assert closed.item() == pytest.approx(reference.item(), rel=0.01)
+    closed.backward()
+    reference.backward()
+    cos = torch.nn.functional.cosine_similarity(a.grad.flatten(), b.grad.flatten(), dim=0)
+    assert cos.item() > 0.95
