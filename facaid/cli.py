@@ -148,10 +148,11 @@ def cmd_reconstruct(args: argparse.Namespace) -> None:
     seg = Segmentation.from_dict(_read_json(args.input), clip=args.clip)
     model, tokenizer = load_model(args.checkpoint)
     result = reconstruct(seg, model=model, tokenizer=tokenizer, k=args.k, sizing=not args.no_sizing,
-                         seed=args.seed)
+                         seed=args.seed, induce=not args.no_induce)
     Path(args.out).write_text(result.procedure.to_json(indent=1) + "\n")
     print(f"wrote {args.out}: pixel accuracy {100 * result.accuracy:.2f} % "
-          f"(decoded {100 * result.accuracy_decoded:.2f} %), {1000 * result.timings['total']:.0f} ms")
+          f"(decoded {100 * result.accuracy_decoded:.2f} %), {1000 * result.timings['total']:.0f} ms, "
+          f"{result.source} structure")
     if args.png:
         render_segmentation(to_segmentation(result.procedure), outline=True).save(args.png)
         print(f"wrote {args.png}")
@@ -184,7 +185,7 @@ def cmd_evaluate_real(args: argparse.Namespace) -> None:
         raise CliError(f"annotations not found at {args.data} (pass --data PATH)")
     model, tokenizer = load_model(args.checkpoint)
     result = evaluate_real(model, tokenizer, args.data, k=args.k, limit=args.limit, gallery=args.gallery,
-                           progress=not args.quiet)
+                           progress=not args.quiet, induce=not args.no_induce)
     result["checkpoint"] = str(args.checkpoint)
     print(format_summary(result))
     if args.gallery:
@@ -282,6 +283,8 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--k", type=int, default=4, help="candidates decoded and reranked (default 4)")
     c.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
     c.add_argument("--no-sizing", action="store_true", help="skip the sizing optimizer")
+    c.add_argument("--no-induce", action="store_true",
+                   help="only the model's structures (no induced structure when they fit badly)")
     c.add_argument("--clip", action="store_true", help="clip rectangles that reach outside the image")
     c.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory (default: shipped)")
     c.add_argument("--json", help="write the figures (accuracy, IoU, timings) to this JSON file")
@@ -304,6 +307,7 @@ def build_parser() -> argparse.ArgumentParser:
     r2.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory")
     r2.add_argument("--k", type=int, default=4, help="candidates per facade (default 4)")
     r2.add_argument("--limit", type=int, help="only the first N facades")
+    r2.add_argument("--no-induce", action="store_true", help="only the model's structures (the model alone)")
     r2.add_argument("--gallery", default="out/evaluate-real/gallery.png", help="gallery PNG of the first 20")
     r2.add_argument("--json", help="write the figures to this JSON file")
     r2.add_argument("--quiet", action="store_true", help="no progress bar")

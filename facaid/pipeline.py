@@ -6,6 +6,9 @@ loaded once per process on first use (CUDA when present) unless a model is passe
 A second chance: when the sized best candidate reproduces less than ``retry_below`` of the pixels, its
 structure is likely wrong (sizing cannot change counts or labels), so ``retry_k`` more samples are decoded and
 every candidate gets the geometric fit alone; the best of those is sized fully and kept if it does better.
+Before that (unless a prefix is given or ``induce`` is off) the structure induced straight from the segmentation
+(`facaid.induce`: guillotine cuts folded into repeats) is sized too and kept if it does better, and then
+the sampling is skipped. ``result.source`` says which kind of structure won.
 """
 
 from __future__ import annotations
@@ -21,6 +24,7 @@ import torch
 
 from facaid.decoding import Candidate, decode, ranked_candidates
 from facaid.grammar.procedure import Procedure
+from facaid.induce import induce_procedure
 from facaid.labels import FACADE
 from facaid.metrics import procedure_accuracy
 from facaid.model import FacaidModel, load_model
@@ -38,10 +42,11 @@ class Reconstruction:
     iou: dict[str, float]
     timings: dict[str, float] = field(default_factory=dict)  # seconds per stage
     retried: bool = False  # the second chance ran (the first sized candidate was below retry_below)
+    source: str = "model"  # "model" (a decoded candidate) or "induced" (facaid.induce)
 
     def to_dict(self) -> dict[str, Any]:
         return {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
-                "timings": self.timings, "retried": self.retried}
+                "timings": self.timings, "retried": self.retried, "source": self.source}
 
 
 def fit_to_model(seg: Segmentation, tokenizer: Tokenizer) -> Segmentation:
@@ -66,7 +71,8 @@ def default_model(path: str = str(DEFAULT_CHECKPOINT)) -> tuple[FacaidModel, Tok
 
 def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None = None,
                 tokenizer: Tokenizer | None = None, k: int = 4, sizing: bool = True, seed: int = 0,
-                prefix: list[int] | None = None, retry_below: float = 0.97, retry_k: int = 8) -> Reconstruction:
+                prefix: list[int] | None = None, retry_below: float = 0.97, retry_k: int = 8,
+                induce: bool = True) -> Reconstruction:
     """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object)."""
     seg = segmentation if isinstance(segmentation, Segmentation) else Segmentation.from_dict(segmentation)
     if model is None or tokenizer is None:
@@ -81,14 +87,22 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     decoded = ranked[0].procedure
     before = procedure_accuracy(decoded, flat)
     retried = False
+    source = "model"
     if sizing:
         fitted = fit_sizes(decoded, flat)
-        if fitted.accuracy < retry_below and retry_k:
+        if fitted.accuracy < retry_below and induce and prefix is None:
+            structure = induce_procedure(flat)
+            if structure is not None:
+                other = fit_sizes(structure, flat)
+                if other.accuracy > fitted.accuracy:
+                    fitted, before, source = other, procedure_accuracy(structure, flat), "induced"
+        if fitted.accuracy < retry_below and retry_k and source == "model":
             retried = True
             more = decode(model, tokenizer, readable, k=retry_k, sample=True, greedy=0, seed=seed + 1, prefix=prefix)
             other = _second_chance(ranked[1:] + more, ranked[0], flat)
             if other is not None and other.accuracy > fitted.accuracy:
                 fitted, before = other, procedure_accuracy(other.procedure, flat)  # before: of that candidate
+                source = "model"
         proc, accuracy, iou = fitted.procedure, fitted.accuracy, fitted.iou
     else:
         from facaid.metrics import procedure_iou
@@ -96,8 +110,8 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
         proc, accuracy, iou = decoded, before, procedure_iou(decoded, flat)
     t3 = time.perf_counter()
     timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, total=t3 - t0)
-    proc.meta = {"source": "facaid.reconstruct", "k": k, "accuracy": round(accuracy, 6)}
-    return Reconstruction(proc, before, accuracy, iou, timings, retried)
+    proc.meta = {"source": "facaid.reconstruct", "structure": source, "k": k, "accuracy": round(accuracy, 6)}
+    return Reconstruction(proc, before, accuracy, iou, timings, retried, source)
 
 
 def _second_chance(candidates: list[Candidate], first: Candidate, flat: Segmentation):

@@ -68,12 +68,12 @@ def test_evaluate_real_on_cmp_records(tiny, tmp_path, cmp_records, capsys):
 def test_second_chance_sizes_more_candidates_when_the_first_fits_badly(tiny):
     model, tok = tiny  # untrained: its structures fit badly, so the second chance runs
     seg = generate(6).segmentation
-    first = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=0)
+    first = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=0, induce=False)
     assert not first.retried and first.accuracy < 0.97
-    again = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2)
+    again = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False)
     assert again.retried and again.to_dict()["retried"]
     assert again.accuracy >= first.accuracy
     validate(again.procedure)
     assert again.accuracy == procedure_accuracy(again.procedure, flatten(seg))
-    never = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_below=0.0)
+    never = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_below=0.0, induce=False)
     assert not never.retried and never.accuracy == first.accuracy

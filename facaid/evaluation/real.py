@@ -1,8 +1,9 @@
 """Evaluation on real facades (the CMP annotations): `facaid evaluate-real`. For evaluation only.
 
 Each record is read as layered rectangles (clipped to the image; degenerate boxes kept as the 1-pixel boxes
-they are), flattened by the paint order, reconstructed, and compared at full resolution with its own label
-map. The trivial baseline paints everything inside the building footprint as wall.
+they are), flattened by the paint order, reconstructed (the model's structures and, where they fit badly, the
+induced one; ``induce=False`` for the model alone), and compared at full resolution with its own label map.
+The trivial baseline paints everything inside the building footprint as wall.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ def all_wall(label_map: np.ndarray) -> np.ndarray:
 
 def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *, k: int = 4,
                   limit: int | None = None, gallery: str | Path | None = None, gallery_count: int = 20,
-                  progress: bool = True) -> dict:
+                  progress: bool = True, induce: bool = True) -> dict:
     records = load_records(path, limit)
     acc, acc_decoded, base, times = [], [], [], []
     inter = np.zeros(len(LABELS))
@@ -55,11 +56,12 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
     base_union = np.zeros(len(LABELS))
     pictures = []
     per_facade = []
+    nodes = []
     for i, (rid, seg) in enumerate(tqdm(records, desc="evaluate-real", disable=not progress)):
         flat = flatten(seg)
         target = rasterize(flat)
         t0 = time.perf_counter()
-        result = reconstruct(flat, model=model, tokenizer=tokenizer, k=k)
+        result = reconstruct(flat, model=model, tokenizer=tokenizer, k=k, induce=induce)
         times.append(time.perf_counter() - t0)
         pred = rasterize(to_segmentation(result.procedure))
         trivial = all_wall(target)
@@ -72,7 +74,9 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
             union[c] += (t | p).sum()
             base_inter[c] += (t & b).sum()
             base_union[c] += (t | b).sum()
-        per_facade.append({"id": rid, "accuracy": acc[-1], "baseline": base[-1], "seconds": times[-1]})
+        nodes.append(sum(1 for _ in result.procedure.nodes()))
+        per_facade.append({"id": rid, "accuracy": acc[-1], "baseline": base[-1], "seconds": times[-1],
+                           "source": result.source, "nodes": nodes[-1]})
         if gallery is not None and i < gallery_count:
             pictures.append(side_by_side([colorize(target), colorize(pred)], height=200, gap=4))
     iou = {LABELS[c]: float(inter[c] / union[c]) for c in range(len(LABELS)) if union[c]}
@@ -83,6 +87,9 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
     return {
         "facades": len(records),
         "k": k,
+        "induce": induce,
+        "induced_share": float(np.mean([f["source"] == "induced" for f in per_facade])) if per_facade else 0.0,
+        "nodes_median": float(np.median(nodes)) if nodes else 0.0,
         "pixel_accuracy": {"mean": float(np.mean(acc)), "median": float(np.median(acc)),
                            "decoded_mean": float(np.mean(acc_decoded))},
         "baseline_all_wall": {"mean": float(np.mean(base)), "iou": base_iou},
@@ -114,6 +121,9 @@ def format_summary(result: dict) -> str:
         f"{100 * result['baseline_all_wall']['mean']:.2f} %",
         f"mean IoU over the 11 building classes: {100 * result['mean_iou']:.1f} %",
         f"seconds per facade: median {result['seconds_per_facade']['median']:.2f}",
+        f"structure: induced for {100 * result['induced_share']:.1f} % of the facades"
+        + ("" if result["induce"] else " (induction off: the model alone)")
+        + f"; median {result['nodes_median']:.0f} nodes per procedure",
         f"{'class':<11} {'IoU':>7} {'baseline':>9}",
     ]
     for name, v in result["iou"].items():
