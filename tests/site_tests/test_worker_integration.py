@@ -38,6 +38,7 @@ def check_done(job: Job, attempts: int) -> None:
     assert job.status == "done", job.message
     assert job.attempts == attempts and job.progress == 1.0 and job.result is not None
     assert job.result.accuracy > 0.8 and job.result.segmentation_id == job.segmentation_id
+    assert job.result.metrics["source"] in ("model", "induced") and "timings" in job.result.metrics
 
 
 def test_a_job_runs_end_to_end(alice, worker):
@@ -45,7 +46,7 @@ def test_a_job_runs_end_to_end(alice, worker):
     job = submit(alice)
     check_done(wait_for(job, {"done", "failed"}), attempts=1)
     page = client_for(alice).get(f"/procedures/{job.result.code}").content.decode()
-    assert "pixel accuracy" in page
+    assert "pixel accuracy" in page and 'id="structure"' in page
 
 
 def test_a_worker_killed_mid_job_loses_no_job(alice, worker):
