@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from facaid.grammar.decompose import _chunked, _cut_rects, _least_crossed_cut, _partition, _sizes
+from facaid.grammar.decompose import _chunked, _cut_rects, _least_crossed_cut, _partition
 from facaid.grammar.procedure import MAX_COUNT, Node, Procedure, ProcedureError, Size
-from facaid.labels import FACADE, LABELS
+from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.segmentation import Segmentation
 
 
@@ -305,9 +305,15 @@ def _node(tree: _Tree) -> Node:
                                                    zip(tree.lengths, children, strict=True)],
                            tail=tree.tail, role=role)
     lengths = [int(round(v)) for v in tree.lengths]
-    labels = [c.label if c.rule == "leaf" else None for c in tree.children]
-    # the largest wall or background piece floats (as in decompose); every value is the exact length
-    modes = [s.mode for s in _sizes(lengths, labels)]
+    # one child floats, so that a resized facade grows there: the largest repeat (which then lays out more
+    # copies), else the largest wall piece, else the largest background piece (not the sky beside a wall)
+    modes = ["abs"] * len(lengths)
+    for kind in ("repeat", FACADE, BACKGROUND):
+        found = [i for i, c in enumerate(tree.children)
+                 if (c.rule == kind if kind == "repeat" else c.rule == "leaf" and c.label == kind)]
+        if found:
+            modes[max(found, key=lambda i: lengths[i])] = "flt"
+            break
     items = [(Size(m, v), c) for m, v, c in zip(modes, tree.lengths, children, strict=True)]
     return _chunked(tree.axis, items, lengths)
 

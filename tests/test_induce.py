@@ -3,11 +3,14 @@ import pytest
 
 from facaid.generator import generate
 from facaid.grammar.decompose import procedure_from_segmentation
+from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure, validate
 from facaid.induce import induce_procedure
+from facaid.labels import LABEL_ID
 from facaid.metrics import procedure_accuracy
 from facaid.pipeline import reconstruct
-from facaid.segmentation import Rect, Segmentation, flatten
+from facaid.segmentation import Rect, Segmentation, flatten, rasterize
+from facaid.variation import resize
 
 
 def _grid(jitter: int = 0, seed: int = 0) -> Segmentation:
@@ -94,3 +97,16 @@ def test_reconstruct_keeps_the_induced_structure_when_the_model_fits_badly(tiny)
     assert result.procedure.meta["structure"] == "induced"
     model_only = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False)
     assert model_only.source == "model" and model_only.accuracy < result.accuracy
+
+
+def test_resizing_an_induced_facade_stretches_its_wall_and_adds_tiles_not_sky():
+    rects = [Rect(1, 0, 0, 320, 300)]  # the building; the 100 px on its right are background (a gap)
+    rects += [Rect(2, 30 + 70 * t, 40 + 90 * f, 70 + 70 * t, 100 + 90 * f) for f in range(3) for t in range(4)]
+    seg = flatten(Segmentation(420, 300, tuple(rects)))
+    proc = induce_procedure(seg)
+    assert procedure_accuracy(proc, seg) == 1.0
+    wider = resize(proc, 560, 300)
+    labels = rasterize(to_segmentation(wider))
+    assert (labels == LABEL_ID["background"]).sum() == 100 * 300  # the sky beside it keeps its width
+    windows = [r for r in to_segmentation(wider).rects if r.label == LABEL_ID["window"]]
+    assert len(windows) == 3 * 6  # the rows of windows repeat to fill the wider wall
