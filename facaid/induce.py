@@ -164,8 +164,8 @@ class _Inducer:
 
     def cut(self, rects: np.ndarray, box: tuple[int, int, int, int], prefer_y: bool, depth: int = 0) -> _Tree:
         """Split the box into bands of rectangles with wall between them; the wall is what no rectangle covers.
-        Near the top, every way to cut (bands along y or x, or only at the rectangles that span the box) is
-        tried and the one that folds shortest kept; deeper, floors alternate with tiles. Where no band
+        Near the top, every way to cut (bands along y or x, strict bands, or only at the rectangles that span
+        the box) is tried and the one that folds shortest kept; deeper, floors alternate with tiles. Where no band
         structure exists (a pinwheel), cut where the fewest rectangles are crossed, as `decompose` does."""
         rects = _grow(rects, box, self.tol)
         x0, y0, x1, y1 = box
@@ -186,6 +186,12 @@ class _Inducer:
                 spans = _spanning(rects, box, axis)
                 if spans is not None and len(spans[1]) > 1:
                     options.append((axis, *spans))
+                # strict bands (no tolerance) keep rows that overlap at all together: the wings of a building
+                # whose floors do not line up stay whole, to be told apart one level down
+                lo_col, hi_col, lo, hi = (2, 4, y0, y1) if axis == "y" else (1, 3, x0, x1)
+                strict = _bands(rects, lo_col, hi_col, 0.0)
+                if 1 < len(strict[1]) < len(next((o[2] for o in options if o[0] == axis), [])):
+                    options.append((axis, *strict))
         if not options:
             axis, lo_col, hi_col, lo, hi, cut = _least_crossed_cut(rects, box)
             options.append((axis, *_bands(_cut_rects(rects, [cut], lo_col, hi_col), lo_col, hi_col, 0.0)))

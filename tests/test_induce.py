@@ -61,7 +61,7 @@ def test_hand_drawn_misalignments_still_fold_and_fit_closely():
     assert procedure_accuracy(proc, seg) > 0.97
 
 
-@pytest.mark.parametrize("seed, least", [(0, 0.97), (3, 0.97), (5, 0.88)])
+@pytest.mark.parametrize("seed, least", [(0, 0.97), (3, 0.97), (5, 0.93)])
 def test_generated_facades_are_induced_with_repeats_and_reproduced(seed, least):
     sample = generate(seed)
     seg = flatten(sample.segmentation)
@@ -69,7 +69,7 @@ def test_generated_facades_are_induced_with_repeats_and_reproduced(seed, least):
     validate(proc)
     assert (proc.width, proc.height) == (seg.width, seg.height)
     # seed 5 has two wings whose floors do not line up and no clean cut between them (the ground floor runs
-    # under both): the floors are cut across both wings and folded with averaged heights
+    # under both): strict bands keep the wings whole above the ground floor, but some averaging remains
     assert procedure_accuracy(proc, seg) > least
     assert _repeats(proc)
     assert _nodes(proc) < _nodes(procedure_from_segmentation(seg))
