@@ -45,6 +45,7 @@ def load_segmentation_or_procedure(obj: Any):
 
 def _write_json(path: str | None, payload: dict) -> None:
     if path:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)  # a long run's figures are not lost to a missing folder
         Path(path).write_text(json.dumps(payload, indent=2) + "\n")
         print(f"wrote {path}")
 

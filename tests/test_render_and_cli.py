@@ -95,7 +95,7 @@ def test_cli_generate_writes_shards(tmp_path, capsys):
 def test_cli_stats(tmp_path, capsys, cmp_records):
     small = tmp_path / "cmp.jsonl"
     small.write_text("\n".join(json.dumps(r) for r in cmp_records[:5]) + "\n")
-    report = tmp_path / "stats.json"
+    report = tmp_path / "not" / "yet" / "stats.json"  # folders are made rather than the figures lost
     assert main(["generate", "--stats", "--count", "20", "--cmp", str(small), "--json", str(report),
                  "--quiet"]) == 0
     out = capsys.readouterr().out
