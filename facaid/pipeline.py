@@ -95,14 +95,13 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
             if structure is not None:
                 other = fit_sizes(structure, flat)
                 if other.accuracy > fitted.accuracy:
-                    fitted, before, source = other, procedure_accuracy(structure, flat), "induced"
+                    fitted, before, source = other, other.accuracy_before, "induced"
         if fitted.accuracy < retry_below and retry_k and source == "model":
             retried = True
             more = decode(model, tokenizer, readable, k=retry_k, sample=True, greedy=0, seed=seed + 1, prefix=prefix)
             other = _second_chance(ranked[1:] + more, ranked[0], flat)
             if other is not None and other.accuracy > fitted.accuracy:
-                fitted, before = other, procedure_accuracy(other.procedure, flat)  # before: of that candidate
-                source = "model"
+                fitted, before = other, other.accuracy_before  # before sizing, of that candidate
         proc, accuracy, iou = fitted.procedure, fitted.accuracy, fitted.iou
     else:
         from facaid.metrics import procedure_iou
