@@ -12,6 +12,7 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass, replace
 
+from facaid.generator.canonical import canonical, structure
 from facaid.generator.styles import Style
 from facaid.grammar.procedure import Node, Procedure, Size
 
@@ -235,7 +236,8 @@ class Builder:
         center = None
         if layout.symmetric and self.chance(0.35):
             wider = replace(ft, window_w=min(ft.window_w * 1.25, layout.bay_w - 0.3), deco=ft.deco or ft.hood)
-            center = self.tile(wider, layout.bay_w, s.floor_h)
+            if wider.deco != ft.deco or wider.window_w >= 1.1 * ft.window_w:  # else it would pass for a tile
+                center = self.tile(wider, layout.bay_w, s.floor_h)
         row = self.with_margins(layout, self.choose_row(layout, tile, center))
         if ft.balcony == "band":
             return Node.split("y", [(self.flt(s.floor_h - self.balcony_h), row),
@@ -254,15 +256,19 @@ class Builder:
         """H_p for the stack of upper floors: runs of identical floors become repeats. Returns (node, height)."""
         self.balcony_h = self.rng.uniform(0.8, 1.1)
         band_h = self.rng.uniform(0.15, 0.35)
+        runs: list[tuple[FloorType, int, Node]] = []  # (type, floors, the floor node)
+        for ft in types:
+            if runs and runs[-1][0] is ft:
+                runs[-1] = (ft, runs[-1][1] + 1, runs[-1][2])
+                continue
+            floor = self.floor(s, layout, ft)
+            if runs and self.looks_alike(runs[-1], ft, floor):  # two runs a segmentation cannot tell apart
+                runs[-1] = (runs[-1][0], runs[-1][1] + 1, runs[-1][2])
+            else:
+                runs.append((ft, 1, floor))
         items: list[tuple[Size, Node]] = []
         height = 0.0
-        i = 0
-        while i < len(types):
-            j = i
-            while j + 1 < len(types) and types[j + 1] is types[i]:
-                j += 1
-            ft, n = types[i], j - i + 1
-            floor = self.floor(s, layout, ft)
+        for ft, n, floor in runs:
             pattern = [(self.flt(s.floor_h), floor)]
             unit_h = s.floor_h
             if ft.band_below:
@@ -273,10 +279,17 @@ class Builder:
             else:
                 items.append(pattern[0])
             height += n * unit_h
-            i = j + 1
         if len(items) == 1:
             return items[0][1], height
         return Node.split("y", items, role="floors"), height
+
+    @staticmethod
+    def looks_alike(run: tuple[FloorType, int, Node], ft: FloorType, floor: Node) -> bool:
+        """Whether a floor of type ``ft`` would pass for one more floor of ``run``: the same tree, the same band
+        below, windows within 5 % of the same height."""
+        other, _, other_floor = run
+        return (other.band_below == ft.band_below and abs(other.window_h - ft.window_h) <= 0.05 * other.window_h
+                and structure(other_floor) == structure(floor))
 
     # --- ground floor and attic -------------------------------------------------------------------------------
     def entrance(self, bay_w: float, height: float, hood: bool) -> Node:
@@ -336,8 +349,11 @@ class Builder:
         elif layout.symmetric and layout.bays % 2 == 1:
             row = self.choose_row(layout, bay, entrance)
         else:
+            door = self.rng.randrange(layout.bays)
+            if layout.bays % 2 == 1 and layout.bays >= 3 and door == layout.bays // 2:  # symmetric after all
+                return self.ground_row(layout, self.choose_row(layout, bay, entrance))
             bays = [bay.copy() for _ in range(layout.bays)]
-            bays[self.rng.randrange(layout.bays)] = entrance
+            bays[door] = entrance
             pillar = layout.pillar_w > 0
             items: list[tuple[Size, Node]] = []
             for b in bays:
@@ -347,6 +363,9 @@ class Builder:
             if pillar:
                 items.append((self.abs(layout.pillar_w), Node.leaf("pillar")))
             row = Node.split("x", items, role="bay")
+        return self.ground_row(layout, row)
+
+    def ground_row(self, layout: Layout, row: Node) -> Node:
         node = self.with_margins(layout, row)
         node.role = "ground"
         return node
@@ -427,4 +446,4 @@ def build_procedure(rng: random.Random, styles: list[Style], long_side: float) -
     scale = long_side / max(total_w, total_h)
     width_px = max(8, round(total_w * scale))
     height_px = max(8, round(total_h * scale))
-    return Procedure(width_px, height_px, _scaled(body, scale))
+    return canonical(Procedure(width_px, height_px, _scaled(body, scale)))

@@ -1,0 +1,93 @@
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from facaid.generator import STYLE_NAMES, generate_procedure
+from facaid.generator.canonical import IMPLICIT, MIN_GAP, canonical, structure
+from facaid.grammar import Procedure, execute
+from facaid.grammar.execute import first_boxes, leaf_array
+from facaid.grammar.procedure import Node, Size
+
+
+def wall(role=None):
+    return Node.leaf("facade", role=role)
+
+
+def test_invisible_wall_goes_and_a_lone_child_takes_the_split_s_place():
+    column = Node.split("y", [(Size("flt", 2), wall()), (Size("abs", 100), Node.leaf("window")),
+                              (Size("flt", 300), wall())])
+    tile = Node.split("x", [(Size("flt", 1), wall()), (Size("abs", 500), column), (Size("flt", 1), wall())],
+                      role="tile")
+    proc = canonical(Procedure(512, 402, tile))
+    root = proc.root
+    # the side walls are 6 pixels wide, over 512 / 128 = 4: they stay
+    assert root.rule == "split" and len(root.children) == 3
+    column = root.children[1]
+    assert [c.label for c in column.children] == ["window", "facade"]  # the 2-pixel top wall went
+    assert [s.mode for s in column.sizes] == ["abs", "flt"]
+
+
+def test_lone_child_inherits_the_role_and_a_centre_that_went_clears_center():
+    inner = Node.split("y", [(Size("abs", 1), wall()), (Size("flt", 99), Node.leaf("window"))])
+    tile = Node.split("x", [(Size("abs", 1), wall()), (Size("flt", 100), inner)], role="tile")
+    proc = canonical(Procedure(256, 256, tile))  # 1-pixel walls, under 256 / 128 = 2 pixels
+    assert (proc.root.rule, proc.root.label, proc.root.role) == ("leaf", "window", "tile")
+
+    # the centre (a half-pixel door) goes: window and its reflection remain, a mirror without centre
+    m = Node.mirror("x", [(Size("flt", 100), Node.leaf("window")), (Size("abs", 0.5), Node.leaf("door"))],
+                    center=True)
+    proc = canonical(Procedure(256, 256, m))
+    assert proc.root.rule == "mirror" and not proc.root.center
+    assert [c.label for c in proc.root.children] == ["window"]
+
+    # a side child goes: the centre stays the centre
+    m = Node.mirror("x", [(Size("abs", 0.5), Node.leaf("door")), (Size("flt", 60), Node.leaf("window")),
+                          (Size("flt", 60), wall())], center=True)
+    proc = canonical(Procedure(256, 256, m))
+    assert proc.root.center and [c.label for c in proc.root.children] == ["window", "facade"]
+
+
+def test_canonical_keeps_the_picture_within_the_removed_gaps():
+    column = Node.split("y", [(Size("flt", 3), wall()), (Size("abs", 200), Node.leaf("window")),
+                              (Size("flt", 197), wall())])
+    proc = Procedure(400, 400, Node.split("x", [(Size("flt", 1), wall()), (Size("abs", 100), column),
+                                                (Size("flt", 1), wall())]))
+    before = leaf_array(proc)
+    after = leaf_array(canonical(proc))
+    win_before = before[before[:, 0] == 2][0, 1:]
+    win_after = after[after[:, 0] == 2][0, 1:]
+    assert np.abs(win_before - win_after).max() <= 3
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(min_value=0, max_value=2**63), st.sampled_from((None, *STYLE_NAMES)))
+def test_generated_procedures_show_every_node(seed, style):
+    proc = generate_procedure(seed, style)
+    boxes = first_boxes(proc)
+    for _, node in proc.nodes():
+        if node.rule in ("split", "mirror"):
+            if node.rule == "split" or node.center:
+                assert len(node.children) >= 2
+            for child in node.children:
+                if child.rule == "leaf" and id(child) in boxes:
+                    x0, y0, x1, y1 = boxes[id(child)]
+                    extent, side = (x1 - x0, proc.width) if node.axis == "x" else (y1 - y0, proc.height)
+                    assert extent >= (MIN_GAP * side if child.label in IMPLICIT else 1.0) - 1e-6
+        if node.role == "floors" and node.rule == "split":  # runs of floors that look alike are one repeat
+            for a, b in zip(node.children, node.children[1:], strict=False):
+                assert structure(a) != structure(b)
+    assert len(execute(proc)) > 0
+
+
+def test_an_entrance_in_the_middle_of_an_odd_row_is_a_mirror():
+    seen = 0
+    for seed in range(400):
+        proc = generate_procedure(seed)
+        for _, node in proc.nodes():
+            if node.role == "bay" and node.rule == "split":
+                bays = [c for c in node.children if c.label != "pillar"]
+                doors = [i for i, c in enumerate(bays) if c.role == "entrance"]
+                if len(bays) % 2 == 1 and doors:
+                    seen += 1
+                    assert doors != [len(bays) // 2]
+    assert seen > 10
