@@ -131,7 +131,8 @@ def cmd_evaluate(args: argparse.Namespace) -> None:
         torch.set_num_threads(args.threads)
     model, tokenizer = load_model(args.checkpoint)
     result = evaluate_synthetic(model, tokenizer, args.count, args.seed, noise_count=args.noise_count,
-                                unconstrained_count=args.unconstrained_count, progress=not args.quiet)
+                                unconstrained_count=args.unconstrained_count, best_of=args.best_of,
+                                progress=not args.quiet)
     result["checkpoint"] = str(args.checkpoint)
     report = write_report(result, args.report)
     print(report.read_text().split("## Noise")[0].strip())
@@ -269,6 +270,8 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--noise-count", type=int, default=100, help="facades in the noise curve (default 100)")
     e.add_argument("--unconstrained-count", type=int, default=200,
                    help="facades decoded without the grammar mask (default 200)")
+    e.add_argument("--best-of", type=int, default=0, metavar="K",
+                   help="also decode best of K (greedy + K-1 samples reranked by reproduction), as reconstruct does")
     e.add_argument("--report", default="out/evaluate", help="report directory (default out/evaluate)")
     e.add_argument("--json", help="write the figures to this JSON file")
     e.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")

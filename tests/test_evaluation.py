@@ -44,7 +44,7 @@ def test_unconstrained_decoding_reports_invalid_sequences(tiny):
 def test_evaluate_and_report(tiny, tmp_path):
     model, tok = tiny
     result = evaluate_synthetic(model, tok, count=3, seed=1000, noise_count=1, unconstrained_count=1,
-                                progress=False)
+                                best_of=3, progress=False)
     assert result["count"] == 3 and result["validity"]["constrained"] == 1.0
     assert result["validity"]["unconstrained"] == 0.0
     assert 0.0 <= result["exact_structure_rate"] <= 1.0
@@ -53,6 +53,10 @@ def test_evaluate_and_report(tiny, tmp_path):
     report = write_report(result, tmp_path / "report")
     text = report.read_text()
     assert "NLL per token, with nullification" in text
+    best = result["best_of"]
+    assert best["k"] == 3 and 0.0 <= best["exact_structure_rate"] <= 1.0 and best["latency_ms"]["median"] > 0
+    assert [p["count"] for p in best["noise"]] == [1] * 5
+    assert "exact structure (TED = 0), best of 3" in text and "Mean TED under noise, best of 3" in text
     for png in ("ted.png", "productions.png", "noise.png"):
         assert (tmp_path / "report" / png).stat().st_size > 1000
 
@@ -62,8 +66,9 @@ def test_cli_evaluate(tiny, tmp_path, capsys):
     save_model(model, tok, tmp_path / "ckpt")
     out = tmp_path / "figures.json"
     assert main(["evaluate", "--checkpoint", str(tmp_path / "ckpt"), "--count", "2", "--noise-count", "0",
-                 "--unconstrained-count", "1", "--report", str(tmp_path / "rep"), "--json", str(out),
+                 "--unconstrained-count", "1", "--best-of", "2", "--report", str(tmp_path / "rep"), "--json", str(out),
                  "--quiet"]) == 0
-    assert json.loads(out.read_text())["count"] == 2
+    figures = json.loads(out.read_text())
+    assert figures["count"] == 2 and figures["best_of"]["k"] == 2
     assert main(["evaluate", "--checkpoint", str(tmp_path / "missing"), "--count", "2"]) == 2
     assert "no checkpoint" in capsys.readouterr().err

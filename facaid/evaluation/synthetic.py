@@ -17,7 +17,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from facaid.decoding import decode
+from facaid.decoding import best_of_k, decode
 from facaid.evaluation.noise import perturb
 from facaid.evaluation.ted import tree_edit_distance, tree_size
 from facaid.generator import generate
@@ -64,8 +64,10 @@ def nll(model: FacaidModel, tokenizer: Tokenizer, examples: list, batch_size: in
 
 
 def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, seed: int, *,
-                       noise_count: int = 100, unconstrained_count: int = 200,
+                       noise_count: int = 100, unconstrained_count: int = 200, best_of: int = 0,
                        progress: bool = True) -> dict:
+    """Figures of the greedy decoder; with ``best_of`` = K > 1 also of best-of-K decoding (the greedy candidate
+    and K-1 samples, the one whose execution reproduces the input best), as `facaid.reconstruct` decodes."""
     model.eval()
     examples, skipped, index = [], 0, 0
     while len(examples) < count:
@@ -90,6 +92,9 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
     valid_unconstrained = 0
     noise_teds: dict[float, list[int]] = {lv: [] for lv in NOISE_LEVELS}
     noise_measured: dict[float, list[float]] = {lv: [] for lv in NOISE_LEVELS}
+    best_teds: list[int] = []
+    best_latency: list[float] = []
+    best_noise: dict[float, list[int]] = {lv: [] for lv in NOISE_LEVELS}
     for i, ex in enumerate(tqdm(examples, desc="evaluate", disable=not progress)):
         s = ex["sample"]
         t0 = time.perf_counter()
@@ -97,6 +102,11 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
         latency.append(time.perf_counter() - t0)
         d = tree_edit_distance(s.procedure.root, pred.procedure.root)
         teds.append(d)
+        if best_of > 1:
+            t0 = time.perf_counter()
+            best = best_of_k(model, tokenizer, s.segmentation, best_of, seed=i)
+            best_latency.append(time.perf_counter() - t0)
+            best_teds.append(tree_edit_distance(s.procedure.root, best.procedure.root))
         norm.append(d / tree_size(s.procedure.root))
         truth_counts.update(production(n) for _, n in s.procedure.nodes())
         pred_counts.update(production(n) for _, n in pred.procedure.nodes())
@@ -106,16 +116,31 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
         if i < noise_count:
             noise_teds[0.0].append(d)
             noise_measured[0.0].append(0.0)
+            if best_of > 1:
+                best_noise[0.0].append(best_teds[-1])
             for level in NOISE_LEVELS[1:]:
                 noisy, measured = perturb(s.segmentation, level, seed=i)
-                p = decode(model, tokenizer, fit_to_model(noisy, tokenizer))[0]  # noise can add pieces
+                noisy = fit_to_model(noisy, tokenizer)  # noise can add pieces
+                p = decode(model, tokenizer, noisy)[0]
                 noise_teds[level].append(tree_edit_distance(s.procedure.root, p.procedure.root))
                 noise_measured[level].append(measured)
+                if best_of > 1:
+                    p = best_of_k(model, tokenizer, noisy, best_of, seed=i)
+                    best_noise[level].append(tree_edit_distance(s.procedure.root, p.procedure.root))
 
     teds_arr = np.array(teds)
     hist = Counter(min(int(t), 20) for t in teds)
     norm_hist = Counter(min(int(x * 20), 20) for x in norm)  # bins of 0.05
     n_unconstrained = min(unconstrained_count, len(examples))
+    best = None
+    if best_of > 1:
+        b = np.array(best_teds)
+        best = {"k": best_of, "exact_structure_rate": float((b == 0).mean()), "ted_mean": float(b.mean()),
+                "ted_le5": float((b <= 5).mean()),
+                "latency_ms": {"median": 1000 * statistics.median(best_latency),
+                               "p90": 1000 * float(np.percentile(best_latency, 90))},
+                "noise": [{"level": lv, "mean_ted": float(np.mean(best_noise[lv])) if best_noise[lv] else None,
+                           "count": len(best_noise[lv])} for lv in NOISE_LEVELS]}
     return {
         "count": len(examples),
         "seed": seed,
@@ -135,6 +160,7 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
         "latency_ms": {"median": 1000 * statistics.median(latency),
                        "p90": 1000 * float(np.percentile(latency, 90))},
         "productions": {"truth": dict(truth_counts.most_common()), "predicted": dict(pred_counts.most_common())},
+        "best_of": best,
     }
 
 
@@ -215,6 +241,24 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
         if p["mean_ted"] is not None:
             lines.append(f"| {100 * p['level']:.0f} % | {100 * p['measured']:.1f} % | {p['mean_ted']:.2f} | "
                          f"{p['count']} |")
+    if r.get("best_of"):
+        b = r["best_of"]
+        k = b["k"]
+        lines[lines.index("## Noise robustness") - 1:lines.index("## Noise robustness") - 1] = [
+            "",
+            f"Best of {k} (the greedy candidate and {k - 1} samples, the one whose execution reproduces the input "
+            "best, as `facaid.reconstruct` decodes):",
+            "",
+            "| figure | value |",
+            "| --- | --- |",
+            f"| exact structure (TED = 0), best of {k} | {100 * b['exact_structure_rate']:.1f} % |",
+            f"| TED ≤ 5, best of {k} | {100 * b['ted_le5']:.1f} % |",
+            f"| mean TED, best of {k} | {b['ted_mean']:.2f} |",
+            f"| inference latency, best of {k}, batch 1 (median / p90) | {b['latency_ms']['median']:.0f} / "
+            f"{b['latency_ms']['p90']:.0f} ms |",
+        ]
+        lines += ["", f"Mean TED under noise, best of {k}: " + ", ".join(
+            f"{100 * p['level']:.0f} %: {p['mean_ted']:.2f}" for p in b["noise"] if p["mean_ted"] is not None) + "."]
     lines += ["", "![noise](noise.png)", "", "## Tree edit distance", "", "![ted](ted.png)", "",
               "## Productions", "", "![productions](productions.png)", ""]
     path = out / "report.md"
