@@ -5,6 +5,7 @@ import torch
 
 from facaid.generator import generate
 from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model, save_model
+from facaid.paths import DEFAULT_CHECKPOINT, ROOT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 from facaid.train import load_config, lr_at, train
 
@@ -136,6 +137,17 @@ def test_config_errors(tmp_path):
     bad.write_text("[optimizer]\nlr = 3\n")
     with pytest.raises(ValueError, match="unknown table"):
         load_config(bad)
+
+
+@pytest.mark.parametrize("name", ["small", "gpu", "finetune-noise", "finetune-canonical", "finetune-canonical-2"])
+def test_committed_configs_build_the_shipped_architecture(name):
+    """The configs that made the shipped checkpoint (and the CPU recipe) parse and describe its model."""
+    model_config, tok_config, train_config = load_config(ROOT / "configs" / f"{name}.toml")
+    shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
+    for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes"):
+        assert getattr(model_config, key) == shipped[key], key
+    assert tok_config.to_dict() == shipped["tokenizer"]
+    assert train_config.steps > 0 and train_config.lr > train_config.min_lr
 
 
 def test_learning_rate_schedule():
