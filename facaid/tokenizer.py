@@ -166,6 +166,11 @@ class TokenGrammar:
         r = vocab.ranges
         self._masks = {name: self._mask(r[name]) for name in r}
         self._eos = self._mask(range(EOS, EOS + 1))
+        # a split's first size copies its child as often as the split is copied; a repeat (count 1, and room
+        # for a tail) or a mirror twice as often
+        self._splits = np.zeros(len(vocab), dtype=bool)
+        self._splits[[i for i in r["rule"] if vocab.tokens[i].startswith("split")]] = True
+        self._doubling = self._masks["rule"] & ~self._splits
 
     def _mask(self, ids: range) -> np.ndarray:
         m = np.zeros(len(self.vocab), dtype=bool)
@@ -185,11 +190,14 @@ class TokenGrammar:
         if self.open is None:
             if not self.pending:
                 return self._eos.copy()
-            _, depth, _, _ = self.pending[0]
+            _, depth, copies, _ = self.pending[0]
             out = m["label"].copy()
             if (depth + 1 < MAX_DEPTH and self.nodes + 2 <= MAX_NODES
                     and 1 + self._INNER_MIN + len(self.pending) - 1 <= room):
-                out |= m["rule"]
+                if self.expanded + copies <= MAX_LEAVES:  # the leaf budget: the smallest expansion must fit
+                    out |= self._splits
+                if self.expanded + 2 * copies <= MAX_LEAVES:
+                    out |= self._doubling
             return out
         o = self.open
         if o.phase == "role":

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 import torch
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from facaid.decoding import GrammarLogitsProcessor, best_of_k, decode, prefix_from_procedure
@@ -16,6 +16,7 @@ TOK = Tokenizer(CONFIG)
 
 @settings(max_examples=60, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(40, 160))
+@example(1383, 90)  # once offered a repeat whose smallest expansion overran the leaf budget
 def test_random_logits_always_give_a_valid_procedure(seed, max_len):
     rng = np.random.default_rng(seed)
     proc = GrammarLogitsProcessor(TOK, [(300.0, 200.0)], max_len=max_len)
@@ -31,6 +32,24 @@ def test_random_logits_always_give_a_valid_procedure(seed, max_len):
     result = TOK.decode_procedure(ids, 300, 200)
     validate(result)
     assert len(execute(result)) >= 1
+
+
+def test_a_rule_is_offered_only_where_its_smallest_expansion_fits_the_leaf_budget():
+    v = TOK.vocab
+    g = TokenGrammar(v, 300.0, 200.0)
+    # three nested repeats: the next slot may be copied 65 * 65 * 9 = 38,025 times (a tail each), and 42,316
+    # leaves are spoken for
+    for rule, count in (("repeat_x", 64), ("repeat_y", 64), ("repeat_x", 8)):
+        for token in (rule, "role:none", f"count:{count}", "abs:10", "end:0"):
+            g.step(v.id(token))
+    allowed = g.allowed()
+    assert g.expanded == 42_316 and g.pending[0][2] == 38_025
+    assert allowed[v.id("split_x")] and allowed[v.id("split_y")] and allowed[v.id("label:window")]
+    # a repeat (count 1 and a tail) or a mirror would copy its child 76,050 times: over the 100,000 budget
+    assert not any(allowed[v.id(r)] for r in ("repeat_x", "repeat_y", "mirror_x", "mirror_y"))
+    for token in ("split_x", "role:none", "abs:10", "end:0", "label:window", "<eos>"):
+        g.step(v.id(token))
+    assert len(execute(g.procedure())) == 64 * 64 * 8  # the budget counts a tail's copy that none of these has
 
 
 def test_mask_matches_an_explicit_boolean_matrix():
