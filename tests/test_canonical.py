@@ -1,9 +1,9 @@
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.generator.canonical import IMPLICIT, MIN_GAP, canonical, structure
+from facaid.generator.canonical import IMPLICIT, MIN_GAP, canonical, merge_floor_runs, structure
 from facaid.grammar import Procedure, execute
 from facaid.grammar.execute import first_boxes, leaf_array
 from facaid.grammar.procedure import Node, Size
@@ -61,6 +61,7 @@ def test_canonical_keeps_the_picture_within_the_removed_gaps():
 
 @settings(max_examples=60, deadline=None)
 @given(st.integers(min_value=0, max_value=2**63), st.sampled_from((None, *STYLE_NAMES)))
+@example(18582, "haussmann")  # two runs of floors told apart only by a gap that canonical removed
 def test_generated_procedures_show_every_node(seed, style):
     proc = generate_procedure(seed, style)
     boxes = first_boxes(proc)
@@ -76,6 +77,32 @@ def test_generated_procedures_show_every_node(seed, style):
         if node.role == "floors" and node.rule == "split":  # runs of floors that look alike are one repeat
             for a, b in zip(node.children, node.children[1:], strict=False):
                 assert structure(a) != structure(b)
+    assert len(execute(proc)) > 0
+
+
+def test_runs_of_floors_that_look_alike_become_one_repeat():
+    def floor(window_h):
+        return Node.split("y", [(Size("flt", 1), wall()), (Size("abs", window_h), Node.leaf("window"))],
+                          role="floor")
+
+    band = (Size("abs", 3), Node.leaf("molding", role="band"))
+    runs = Node.split("y", [
+        (Size("flt", 60), Node.repeat("y", 2, [(Size("flt", 27), floor(20)), band], role="floors")),
+        (Size("flt", 90), Node.repeat("y", 3, [(Size("flt", 27), floor(21)), band], role="floors")),
+        (Size("flt", 30), Node.split("y", [(Size("flt", 1), wall()), (Size("abs", 10), Node.leaf("door"))],
+                                     role="floor")),
+    ], role="floors")
+    merge_floor_runs(runs)
+    assert [(c.rule, c.count) for c in runs.children] == [("repeat", 5), ("split", None)]
+    assert [s.value for s in runs.sizes] == [150, 30]
+    assert runs.children[0].children[0].children[1].label == "window"
+
+    # a lone floor followed by a repeat of the same floor: one repeat that fills the whole split
+    alike = Node.split("y", [(Size("flt", 30), floor(20)),
+                             (Size("flt", 60), Node.repeat("y", 2, [(Size("flt", 30), floor(22))], role="floors"))],
+                       role="floors")
+    proc = canonical(Procedure(300, 900, alike))
+    assert (proc.root.rule, proc.root.count, proc.root.role) == ("repeat", 3, "floors")
     assert len(execute(proc)) > 0
 
 

@@ -12,7 +12,7 @@ child gives way to that child, which takes over its role if it has none.
 from __future__ import annotations
 
 from facaid.grammar.execute import first_boxes
-from facaid.grammar.procedure import Node, Procedure, validate
+from facaid.grammar.procedure import Node, Procedure, Size, validate
 
 MIN_GAP = 1 / 128  # of the image side: narrower wall or background is invisible in the model's input
 IMPLICIT = ("facade", "background")
@@ -34,12 +34,13 @@ def canonical(proc: Procedure) -> Procedure:
         if node.rule not in ("split", "mirror") or len(node.children) < 2:
             return node
         keep = [i for i, child in enumerate(node.children) if not invisible(child, node.axis)]
-        if not keep or len(keep) == len(node.children):
-            return node
-        if node.rule == "mirror" and node.center and keep[-1] != len(node.children) - 1:
-            node.center = False  # the middle child went
-        node.sizes = [node.sizes[i] for i in keep]
-        node.children = [node.children[i] for i in keep]
+        if keep and len(keep) < len(node.children):
+            if node.rule == "mirror" and node.center and keep[-1] != len(node.children) - 1:
+                node.center = False  # the middle child went
+            node.sizes = [node.sizes[i] for i in keep]
+            node.children = [node.children[i] for i in keep]
+        if node.rule == "split" and node.role == "floors":
+            merge_floor_runs(node)
         if len(node.children) == 1 and (node.rule == "split" or node.center):
             child = node.children[0]
             if child.role is None:
@@ -50,6 +51,40 @@ def canonical(proc: Procedure) -> Procedure:
     proc.root = visit(proc.root)
     validate(proc)
     return proc
+
+
+def _floor_run(size: Size, node: Node) -> tuple[int, list[tuple[Size, Node]]] | None:
+    """A child of a floors split as (floors, pattern): a repeat of floors or one floor; None if neither."""
+    if size.mode != "flt":
+        return None
+    if node.rule == "repeat" and node.role == "floors" and isinstance(node.count, int) and not node.tail:
+        return node.count, list(zip(node.sizes, node.children, strict=True))
+    if node.role == "floor":
+        return 1, [(Size("flt", 1.0), node)]
+    return None
+
+
+def merge_floor_runs(split: Node) -> None:
+    """Neighbouring runs of floors whose trees (and bands) are the same become one repeat, in place: the
+    generator compared floors before `canonical` removed the gaps, so two runs may look alike only now. The
+    merged run takes the first run's proportions for every floor."""
+    items = list(zip(split.sizes, split.children, strict=True))
+    merged: list[tuple[Size, Node]] = []
+    for size, node in items:
+        if merged:
+            prev = _floor_run(*merged[-1])
+            cur = _floor_run(size, node)
+            if prev and cur and _pattern_structure(prev[1]) == _pattern_structure(cur[1]):
+                repeat = Node.repeat(split.axis, prev[0] + cur[0], prev[1], role="floors")
+                merged[-1] = (Size("flt", merged[-1][0].value + size.value), repeat)
+                continue
+        merged.append((size, node))
+    split.sizes = [s for s, _ in merged]
+    split.children = [n for _, n in merged]
+
+
+def _pattern_structure(pattern: list[tuple[Size, Node]]) -> tuple:
+    return tuple((s.mode, structure(n)) for s, n in pattern)
 
 
 def structure(node: Node) -> tuple:
