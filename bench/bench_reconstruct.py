@@ -1,6 +1,6 @@
 """Reconstruction: sizing accuracy and time, and the whole pipeline with the shipped model.
 
-    .venv/bin/python bench/bench_reconstruct.py [--count 100] [--k 4] [--checkpoint DIR] [--no-model]
+    .venv/bin/python bench/bench_reconstruct.py [--count 100] [--k 8] [--checkpoint DIR] [--no-model]
 
 Held-out generated facades (dataset seed 1000). Sizing alone starts from the true structure with sizes
 quantized by the tokenizer (what a perfect decoder would give); the pipeline runs `facaid.reconstruct` (the
@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 
+from facaid.defaults import DEFAULT_K
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.paths import DEFAULT_CHECKPOINT
@@ -33,7 +34,7 @@ def report(name: str, acc: list[float], secs: list[float]) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--count", type=int, default=100)
-    parser.add_argument("--k", type=int, default=4)
+    parser.add_argument("--k", type=int, default=DEFAULT_K)
     parser.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT))
     parser.add_argument("--no-model", action="store_true")
     args = parser.parse_args()

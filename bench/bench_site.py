@@ -1,13 +1,13 @@
 """The site under load, and the worker's throughput.
 
-    .venv/bin/python bench/bench_site.py [--clients 50] [--seconds 20] [--jobs 12]
+    .venv/bin/python bench/bench_site.py [--clients 50] [--seconds 20] [--jobs 12] [--k 8]
 
 Starts its own Redis, gunicorn (2 workers x 4 threads, as `scripts/run`) and one Celery worker on a scratch
 SQLite database in a temporary directory, fills it with public procedures and jobs, then:
 1. 50 concurrent keep-alive clients on loopback request the gallery (`GET /api/v1/gallery/`) and a job's status
    (`GET /api/v1/jobs/<code>/`) for N seconds: requests/s, median and p95 latency per endpoint;
-2. submits J reconstruction jobs (generated facades, k = 4) to one CPU worker: jobs per minute from the first
-   claim to the last finish.
+2. submits J reconstruction jobs (generated facades, k candidates each: 8, the site's default) to one CPU
+   worker: jobs per minute from the first claim to the last finish.
 """
 
 from __future__ import annotations
@@ -25,6 +25,8 @@ import tempfile
 import threading
 import time
 from pathlib import Path
+
+from facaid.defaults import DEFAULT_K
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -116,6 +118,7 @@ def main() -> None:
     ap.add_argument("--clients", type=int, default=50)
     ap.add_argument("--seconds", type=float, default=20)
     ap.add_argument("--jobs", type=int, default=12)
+    ap.add_argument("--k", type=int, default=DEFAULT_K, help=f"candidates per job (default {DEFAULT_K}, the site's)")
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="facaid-bench-"))
     redis_port, web_port = free_port(), free_port()
@@ -165,7 +168,7 @@ photo = Photo.objects.get(title="bench")
 for i in range({args.jobs}):
     s = generate(sample_seed(1000, i))
     seg = Segmentation.objects.create(photo=photo, version=i + 2, data=s.segmentation.to_dict())
-    jobs.submit(owner=user, segmentation=seg, params={{"k": 4, "seed": 0}})
+    jobs.submit(owner=user, segmentation=seg, params={{"k": {args.k}, "seed": 0}})
 """
         manage(env, "shell", "-c", submit)
         status = """

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from facaid.defaults import DEFAULT_K
 from facaid.generator import STYLE_NAMES
 from facaid.paths import DEFAULT_CHECKPOINT, DEFAULT_CMP
 
@@ -271,7 +272,8 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--unconstrained-count", type=int, default=200,
                    help="facades decoded without the grammar mask (default 200)")
     e.add_argument("--best-of", type=int, default=0, metavar="K",
-                   help="also decode best of K (greedy + K-1 samples reranked by reproduction), as reconstruct does")
+                   help=f"also decode best of K (greedy + K-1 samples ranked by reproduction), as reconstruct does "
+                        f"(which decodes {DEFAULT_K})")
     e.add_argument("--report", default="out/evaluate", help="report directory (default out/evaluate)")
     e.add_argument("--json", help="write the figures to this JSON file")
     e.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
@@ -284,7 +286,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("input", help="segmentation JSON")
     c.add_argument("--out", required=True, help="procedure JSON to write")
     c.add_argument("--png", help="also render the reconstruction to this PNG")
-    c.add_argument("--k", type=int, default=4, help="candidates decoded and reranked (default 4)")
+    c.add_argument("--k", type=int, default=DEFAULT_K, help=f"candidates decoded and reranked (default {DEFAULT_K})")
     c.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
     c.add_argument("--no-sizing", action="store_true", help="skip the sizing optimizer")
     c.add_argument("--no-induce", action="store_true",
@@ -309,7 +311,7 @@ def build_parser() -> argparse.ArgumentParser:
                                     "baseline, with a gallery PNG (input | reconstruction).")
     r2.add_argument("--data", default=str(DEFAULT_CMP), help="annotations.jsonl (default: the shared CMP file)")
     r2.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory")
-    r2.add_argument("--k", type=int, default=4, help="candidates per facade (default 4)")
+    r2.add_argument("--k", type=int, default=DEFAULT_K, help=f"candidates per facade (default {DEFAULT_K})")
     r2.add_argument("--limit", type=int, help="only the first N facades")
     r2.add_argument("--no-induce", action="store_true", help="only the model's structures (the model alone)")
     r2.add_argument("--gallery", default="out/evaluate-real/gallery.png", help="gallery PNG of the first 20")

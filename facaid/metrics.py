@@ -1,4 +1,4 @@
-"""Comparing label maps: pixel accuracy, per-class IoU, and cheap low-resolution rasterization."""
+"""Comparing label maps: pixel accuracy, per-class IoU, element counts, and cheap low-resolution rasterization."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 
 from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.procedure import Procedure
-from facaid.labels import LABELS, PRIORITY
+from facaid.labels import BACKGROUND, FACADE, LABELS, PRIORITY
 from facaid.segmentation import Segmentation, rasterize
 
 
@@ -26,6 +26,36 @@ def class_iou(a: np.ndarray, b: np.ndarray) -> dict[str, float]:
         union = int((pa | pb).sum())
         if union:
             out[name] = float((pa & pb).sum() / union)
+    return out
+
+
+def _regions(boxes: np.ndarray) -> int:
+    """The number of connected regions of boxes (N, 4: x0, y0, x1, y1), where two boxes that share an edge or
+    overlap are connected (touching corners are not)."""
+    x0, y0, x1, y1 = boxes.T
+    ox = np.minimum(x1[:, None], x1) - np.maximum(x0[:, None], x0)  # overlap along x (0: edges touch)
+    oy = np.minimum(y1[:, None], y1) - np.maximum(y0[:, None], y0)
+    joined = ((ox >= 0) & (oy > 0)) | ((ox > 0) & (oy >= 0))
+    parent = np.arange(len(boxes))
+    for i, j in zip(*np.nonzero(np.triu(joined, 1)), strict=True):  # union-find
+        while parent[i] != i:
+            i = parent[i]
+        while parent[j] != j:
+            j = parent[j]
+        parent[i] = j
+    return int(sum(parent[i] == i for i in range(len(boxes))))
+
+
+def element_counts(seg: Segmentation) -> np.ndarray:
+    """How many elements of each class a segmentation shows: (len(LABELS),) int64, the connected regions of
+    each element class's rectangles (`_regions`); the background and the wall count 0. Any cover of the same
+    picture gives the same counts, so a flattened segmentation (pieces) counts like the rectangles the pieces
+    came from."""
+    out = np.zeros(len(LABELS), dtype=np.int64)
+    rows = seg.to_array()
+    for label in np.unique(rows[:, 0]):
+        if label not in (BACKGROUND, FACADE):
+            out[label] = _regions(rows[rows[:, 0] == label, 1:])
     return out
 
 

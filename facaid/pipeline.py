@@ -23,6 +23,7 @@ import numpy as np
 import torch
 
 from facaid.decoding import Candidate, decode, ranked_candidates
+from facaid.defaults import DEFAULT_K
 from facaid.grammar.procedure import Procedure
 from facaid.induce import induce_procedure
 from facaid.labels import FACADE
@@ -70,7 +71,7 @@ def default_model(path: str = str(DEFAULT_CHECKPOINT)) -> tuple[FacaidModel, Tok
 
 
 def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None = None,
-                tokenizer: Tokenizer | None = None, k: int = 4, sizing: bool = True, seed: int = 0,
+                tokenizer: Tokenizer | None = None, k: int = DEFAULT_K, sizing: bool = True, seed: int = 0,
                 prefix: list[int] | None = None, retry_below: float = 0.97, retry_k: int = 8,
                 induce: bool = True) -> Reconstruction:
     """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object)."""
@@ -82,7 +83,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     flat = flatten(seg)
     readable = fit_to_model(flat, tokenizer)
     t1 = time.perf_counter()
-    ranked = ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix)
+    ranked = ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix, reference=flat)
     t2 = time.perf_counter()
     decoded = ranked[0].procedure
     before = procedure_accuracy(decoded, flat)

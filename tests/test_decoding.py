@@ -4,9 +4,18 @@ import torch
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from facaid.decoding import GrammarLogitsProcessor, best_of_k, decode, prefix_from_procedure
+from facaid.decoding import (
+    Candidate,
+    GrammarLogitsProcessor,
+    best_of_k,
+    decode,
+    prefix_from_procedure,
+    rank_key,
+    ranked_candidates,
+    score,
+)
 from facaid.generator import generate
-from facaid.grammar import execute, validate
+from facaid.grammar import Procedure, execute, validate
 from facaid.model import FacaidConfig, FacaidModel
 from facaid.tokenizer import BOS, EOS, PAD, TokenGrammar, Tokenizer, TokenizerConfig
 
@@ -144,3 +153,42 @@ def test_incremental_and_module_decoding_agree(tiny_model):
     a = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1)
     b = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1, incremental=False)
     assert [c.ids for c in a] == [c.ids for c in b]
+
+
+def _candidate(accuracy: float, count_error: int, logprob: float) -> Candidate:
+    return Candidate([BOS, EOS], logprob, None, accuracy=accuracy, count_error=count_error)
+
+
+def test_rank_key_weighs_element_counts_against_accuracy_then_likelihood():
+    key = rank_key
+    assert key(_candidate(0.95, 0, -30.0)) > key(_candidate(0.97, 4, -10.0))  # a wrong count costs more
+    assert key(_candidate(0.951, 0, -10.0)) > key(_candidate(0.954, 0, -20.0))  # a near tie: the likelier
+    assert key(_candidate(0.96, 0, -30.0)) > key(_candidate(0.94, 0, -10.0))  # two points are not a tie
+    assert key(_candidate(0.96, 1, -10.0)) > key(_candidate(0.94, 0, -30.0))  # one element for two points
+
+
+def test_score_counts_the_elements_a_wrong_repeat_count_adds():
+    sample = next(s for s in map(generate, range(100))
+                  if any(n.rule == "repeat" and n.count != "fill" and n.count > 1 and _elements(n)
+                         for _, n in s.procedure.nodes()))
+    exact = Candidate([BOS, EOS], 0.0, sample.procedure)
+    assert score(exact, sample.segmentation) > 0.95 and exact.count_error == 0  # 1/4 scale: edges round
+    wrong = Procedure.from_dict(sample.procedure.to_dict())
+    path, node = next((p, n) for p, n in wrong.nodes()
+                      if n.rule == "repeat" and n.count != "fill" and n.count > 1 and _elements(n))
+    node.count -= 1
+    off = Candidate([BOS, EOS], 0.0, wrong)
+    score(off, sample.segmentation)
+    assert off.count_error > 0 and off.accuracy < exact.accuracy
+
+
+def _elements(node) -> bool:
+    return any(n.rule == "leaf" and n.label not in ("facade", "background") for _, n in node.walk())
+
+
+def test_ranked_candidates_are_sorted_by_rank_key(tiny_model):
+    seg = generate(4).segmentation
+    ranked = ranked_candidates(tiny_model, TOK, seg, k=5, seed=2)
+    assert len(ranked) == 5 and all(c.count_error is not None for c in ranked)
+    keys = [rank_key(c) for c in ranked]
+    assert keys == sorted(keys, reverse=True)

@@ -6,13 +6,14 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from facaid.defaults import DEFAULT_K
 from facaid.grammar import Procedure
 from facaid.segmentation import Segmentation
 
 Progress = Callable[[float, str], None]
 
 
-def reconstruct(segmentation: dict, checkpoint: str, *, k: int = 4, seed: int = 0,
+def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed: int = 0,
                 prefix: dict | None = None, prefix_nodes: int = 0, progress: Progress | None = None
                 ) -> dict[str, Any]:
     """Segmentation JSON -> {"procedure": JSON, "accuracy", "accuracy_decoded", "iou", "timings"}.

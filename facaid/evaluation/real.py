@@ -17,6 +17,7 @@ import numpy as np
 from PIL import Image
 from tqdm import tqdm
 
+from facaid.defaults import DEFAULT_K
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.metrics import pixel_accuracy
@@ -45,7 +46,7 @@ def all_wall(label_map: np.ndarray) -> np.ndarray:
     return np.where(label_map != BACKGROUND, FACADE, BACKGROUND).astype(np.uint8)
 
 
-def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *, k: int = 4,
+def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *, k: int = DEFAULT_K,
                   limit: int | None = None, gallery: str | Path | None = None, gallery_count: int = 20,
                   progress: bool = True, induce: bool = True) -> dict:
     records = load_records(path, limit)

@@ -19,6 +19,7 @@ from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
+from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import to_segmentation
 from facaid.rectify import rectify
 from facaid.variation import vary
@@ -180,7 +181,7 @@ def segmentation_detail(request, code):
 
 # --- jobs ---------------------------------------------------------------------------------------------------------
 
-def submit_job(user, segmentation: Segmentation, k=4, seed=0, prefix: Procedure | None = None,
+def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
                prefix_nodes: int = 0) -> Job:
     params = {"k": k, "seed": seed}
     if prefix is not None and prefix_nodes > 0:
@@ -375,10 +376,10 @@ def procedure_rerun(request, code):
         raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
     try:
         nodes = int(request.data.get("nodes", 1))
-        k = int(request.data.get("k", 4))
+        k = int(request.data.get("k", DEFAULT_K))
     except (TypeError, ValueError, AttributeError):
         raise ValidationError({"nodes": "nodes and k must be integers"}) from None
-    if not (1 <= nodes <= 8192 and 1 <= k <= 16):
-        raise ValidationError({"nodes": "nodes must be within 1..8192 and k within 1..16"})
+    if not (1 <= nodes <= 8192 and 1 <= k <= MAX_K):
+        raise ValidationError({"nodes": f"nodes must be within 1..8192 and k within 1..{MAX_K}"})
     job = submit_job(request.user, proc.segmentation, k=k, seed=0, prefix=proc, prefix_nodes=nodes)
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)

@@ -1,5 +1,6 @@
 from django import forms
 
+from facaid.defaults import DEFAULT_K, MAX_K
 from webapp.facades.models import Visibility
 
 
@@ -20,7 +21,7 @@ class SegmentationForm(forms.Form):
 
 
 class ReconstructForm(forms.Form):
-    k = forms.IntegerField(min_value=1, max_value=16, initial=4, help_text="candidates decoded and compared")
+    k = forms.IntegerField(min_value=1, max_value=MAX_K, initial=DEFAULT_K, help_text="candidates decoded and compared")
     seed = forms.IntegerField(min_value=0, max_value=2**31 - 1, initial=0)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from rest_framework import serializers
 
+from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import Procedure as ProcedureTree
 from facaid.grammar.procedure import ProcedureError
 from facaid.segmentation import Segmentation as SegmentationData
@@ -125,7 +126,7 @@ class JobSerializer(serializers.ModelSerializer):
 
 class JobCreateSerializer(serializers.Serializer):
     segmentation = serializers.UUIDField()
-    k = serializers.IntegerField(min_value=1, max_value=16, default=4)
+    k = serializers.IntegerField(min_value=1, max_value=MAX_K, default=DEFAULT_K)
     seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
     prefix_procedure = serializers.UUIDField(required=False, allow_null=True, default=None)
     prefix_nodes = serializers.IntegerField(min_value=0, max_value=8192, default=0)

@@ -10,6 +10,7 @@ from celery.signals import worker_ready
 from django.conf import settings
 from django.db import OperationalError, close_old_connections, transaction
 
+from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
 from webapp.facades import jobs
 from webapp.facades.models import Job, Procedure, Visibility
@@ -71,7 +72,7 @@ def _compute(job: Job) -> dict:
     def progress(fraction: float, stage: str) -> None:
         jobs.beat(job.id, fraction, stage)
 
-    return compute.reconstruct(job.segmentation.data, settings.FACAID_CHECKPOINT, k=int(params.get("k", 4)),
+    return compute.reconstruct(job.segmentation.data, settings.FACAID_CHECKPOINT, k=int(params.get("k", DEFAULT_K)),
                                seed=int(params.get("seed", 0)), prefix=prefix,
                                prefix_nodes=int(params.get("prefix_nodes", 0)), progress=progress)
 

@@ -9,6 +9,7 @@ from django.contrib.auth import get_user_model
 from django.core.files.images import ImageFile
 from django.core.management.base import BaseCommand
 
+from facaid.defaults import DEFAULT_K
 from facaid.generator import generate
 from facaid.render import render_segmentation
 from webapp.facades import jobs
@@ -38,5 +39,5 @@ class Command(BaseCommand):
         photo.save()
         seg = Segmentation.objects.create(photo=photo, version=1, data=sample.segmentation.to_dict(),
                                           rect_count=len(sample.segmentation.rects))
-        jobs.submit(owner=user, segmentation=seg, params={"k": 4, "seed": 0, "visibility": Visibility.PUBLIC})
+        jobs.submit(owner=user, segmentation=seg, params={"k": DEFAULT_K, "seed": 0, "visibility": Visibility.PUBLIC})
         self.stdout.write(f"demo account created: log in as {USERNAME} / {PASSWORD}; its facade is queued")

@@ -1,0 +1,38 @@
+import numpy as np
+import pytest
+
+from facaid.generator import generate
+from facaid.grammar.execute import to_segmentation
+from facaid.labels import LABEL_ID
+from facaid.metrics import element_counts
+from facaid.segmentation import Rect, Segmentation, flatten
+
+W, D = LABEL_ID["window"], LABEL_ID["door"]
+
+
+def counts(*rects: tuple[int, int, int, int, int]) -> np.ndarray:
+    wall = Rect(LABEL_ID["facade"], 0, 0, 100, 100)
+    return element_counts(Segmentation(100, 100, (wall, *map(Rect._make, rects))))
+
+
+def test_element_counts_joins_rectangles_that_share_an_edge_or_overlap():
+    assert counts()[W] == 0  # the wall is not an element
+    assert counts((W, 10, 10, 20, 20), (W, 30, 10, 40, 20))[W] == 2
+    assert counts((W, 10, 10, 20, 20), (W, 20, 10, 30, 20))[W] == 1  # side by side
+    assert counts((W, 10, 10, 20, 20), (W, 10, 20, 20, 30))[W] == 1  # one on the other
+    assert counts((W, 10, 10, 20, 20), (W, 15, 15, 25, 25))[W] == 1  # overlapping
+    assert counts((W, 10, 10, 20, 20), (W, 20, 20, 30, 30))[W] == 2  # corners only
+    chain = counts((W, 0, 0, 10, 10), (W, 10, 0, 20, 10), (W, 40, 0, 50, 10), (W, 20, 0, 30, 10))
+    assert chain[W] == 2  # union over a chain, whatever the order
+    mixed = counts((W, 10, 10, 20, 20), (D, 20, 10, 30, 20))
+    assert (mixed[W], mixed[D]) == (1, 1)  # classes count apart
+
+
+@pytest.mark.parametrize("seed", [3, 17, 40])
+def test_element_counts_are_the_same_for_any_cover_of_the_picture(seed):
+    sample = generate(seed)
+    pieces = sample.segmentation
+    expected = element_counts(to_segmentation(sample.procedure))
+    assert expected.sum() > 0
+    assert np.array_equal(element_counts(pieces), expected)
+    assert np.array_equal(element_counts(flatten(pieces, wall="footprint")), expected)
