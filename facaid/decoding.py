@@ -16,7 +16,7 @@ import numpy as np
 import torch
 
 from facaid.defaults import DEFAULT_K, TEMPERATURE
-from facaid.grammar.execute import to_segmentation
+from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.incremental import IncrementalDecoder
 from facaid.metrics import element_counts, pixel_accuracy, scaled_label_map, scaled_procedure_map
@@ -198,8 +198,10 @@ def score(candidate: Candidate, seg: Segmentation, target: np.ndarray | None = N
         target = scaled_label_map(seg, scale)
     if counts is None:
         counts = element_counts(seg)
-    candidate.accuracy = pixel_accuracy(scaled_procedure_map(candidate.procedure, scale), target)
-    candidate.count_error = int(np.abs(element_counts(to_segmentation(candidate.procedure)) - counts).sum())
+    leaves = execute(candidate.procedure)  # once, for both figures
+    candidate.accuracy = pixel_accuracy(scaled_procedure_map(candidate.procedure, scale, leaves), target)
+    shown = element_counts(to_segmentation(candidate.procedure, leaves))
+    candidate.count_error = int(np.abs(shown - counts).sum())
     return candidate.accuracy
 
 
@@ -218,7 +220,8 @@ def ranked_candidates(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentatio
     the model read) and ranked by `rank_key`, best first."""
     candidates = decode(model, tokenizer, seg, k=k, sample=k > 1, greedy=1, temperature=temperature, seed=seed,
                         prefix=prefix)  # one batch: a step costs about the same for 1 row as for K
-    reference = reference or seg
+    if reference is None:
+        reference = seg
     target, counts = scaled_label_map(reference, 0.25), element_counts(reference)
     for c in candidates:
         score(c, reference, target, counts=counts)

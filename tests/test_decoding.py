@@ -168,22 +168,22 @@ def test_rank_key_weighs_element_counts_against_accuracy_then_likelihood():
 
 
 def test_score_counts_the_elements_a_wrong_repeat_count_adds():
-    sample = next(s for s in map(generate, range(100))
-                  if any(n.rule == "repeat" and n.count != "fill" and n.count > 1 and _elements(n)
-                         for _, n in s.procedure.nodes()))
+    sample = next(s for s in map(generate, range(100)) if any(map(_fewer_possible, s.procedure.nodes())))
     exact = Candidate([BOS, EOS], 0.0, sample.procedure)
     assert score(exact, sample.segmentation) > 0.95 and exact.count_error == 0  # 1/4 scale: edges round
     wrong = Procedure.from_dict(sample.procedure.to_dict())
-    path, node = next((p, n) for p, n in wrong.nodes()
-                      if n.rule == "repeat" and n.count != "fill" and n.count > 1 and _elements(n))
+    _, node = next(filter(_fewer_possible, wrong.nodes()))
     node.count -= 1
     off = Candidate([BOS, EOS], 0.0, wrong)
     score(off, sample.segmentation)
     assert off.count_error > 0 and off.accuracy < exact.accuracy
 
 
-def _elements(node) -> bool:
-    return any(n.rule == "leaf" and n.label not in ("facade", "background") for _, n in node.walk())
+def _fewer_possible(item) -> bool:
+    """A repeat with a count above 1 whose pattern holds an element: one copy fewer shows fewer elements."""
+    _, node = item
+    return (node.rule == "repeat" and node.count != "fill" and node.count > 1
+            and any(n.rule == "leaf" and n.label not in ("facade", "background") for _, n in node.walk()))
 
 
 def test_ranked_candidates_are_sorted_by_rank_key(tiny_model):
