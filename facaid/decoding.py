@@ -118,8 +118,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     max_len = max_len or tokenizer.config.max_out
     rows = tokenizer.encode_segmentation(seg)
     rects, mask = batch_inputs([rows], device)
-    memory, memory_mask = model.encode(rects, mask)
-    memory, memory_mask = memory.expand(k, -1, -1).contiguous(), memory_mask.expand(k, -1).contiguous()
+    memory, memory_mask = model.encode(rects, mask)  # one row: the K candidates read the same input
     start = [BOS] + [t for t in (prefix or []) if t != BOS]
     processor = GrammarLogitsProcessor(tokenizer, [(seg.width, seg.height)] * k, max_len)
     seqs = [list(start) for _ in range(k)]
@@ -130,7 +129,11 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     local = torch.tensor([tokenizer.local_indices(s, tokenizer.vocab) for s in seqs], device=device)
     boxes = torch.as_tensor(tokenizer.node_boxes(start, seg.width, seg.height), device=device).expand(k, -1, -1)
     past = None
-    fast = IncrementalDecoder(model, memory, memory_mask, max_len) if incremental and not model.training else None
+    fast = None
+    if incremental and not model.training:
+        fast = IncrementalDecoder(model, memory, memory_mask, max_len, rows=k)
+    else:
+        memory, memory_mask = memory.expand(k, -1, -1).contiguous(), memory_mask.expand(k, -1).contiguous()
     errors: list[str | None] = [None] * k
     while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
         if fast is not None:  # the same logits without the Hugging Face modules' per-call overhead
@@ -146,9 +149,9 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
             scores = scores.masked_fill(~torch.from_numpy(processor.mask()).to(device), float("-inf"))
         logp = torch.log_softmax(scores, dim=-1)
         nxt = logp.argmax(-1).cpu()
-        if sample and greedy < k:
-            drawn = torch.multinomial(logp[greedy:].exp().cpu(), 1, generator=gen).squeeze(1)
-            nxt[greedy:] = drawn
+        if sample and greedy < k:  # Gumbel-max: argmax(log p + G) is a draw from p, cheaper than multinomial
+            u = torch.rand(k - greedy, logp.shape[1], generator=gen)
+            nxt[greedy:] = (logp[greedy:].cpu() - torch.log(-torch.log(u))).argmax(-1)
         prev_local = local[:, -1].tolist()
         new_local, new_boxes, none = [], [], []
         for b, t in enumerate(nxt.tolist()):
@@ -219,7 +222,7 @@ def ranked_candidates(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentatio
     """The greedy candidate and K-1 samples, executed, scored against ``reference`` (default: ``seg``, what
     the model read) and ranked by `rank_key`, best first."""
     candidates = decode(model, tokenizer, seg, k=k, sample=k > 1, greedy=1, temperature=temperature, seed=seed,
-                        prefix=prefix)  # one batch: a step costs about the same for 1 row as for K
+                        prefix=prefix)  # one batch, sharing the cross-attention
     if reference is None:
         reference = seg
     target, counts = scaled_label_map(reference, 0.25), element_counts(reference)

@@ -128,8 +128,9 @@ def test_decode_greedy_sampling_and_prefix(tiny_model):
     assert 0.0 <= best.accuracy <= 1.0
 
 
-@pytest.mark.parametrize("k, padded", [(1, False), (3, False), (2, True)])
-def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k, padded):
+@pytest.mark.parametrize("k, padded, shared", [(1, False, False), (3, False, False), (2, True, False),
+                                               (3, False, True)])
+def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k, padded, shared):
     from facaid.incremental import IncrementalDecoder
     from facaid.model import batch_inputs, batch_outputs
 
@@ -142,10 +143,17 @@ def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k,
         memory, memory_mask = tiny_model.encode(rects, mask)
         assert bool(memory_mask.all()) != padded
         full, _ = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
-        fast = IncrementalDecoder(tiny_model, memory, memory_mask, max_len=64)
+        if shared:  # K rows on one memory row: the K queries of a head attend in one product
+            fast = IncrementalDecoder(tiny_model, memory[:1], memory_mask[:1], max_len=64, rows=k)
+            assert fast.shared
+        else:
+            fast = IncrementalDecoder(tiny_model, memory, memory_mask, max_len=64)
         x = tiny_model.embed_outputs(ids, local, boxes)
         steps = torch.stack([fast.step(x[:, i]) for i in range(x.shape[1])], 1)
     assert torch.allclose(steps, full, atol=1e-5)
+    with pytest.raises(ValueError, match="memory has 2 rows"):
+        IncrementalDecoder(tiny_model, torch.zeros(2, 5, memory.shape[-1]), torch.ones(2, 5, dtype=torch.bool),
+                           max_len=8, rows=3)
 
 
 def test_incremental_and_module_decoding_agree(tiny_model):
