@@ -161,7 +161,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
             else:
                 logprob[b] += float(logp[b, t])
                 try:
-                    g.step(t)
+                    g.step(t, check=not constrained)  # a masked choice is allowed already
                 except TokenError as exc:
                     errors[b] = str(exc)
             seqs[b].append(t)

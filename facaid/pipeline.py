@@ -9,6 +9,10 @@ every candidate gets the geometric fit alone; the best of those is sized fully a
 Before that (unless a prefix is given or ``induce`` is off) the structure induced straight from the segmentation
 (`facaid.induce`: guillotine cuts folded into repeats) is sized too and kept if it does better, and then
 the sampling is skipped. ``result.source`` says which kind of structure won.
+
+A shortcut for annotations unlike the model's training data: when the decoded structure reproduces less than
+`FAR_OFF` of the pixels before sizing and the induced one at least `FAR_BEHIND` more, only the induced one is
+sized (``result.shortcut``): sizing the decoded structure could not close that gap, and it is the slowest stage.
 """
 
 from __future__ import annotations
@@ -34,6 +38,13 @@ from facaid.segmentation import Segmentation, flatten, flatten_array
 from facaid.sizing import fit_sizes
 from facaid.tokenizer import Tokenizer
 
+# When the best decoded structure reproduces less than FAR_OFF of the pixels before sizing, the induced structure
+# is read at once; if it reproduces at least FAR_BEHIND more, only it is sized. On 120 generated inputs (dataset
+# seed 3000, clean and with 20 % of the pixels jittered) sizing raised decoded structures that started below 0.9
+# by 0.11 at the median and 0.29 at most, so a gap of 0.35 is one sizing does not close.
+FAR_OFF = 0.9
+FAR_BEHIND = 0.35
+
 
 @dataclass
 class Reconstruction:
@@ -44,10 +55,12 @@ class Reconstruction:
     timings: dict[str, float] = field(default_factory=dict)  # seconds per stage
     retried: bool = False  # the second chance ran (the first sized candidate was below retry_below)
     source: str = "model"  # "model" (a decoded candidate) or "induced" (facaid.induce)
+    shortcut: bool = False  # the decoded structure was far behind the induced one and was not sized
+
 
     def to_dict(self) -> dict[str, Any]:
         return {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
-                "timings": self.timings, "retried": self.retried, "source": self.source}
+                "timings": self.timings, "retried": self.retried, "source": self.source, "shortcut": self.shortcut}
 
 
 def fit_to_model(seg: Segmentation, tokenizer: Tokenizer) -> Segmentation:
@@ -87,12 +100,20 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     t2 = time.perf_counter()
     decoded = ranked[0].procedure
     before = procedure_accuracy(decoded, flat)
-    retried = False
+    retried = shortcut = False
     source = "model"
     if sizing:
-        fitted = fit_sizes(decoded, flat)
-        if fitted.accuracy < retry_below and induce and prefix is None:
-            structure = induce_procedure(flat)
+        structure, read = None, False  # the induced structure, read at most once
+        if induce and prefix is None and before < FAR_OFF:
+            structure, read = induce_procedure(flat), True
+        if structure is not None and procedure_accuracy(structure, flat) >= before + FAR_BEHIND:
+            fitted, source, shortcut = fit_sizes(structure, flat), "induced", True  # the model's is not sized
+            before = fitted.accuracy_before
+        else:
+            fitted = fit_sizes(decoded, flat)
+        if fitted.accuracy < retry_below and induce and prefix is None and not shortcut:
+            if not read:
+                structure = induce_procedure(flat)
             if structure is not None:
                 other = fit_sizes(structure, flat)
                 if other.accuracy > fitted.accuracy:
@@ -111,7 +132,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     t3 = time.perf_counter()
     timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, total=t3 - t0)
     proc.meta = {"source": "facaid.reconstruct", "structure": source, "k": k, "accuracy": round(accuracy, 6)}
-    return Reconstruction(proc, before, accuracy, iou, timings, retried, source)
+    return Reconstruction(proc, before, accuracy, iou, timings, retried, source, shortcut)
 
 
 def _second_chance(candidates: list[Candidate], first: Candidate, flat: Segmentation):

@@ -93,6 +93,7 @@ def test_reconstruct_keeps_the_induced_structure_when_the_model_fits_badly(tiny)
     result = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2)
     assert result.source == "induced" and result.to_dict()["source"] == "induced"
     assert result.accuracy > 0.95 and not result.retried  # the induced structure won: no sampling
+    assert result.shortcut and result.to_dict()["shortcut"]  # far ahead before sizing: the model's not sized
     assert result.accuracy == procedure_accuracy(result.procedure, flatten(seg))
     assert result.procedure.meta["structure"] == "induced"
     model_only = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False)

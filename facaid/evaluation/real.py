@@ -77,7 +77,7 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
             base_union[c] += (t | b).sum()
         nodes.append(sum(1 for _ in result.procedure.nodes()))
         per_facade.append({"id": rid, "accuracy": acc[-1], "baseline": base[-1], "seconds": times[-1],
-                           "source": result.source, "nodes": nodes[-1]})
+                           "source": result.source, "shortcut": result.shortcut, "nodes": nodes[-1]})
         if gallery is not None and i < gallery_count:
             pictures.append(side_by_side([colorize(target), colorize(pred)], height=200, gap=4))
     iou = {LABELS[c]: float(inter[c] / union[c]) for c in range(len(LABELS)) if union[c]}
@@ -90,6 +90,7 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
         "k": k,
         "induce": induce,
         "induced_share": float(np.mean([f["source"] == "induced" for f in per_facade])) if per_facade else 0.0,
+        "shortcut_share": float(np.mean([f["shortcut"] for f in per_facade])) if per_facade else 0.0,
         "nodes_median": float(np.median(nodes)) if nodes else 0.0,
         "pixel_accuracy": {"mean": float(np.mean(acc)), "median": float(np.median(acc)),
                            "decoded_mean": float(np.mean(acc_decoded))},
@@ -124,6 +125,7 @@ def format_summary(result: dict) -> str:
         f"seconds per facade: median {result['seconds_per_facade']['median']:.2f}",
         f"structure: induced for {100 * result['induced_share']:.1f} % of the facades"
         + ("" if result["induce"] else " (induction off: the model alone)")
+        + f", alone (the decoded one far behind, not sized) for {100 * result.get('shortcut_share', 0.0):.1f} %"
         + f"; median {result['nodes_median']:.0f} nodes per procedure",
         f"{'class':<11} {'IoU':>7} {'baseline':>9}",
     ]

@@ -85,7 +85,8 @@ def _store(job: Job, result: dict) -> None:
         proc = Procedure.objects.create(
             owner=job.owner, title=photo.title or "", data=result["procedure"], photo=photo,
             segmentation=job.segmentation, accuracy=result["accuracy"],
-            metrics={k: result[k] for k in ("accuracy_decoded", "iou", "timings", "source", "retried") if k in result},
+            metrics={k: result[k] for k in ("accuracy_decoded", "iou", "timings", "source", "retried", "shortcut")
+                     if k in result},
             parent=Procedure.objects.filter(id=(job.params or {}).get("parent_id", -1)).first(),  # may be gone
             visibility=(job.params or {}).get("visibility", Visibility.PRIVATE))
         Job.objects.filter(id=job.id).update(status=Job.Status.DONE, progress=1.0, stage="done", result=proc,
