@@ -1,6 +1,6 @@
 """Reconstruction: sizing accuracy and time, and the whole pipeline with the shipped model.
 
-    .venv/bin/python bench/bench_reconstruct.py [--count 100] [--k 8] [--checkpoint DIR] [--no-model]
+    .venv/bin/python bench/bench_reconstruct.py [--count 100] [--k K] [--checkpoint DIR] [--no-model]
 
 Held-out generated facades (dataset seed 1000). Sizing alone starts from the true structure with sizes
 quantized by the tokenizer (what a perfect decoder would give); the pipeline runs `facaid.reconstruct` (the

@@ -1,13 +1,13 @@
 """The site under load, and the worker's throughput.
 
-    .venv/bin/python bench/bench_site.py [--clients 50] [--seconds 20] [--jobs 12] [--k 8]
+    .venv/bin/python bench/bench_site.py [--clients 50] [--seconds 20] [--jobs 12] [--k K]
 
 Starts its own Redis, gunicorn (2 workers x 4 threads, as `scripts/run`) and one Celery worker on a scratch
 SQLite database in a temporary directory, fills it with public procedures and jobs, then:
 1. 50 concurrent keep-alive clients on loopback request the gallery (`GET /api/v1/gallery/`) and a job's status
    (`GET /api/v1/jobs/<code>/`) for N seconds: requests/s, median and p95 latency per endpoint;
-2. submits J reconstruction jobs (generated facades, k candidates each: 8, the site's default) to one CPU
-   worker: jobs per minute from the first claim to the last finish.
+2. submits J reconstruction jobs (generated facades, K candidates each, by default the site's
+   `facaid.defaults.DEFAULT_K`) to one CPU worker: jobs per minute from the first claim to the last finish.
 """
 
 from __future__ import annotations

@@ -13,10 +13,43 @@ instead of K vector products over K copies of the memory.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import torch
 import torch.nn.functional as F
 
 from facaid.model import FacaidModel
+
+
+class _Block(NamedTuple):
+    """One GPT-2 block's weights as plain tensors (a module attribute lookup per step costs more than the small
+    matrices); Conv1D weights are (in, out), for ``torch.addmm(bias, x, weight)``."""
+
+    ln_1: tuple[torch.Tensor, torch.Tensor]
+    attn_w: torch.Tensor
+    attn_b: torch.Tensor
+    attn_proj_w: torch.Tensor
+    attn_proj_b: torch.Tensor
+    ln_cross: tuple[torch.Tensor, torch.Tensor]
+    cross_q_w: torch.Tensor
+    cross_q_b: torch.Tensor
+    cross_proj_w: torch.Tensor
+    cross_proj_b: torch.Tensor
+    ln_2: tuple[torch.Tensor, torch.Tensor]
+    fc_w: torch.Tensor
+    fc_b: torch.Tensor
+    mlp_proj_w: torch.Tensor
+    mlp_proj_b: torch.Tensor
+
+    @classmethod
+    def of(cls, block) -> _Block:
+        a, c, m = block.attn, block.crossattention, block.mlp
+        return cls(ln_1=(block.ln_1.weight, block.ln_1.bias), attn_w=a.c_attn.weight, attn_b=a.c_attn.bias,
+                   attn_proj_w=a.c_proj.weight, attn_proj_b=a.c_proj.bias,
+                   ln_cross=(block.ln_cross_attn.weight, block.ln_cross_attn.bias), cross_q_w=c.q_attn.weight,
+                   cross_q_b=c.q_attn.bias, cross_proj_w=c.c_proj.weight, cross_proj_b=c.c_proj.bias,
+                   ln_2=(block.ln_2.weight, block.ln_2.bias), fc_w=m.c_fc.weight, fc_b=m.c_fc.bias,
+                   mlp_proj_w=m.c_proj.weight, mlp_proj_b=m.c_proj.bias)
 
 
 class IncrementalDecoder:
@@ -38,7 +71,6 @@ class IncrementalDecoder:
         self.t = 0
         self.max_len = min(max_len, cfg.n_positions)
         self.mask = None if bool(memory_mask.all()) else memory_mask[:, None, None, :]
-        # the weights as plain tensors: a module attribute lookup per step costs more than the small matrices
         self.wpe = dec.wpe.weight
         self.ln_f = (dec.ln_f.weight, dec.ln_f.bias)
         self.head = (model.lm_head.weight, model.lm_head.bias)
@@ -46,12 +78,8 @@ class IncrementalDecoder:
         b = memory.shape[0]
         with torch.no_grad():
             for block in dec.h:
-                a, c, m = block.attn, block.crossattention, block.mlp
-                self.blocks.append((
-                    (block.ln_1.weight, block.ln_1.bias), a.c_attn.weight, a.c_attn.bias, a.c_proj.weight,
-                    a.c_proj.bias, (block.ln_cross_attn.weight, block.ln_cross_attn.bias), c.q_attn.weight,
-                    c.q_attn.bias, c.c_proj.weight, c.c_proj.bias, (block.ln_2.weight, block.ln_2.bias),
-                    m.c_fc.weight, m.c_fc.bias, m.c_proj.weight, m.c_proj.bias))
+                self.blocks.append(_Block.of(block))
+                c = block.crossattention
                 ck, cv = torch.addmm(c.c_attn.bias, memory.reshape(-1, self.d), c.c_attn.weight).split(self.d, -1)
                 self.cross.append((self._heads(ck.reshape(b, -1, self.d)), self._heads(cv.reshape(b, -1, self.d))))
                 shape = (self.k, self.heads, self.max_len, self.dh)
@@ -81,16 +109,15 @@ class IncrementalDecoder:
         t = self.t
         k, heads, dh = self.k, self.heads, self.dh
         x = x + self.wpe[t]
-        for (ln1, aw, ab, pw, pb, lnc, qw, qb, cw, cb, ln2, fw, fb, mw, mb), (ck, cv), (kc, vc) in zip(
-                self.blocks, self.cross, self.cache, strict=True):
-            q, key, value = torch.addmm(ab, self._ln(x, ln1), aw).split(self.d, -1)
+        for w, (ck, cv), (kc, vc) in zip(self.blocks, self.cross, self.cache, strict=True):
+            q, key, value = torch.addmm(w.attn_b, self._ln(x, w.ln_1), w.attn_w).split(self.d, -1)
             kc[:, :, t] = key.view(k, heads, dh)
             vc[:, :, t] = value.view(k, heads, dh)
             o = F.scaled_dot_product_attention(q.view(k, heads, 1, dh), kc[:, :, : t + 1], vc[:, :, : t + 1])
-            x = x + torch.addmm(pb, o.reshape(k, self.d), pw)
-            q = torch.addmm(qb, self._ln(x, lnc), qw)
-            x = x + torch.addmm(cb, self._cross(q, ck, cv), cw)
-            hidden = F.gelu(torch.addmm(fb, self._ln(x, ln2), fw), approximate="tanh")
-            x = x + torch.addmm(mb, hidden, mw)
+            x = x + torch.addmm(w.attn_proj_b, o.reshape(k, self.d), w.attn_proj_w)
+            q = torch.addmm(w.cross_q_b, self._ln(x, w.ln_cross), w.cross_q_w)
+            x = x + torch.addmm(w.cross_proj_b, self._cross(q, ck, cv), w.cross_proj_w)
+            hidden = F.gelu(torch.addmm(w.fc_b, self._ln(x, w.ln_2), w.fc_w), approximate="tanh")
+            x = x + torch.addmm(w.mlp_proj_b, hidden, w.mlp_proj_w)
         self.t += 1
         return F.linear(self._ln(x, self.ln_f), *self.head)

@@ -57,7 +57,6 @@ class Reconstruction:
     source: str = "model"  # "model" (a decoded candidate) or "induced" (facaid.induce)
     shortcut: bool = False  # the decoded structure was far behind the induced one and was not sized
 
-
     def to_dict(self) -> dict[str, Any]:
         return {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
                 "timings": self.timings, "retried": self.retried, "source": self.source, "shortcut": self.shortcut}
