@@ -10,6 +10,8 @@ checkpoint also holds the tokenizer and the grammar version.
 
 from __future__ import annotations
 
+import copy
+from dataclasses import replace
 from pathlib import Path
 
 import torch
@@ -59,7 +61,11 @@ class FacaidModel(PreTrainedModel):
         tc = config.tokenizer_config
         d = config.d_model
         self.rect_tokens = tc.rect_tokens
-        self.fields = nn.ModuleList(nn.Embedding(n, d) for n in tok.input_vocab_sizes)
+        sizes = tok.input_vocab_sizes
+        self.fields = nn.ModuleList(nn.Embedding(n, d) for n in sizes[:5])  # label, x, y, w, h (and node boxes)
+        # the peer counts of `facaid.tokenizer.peer_counts`, zero at first: a model widened with them
+        # (`widen_for_counts`) starts out computing what it computed without them
+        self.count_fields = nn.ModuleList(nn.Embedding(n, d) for n in sizes[5:])
         self.field_index = nn.Embedding(5, d)
         max_input = (tc.max_rects + 1) * tc.rect_tokens
         if config.encoder == "bidirectional":
@@ -84,6 +90,8 @@ class FacaidModel(PreTrainedModel):
         ))
         self.lm_head = nn.Linear(d, len(tok.vocab), bias=False)
         self.post_init()
+        for emb in self.count_fields:
+            nn.init.zeros_(emb.weight)
 
     def _init_weights(self, module: nn.Module) -> None:
         if isinstance(module, nn.Linear):
@@ -97,9 +105,13 @@ class FacaidModel(PreTrainedModel):
             nn.init.zeros_(module.bias)
 
     def encode(self, rects: torch.Tensor, rect_mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
-        """rects (B, N, 5) int, rect_mask (B, N) bool -> memory (B, M, d) and its mask (B, M)."""
+        """rects (B, N, F) int, rect_mask (B, N) bool -> memory (B, M, d) and its mask (B, M)."""
+        if rects.shape[-1] != 5 + len(self.count_fields):
+            raise ValueError(f"this model reads {5 + len(self.count_fields)} fields per rectangle, got "
+                             f"{rects.shape[-1]}: encode the input with the checkpoint's tokenizer")
         embs = [emb(rects[..., f]) for f, emb in enumerate(self.fields)]  # 5 x (B, N, d)
         if self.rect_tokens == 1:
+            embs += [emb(rects[..., 5 + f]) for f, emb in enumerate(self.count_fields)]
             x = torch.stack(embs, 0).sum(0)  # (B, N, d)
             mask = rect_mask
         else:
@@ -159,6 +171,22 @@ def load_model(path: str | Path, device: str | torch.device = "cpu") -> tuple[Fa
     return model, tokenizer
 
 
+def widen_for_counts(model: FacaidModel, tokenizer: Tokenizer) -> tuple[FacaidModel, Tokenizer]:
+    """The same model reading the peer counts too (``count_features``), their embeddings zero: it gives the
+    same logits as ``model`` until training moves them. The start of a fine-tune that adds the counts."""
+    if tokenizer.config.count_features:
+        raise ValueError("this model reads the peer counts already")
+    tok = Tokenizer(replace(tokenizer.config, count_features=True))
+    config = copy.deepcopy(model.config)
+    config.tokenizer = tok.config.to_dict()
+    wide = FacaidModel(config).to(next(model.parameters()).device)
+    missing, unexpected = wide.load_state_dict(model.state_dict(), strict=False)
+    if unexpected or any(not k.startswith("count_fields.") for k in missing):
+        raise ValueError(f"cannot widen: unexpected {unexpected}, missing {missing}")
+    wide.train(model.training)
+    return wide, tok
+
+
 def save_model(model: FacaidModel, tokenizer: Tokenizer, path: str | Path) -> None:
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)
@@ -167,9 +195,9 @@ def save_model(model: FacaidModel, tokenizer: Tokenizer, path: str | Path) -> No
 
 
 def batch_inputs(rows: list, device: str | torch.device = "cpu") -> tuple[torch.Tensor, torch.Tensor]:
-    """Pad encoded segmentations (each (N_i, 5)) into rects (B, N, 5) and rect_mask (B, N)."""
+    """Pad encoded segmentations (each (N_i, F)) into rects (B, N, F) and rect_mask (B, N)."""
     n = max(len(r) for r in rows)
-    rects = torch.zeros(len(rows), n, 5, dtype=torch.long)
+    rects = torch.zeros(len(rows), n, len(rows[0][0]), dtype=torch.long)
     mask = torch.zeros(len(rows), n, dtype=torch.bool)
     for i, r in enumerate(rows):
         rects[i, : len(r)] = torch.as_tensor(r)

@@ -105,16 +105,17 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
         structure, read = None, False  # the induced structure, read at most once
         if induce and prefix is None and before < FAR_OFF:
             structure, read = induce_procedure(flat), True
-        if structure is not None and procedure_accuracy(structure, flat) >= before + FAR_BEHIND:
-            fitted, source, shortcut = fit_sizes(structure, flat), "induced", True  # the model's is not sized
-            before = fitted.accuracy_before
+        induced_before = procedure_accuracy(structure, flat) if structure is not None else None
+        if induced_before is not None and induced_before >= before + FAR_BEHIND:
+            fitted = fit_sizes(structure, flat, before=induced_before)  # the model's structure is not sized
+            source, shortcut, before = "induced", True, induced_before
         else:
-            fitted = fit_sizes(decoded, flat)
+            fitted = fit_sizes(decoded, flat, before=before)
         if fitted.accuracy < retry_below and induce and prefix is None and not shortcut:
             if not read:
                 structure = induce_procedure(flat)
             if structure is not None:
-                other = fit_sizes(structure, flat)
+                other = fit_sizes(structure, flat, before=induced_before)
                 if other.accuracy > fitted.accuracy:
                     fitted, before, source = other, other.accuracy_before, "induced"
         if fitted.accuracy < retry_below and retry_k and source == "model":

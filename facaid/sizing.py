@@ -103,16 +103,18 @@ def box_integrals(tables: torch.Tensor, index: torch.Tensor, boxes: torch.Tensor
 def fit_sizes(proc: Procedure, target: Segmentation, *, geometry_rounds: int = 2, geometry_steps: int = 20,
               geometry_lr: float = 1.0, polish_steps: int = 160, resolution: int = 1024, lr: float = 0.01,
               patience: int = 15, taus: tuple[float, ...] = (1.0, 0.0),
-              device: str | torch.device = "cpu") -> SizingResult:
+              device: str | torch.device = "cpu", before: float | None = None) -> SizingResult:
     """Fit the sizes of ``proc`` to ``target`` (same image size); returns the fitted procedure and figures.
 
     Two stages, each kept only if it raises the exact full-resolution pixel accuracy: the direct geometric
     fit, then ``polish_steps`` of Adam on the soft-rasterized pixel MSE at ``resolution`` (the raster's longer
-    side). The result is never worse than the input.
+    side). The result is never worse than the input. ``before``: ``procedure_accuracy(proc, target)`` when the
+    caller has it already (it is computed otherwise).
     """
     if (round(proc.width), round(proc.height)) != (target.width, target.height):
         raise ValueError(f"procedure is {proc.width}x{proc.height} but the target is {target.width}x{target.height}")
-    before = procedure_accuracy(proc, target)
+    if before is None:
+        before = procedure_accuracy(proc, target)
     modes = _modes(proc)
     if not modes:
         return SizingResult(proc, 0, 0.0, before, before, procedure_iou(proc, target))

@@ -3,7 +3,9 @@
 Input: each rectangle of the flattened segmentation (footprint layer plus elements) becomes five fields
 (label, x, y, w, h), quantized at ``coord_bins`` steps of the image size, with a bottom-left origin and sorted
 by y then x; a first row carries the image's aspect ratio. The model embeds a row either as five tokens or as
-one token whose five field embeddings are summed (``TokenizerConfig.rect_tokens``).
+one token whose five field embeddings are summed (``TokenizerConfig.rect_tokens``). With
+``TokenizerConfig.count_features`` a row has four more fields, its peer counts (`peer_counts`): how many
+rectangles of its label share its row and its column, and its rank among them, which repeat counts follow.
 
 Output: the derivation tree in breadth-first order, each node a group of tokens:
 
@@ -60,6 +62,15 @@ class TokenizerConfig:
     max_rects: int = 512
     max_out: int = 1024
     rect_tokens: int = 1  # 1: one token per rectangle (summed field embeddings); 5: one per field
+    count_features: bool = False  # four more input fields per rectangle: `peer_counts`
+
+    def __post_init__(self) -> None:
+        if self.count_features and self.rect_tokens != 1:
+            raise ValueError("count_features need rect_tokens = 1 (the fields of a rectangle summed in one token)")
+
+    @property
+    def input_fields(self) -> int:
+        return 9 if self.count_features else 5
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -112,6 +123,33 @@ class Vocabulary:
 
 
 # --- quantization -------------------------------------------------------------------------------------------------
+
+MAX_PEERS = 64  # peer counts and ranks are clipped here
+
+
+def peer_counts(arr: np.ndarray) -> np.ndarray:
+    """(N, 4) int64 for int rows (label, x0, y0, x1, y1), y down: the number of rectangles of the same label
+    in the row's row (vertical overlap >= half the lower height, itself included) and its rank in it from the
+    left, then the same for its column (horizontal overlap, rank from the bottom). A window in a grid of 5 floors
+    by 6 bays gets (6, bay, 5, floor): the counts a repeat needs, which the model would otherwise have to count
+    by attention. Overlap rather than equal edges, so that a jittered segmentation keeps its counts."""
+    if len(arr) == 0:
+        return np.zeros((0, 4), dtype=np.int64)
+    a = np.asarray(arr, dtype=np.float64)
+    same = a[:, 0][:, None] == a[:, 0][None, :]
+    out = []
+    for lo, hi, rank_lo, rank_hi, sign in ((2, 4, 1, 3, 1.0), (1, 3, 2, 4, -1.0)):
+        # peers overlap on the (lo, hi) axis; rank on the other axis (x from the left, y from the bottom)
+        overlap = np.minimum(a[:, hi][:, None], a[:, hi][None, :]) - np.maximum(a[:, lo][:, None], a[:, lo][None, :])
+        extent = a[:, hi] - a[:, lo]
+        peers = same & (overlap >= 0.5 * np.minimum(extent[:, None], extent[None, :])) & (overlap > 0)
+        centre = sign * (a[:, rank_lo] + a[:, rank_hi])
+        order = np.arange(len(a))
+        before = peers & ((centre[None, :] < centre[:, None])
+                          | ((centre[None, :] == centre[:, None]) & (order[None, :] < order[:, None])))
+        out += [np.minimum(peers.sum(1), MAX_PEERS), np.minimum(before.sum(1), MAX_PEERS - 1)]
+    return np.stack(out, axis=1).astype(np.int64)
+
 
 def quantize_size(value: float, side: float, bins: int) -> int:
     """abs/flt sizes: the fraction of the image side, sqrt-spaced so small parts keep precision."""
@@ -331,14 +369,17 @@ class Tokenizer:
 
     # input
     @property
-    def input_vocab_sizes(self) -> tuple[int, int, int, int, int]:
-        """Sizes of the five field embeddings (label incl. the <image> row, x, y, w, h)."""
+    def input_vocab_sizes(self) -> tuple[int, ...]:
+        """Sizes of the field embeddings: label (incl. the <image> row), x, y, w, h, and with
+        ``count_features`` the four `peer_counts`."""
         c = self.config
-        return (len(LABELS) + 1, max(c.coord_bins, c.aspect_bins), c.coord_bins, c.coord_bins + 1,
-                c.coord_bins + 1)
+        sizes = (len(LABELS) + 1, max(c.coord_bins, c.aspect_bins), c.coord_bins, c.coord_bins + 1,
+                 c.coord_bins + 1)
+        return sizes + (MAX_PEERS + 1, MAX_PEERS) * 2 if c.count_features else sizes
 
     def encode_segmentation(self, seg: Segmentation) -> np.ndarray:
-        """(N + 1, 5) int64 rows (label, x, y, w, h); row 0 is the <image> row with the aspect ratio."""
+        """(N + 1, F) int64 rows (label, x, y, w, h[, peer counts]); row 0 is the <image> row with the aspect
+        ratio (and zero counts)."""
         c = self.config
         arr = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
         if len(arr) > c.max_rects:
@@ -349,10 +390,13 @@ class Tokenizer:
     def encode_rect_array(self, width: int, height: int, arr: np.ndarray) -> np.ndarray:
         c = self.config
         rows = np.concatenate([arr[:, :1].astype(np.int64), self.quantize_boxes(arr[:, 1:], width, height)], 1)
+        if c.count_features:
+            rows = np.concatenate([rows, peer_counts(arr)], 1)
         rows = rows[np.lexsort((rows[:, 1], rows[:, 2]))]
         aspect = math.log(width / height)  # in [-log 16, log 16] for sane images
         qa = min(c.aspect_bins - 1, max(0, round((aspect / math.log(16) + 1) / 2 * (c.aspect_bins - 1))))
-        meta = np.array([[len(LABELS), qa, 0, 0, 0]], dtype=np.int64)
+        meta = np.zeros((1, c.input_fields), dtype=np.int64)
+        meta[0, :2] = len(LABELS), qa
         return np.concatenate([meta, rows])
 
     def quantize_boxes(self, boxes: np.ndarray, width: float, height: float) -> np.ndarray:

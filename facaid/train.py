@@ -25,7 +25,15 @@ from tqdm import tqdm
 from facaid.evaluation.noise import jitter
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
-from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model, save_model
+from facaid.model import (
+    FacaidConfig,
+    FacaidModel,
+    batch_inputs,
+    batch_outputs,
+    load_model,
+    save_model,
+    widen_for_counts,
+)
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
 
@@ -51,6 +59,8 @@ class TrainConfig:
     noise: float = 0.0  # share of examples whose input edges are jittered (the target stays the clean procedure)
     noise_sigma: float = 0.006  # the jitter's standard deviation is uniform in [0, this] x the long side
     init: str = ""  # a checkpoint directory whose weights start the run (fine-tuning); fresh optimizer and schedule
+    count_lr_scale: float = 1.0  # the peer counts' embeddings learn at this multiple of the learning rate (a
+    # model widened for them starts them at zero while the rest is trained already)
 
 
 def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
@@ -235,8 +245,11 @@ _ARCHITECTURE = ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", 
 
 def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig, device) -> FacaidModel:
     """The weights of checkpoint ``path`` for a fine-tuning run; its architecture and tokenizer must be the
-    config's."""
+    config's, except that a config with ``count_features`` may start from a checkpoint without them
+    (`widen_for_counts`: their embeddings start at zero)."""
     model, tokenizer = load_model(path, device)
+    if tok_cfg.count_features and not tokenizer.config.count_features:
+        model, tokenizer = widen_for_counts(model, tokenizer)
     if tokenizer.config != tok_cfg:
         raise ValueError(f"train.init {path} was trained with another tokenizer config")
     differ = [k for k in _ARCHITECTURE if getattr(model.config, k) != getattr(model_cfg, k)]
@@ -279,10 +292,13 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         model = FacaidModel(model_cfg).to(device)
         saved = None
     model.train()
-    decay = [p for n, p in model.named_parameters() if p.dim() >= 2]
-    no_decay = [p for n, p in model.named_parameters() if p.dim() < 2]
-    opt = torch.optim.AdamW([{"params": decay, "weight_decay": cfg.weight_decay},
-                             {"params": no_decay, "weight_decay": 0.0}], lr=cfg.lr, betas=(0.9, 0.98))
+    counts = [p for n, p in model.named_parameters() if n.startswith("count_fields.")]
+    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith("count_fields.")]
+    groups = [{"params": [p for n, p in rest if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": 1.0},
+              {"params": [p for n, p in rest if p.dim() < 2], "weight_decay": 0.0, "scale": 1.0}]
+    if counts:
+        groups.append({"params": counts, "weight_decay": 0.0, "scale": cfg.count_lr_scale})
+    opt = torch.optim.AdamW(groups, lr=cfg.lr, betas=(0.9, 0.98))
     if saved is not None:
         opt.load_state_dict(saved["optimizer"])
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -323,7 +339,7 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
             rects, mask = batch_inputs([ex[0] for ex in batch], device)
             ids, local, targets, boxes = batch_outputs([ex[1] for ex in batch], device)
             for group in opt.param_groups:
-                group["lr"] = lr_at(step, cfg)
+                group["lr"] = lr_at(step, cfg) * group["scale"]
             with torch.autocast(device.type, dtype=torch.bfloat16, enabled=use_amp):
                 _, loss = model(rects, mask, ids, local, targets, boxes)
             opt.zero_grad(set_to_none=True)

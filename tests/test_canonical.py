@@ -47,6 +47,24 @@ def test_lone_child_inherits_the_role_and_a_centre_that_went_clears_center():
     assert proc.root.center and [c.label for c in proc.root.children] == ["window", "facade"]
 
 
+def test_a_floor_whose_margins_went_keeps_the_floor_s_role():
+    # the builder's floor: margins (role floor) around a row of bays; margins of 1 px, under 512 / 128 = 4 px
+    def floor(margin):
+        row = Node.repeat("x", 4, [(Size("flt", 1), Node.leaf("window"))], role="bay")
+        return Node.split("x", [(Size("abs", margin), wall()), (Size("flt", 500), row),
+                                (Size("abs", margin), wall())], role="floor")
+
+    floors = Node.split("y", [(Size("flt", 1), floor(1)), (Size("flt", 1), floor(1))], role="floors")
+    proc = canonical(Procedure(512, 400, floors))
+    # both floors are the row now, with the role a floor without margins gets: so they merge into one repeat
+    assert (proc.root.rule, proc.root.role, proc.root.count) == ("repeat", "floors", 2)
+    assert (proc.root.children[0].rule, proc.root.children[0].role) == ("repeat", "floor")
+    # visible margins stay, and so do the roles
+    proc = canonical(Procedure(512, 400, Node.split("y", [(Size("flt", 1), floor(8))], role="floors")))
+    visible = proc.root.children[0]
+    assert (visible.role, len(visible.children), visible.children[1].role) == ("floor", 3, "bay")
+
+
 def test_canonical_keeps_the_picture_within_the_removed_gaps():
     column = Node.split("y", [(Size("flt", 3), wall()), (Size("abs", 200), Node.leaf("window")),
                               (Size("flt", 197), wall())])

@@ -1,10 +1,19 @@
 import json
+from dataclasses import replace
 
 import pytest
 import torch
 
 from facaid.generator import generate
-from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model, save_model
+from facaid.model import (
+    FacaidConfig,
+    FacaidModel,
+    batch_inputs,
+    batch_outputs,
+    load_model,
+    save_model,
+    widen_for_counts,
+)
 from facaid.paths import DEFAULT_CHECKPOINT, ROOT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 from facaid.train import load_config, lr_at, train
@@ -34,6 +43,31 @@ def test_forward_shapes_and_loss(rect_tokens, encoder):
     assert loss.item() == pytest.approx(torch.log(torch.tensor(float(len(tok.vocab)))).item(), rel=0.1)
     memory, memory_mask = model.encode(rects, mask)
     assert memory.shape[1] == rects.shape[1] * rect_tokens
+
+
+def test_widening_for_peer_counts_keeps_the_logits_until_trained(tmp_path):
+    model, tok = tiny()
+    model.eval()
+    wide, wide_tok = widen_for_counts(model, tok)
+    assert wide_tok.config.count_features and not tok.config.count_features
+    narrow_batch, wide_batch = batch(tok, [4, 5]), batch(wide_tok, [4, 5])
+    assert wide_batch[0].shape[-1] == 9 and narrow_batch[0].shape[-1] == 5
+    with torch.no_grad():
+        a, _ = model(*narrow_batch[:4], boxes=narrow_batch[5])
+        b, _ = wide(*wide_batch[:4], boxes=wide_batch[5])
+    assert torch.equal(a, b)
+    # the count embeddings learn: one step moves them and changes the logits
+    wide.train()
+    _, loss = wide(*wide_batch)
+    loss.backward()
+    assert all(e.weight.grad.abs().sum() > 0 for e in wide.count_fields)
+    save_model(wide, wide_tok, tmp_path / "wide")
+    again, again_tok = load_model(tmp_path / "wide")
+    assert again_tok.config == wide_tok.config and len(again.count_fields) == 4
+    with pytest.raises(ValueError, match="reads 9 fields per rectangle, got 5"):
+        again.encode(narrow_batch[0], narrow_batch[1])
+    with pytest.raises(ValueError, match="reads the peer counts already"):
+        widen_for_counts(again, again_tok)
 
 
 def test_padding_does_not_change_a_sequence():
@@ -146,7 +180,9 @@ def test_committed_configs_build_the_shipped_architecture(name):
     shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
     for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes"):
         assert getattr(model_config, key) == shipped[key], key
-    assert tok_config.to_dict() == shipped["tokenizer"]
+    shipped_tok = TokenizerConfig(**shipped["tokenizer"])
+    # the configs before configs/finetune-counts.toml read no peer counts; the rest of the tokenizer is the same
+    assert replace(tok_config, count_features=shipped_tok.count_features) == shipped_tok
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
 
 
@@ -205,6 +241,22 @@ def test_fine_tuning_starts_from_a_checkpoint(tmp_path):
         assert torch.equal(p, q), name
     state = torch.load(tuned / "state.pt", weights_only=False)["state"]
     assert state["step"] == 0
+    # a config that adds the peer counts starts from the same weights, the count embeddings at zero
+    write_config(cfg, tmp_path / "counts", steps=0, extra=f'init = "{base}"')
+    cfg.write_text(cfg.read_text().replace("[tokenizer]", "[tokenizer]\ncount_features = true"))
+    counts, counts_tok = load_model(train(cfg, progress=False))
+    assert counts_tok.config.count_features
+    assert all(torch.equal(p, a.state_dict()[n]) for n, p in counts.state_dict().items() if n in a.state_dict())
+    assert all((e.weight == 0).all() for e in counts.count_fields)
+    # they may learn faster than the rest (train.count_lr_scale): Adam's first steps move them by about lr each
+    moved = {}
+    for scale in (1.0, 10.0):
+        write_config(cfg, tmp_path / f"counts-{scale}", steps=2, extra=f'init = "{base}"\ncount_lr_scale = {scale}')
+        cfg.write_text(cfg.read_text().replace("[tokenizer]", "[tokenizer]\ncount_features = true"))
+        tuned_counts, _ = load_model(train(cfg, progress=False))
+        moved[scale] = max(e.weight.abs().max().item() for e in tuned_counts.count_fields)
+    assert 5 < moved[10.0] / moved[1.0] < 15
+    write_config(cfg, tmp_path / "tuned", steps=0, extra=f'noise = 0.5\ninit = "{base}"')
     text = cfg.read_text()
     cfg.write_text(text.replace("d_model = 16", "d_model = 8"))
     with pytest.raises(ValueError, match="another architecture .d_model"):

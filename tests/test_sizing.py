@@ -35,6 +35,11 @@ def test_sizing_never_makes_things_worse():
     wrong = Procedure(s.procedure.width, s.procedure.height, other.root)
     result = fit_sizes(wrong, s.segmentation, geometry_rounds=1, polish_steps=5)
     assert result.accuracy >= result.accuracy_before
+    # a caller that measured the accuracy before sizing passes it in: the same fit
+    again = fit_sizes(wrong, s.segmentation, geometry_rounds=1, polish_steps=5,
+                      before=procedure_accuracy(wrong, s.segmentation))
+    assert (again.accuracy_before, again.accuracy) == (result.accuracy_before, result.accuracy)
+    assert again.procedure.to_dict() == result.procedure.to_dict()
 
 
 def test_overflow_is_measured_and_pulled_back():

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from facaid.generator import STYLE_NAMES, generate
 from facaid.grammar import Node, Procedure, Size, execute, validate
 from facaid.grammar.execute import first_boxes
-from facaid.tokenizer import BOS, EOS, TokenError, TokenGrammar, Tokenizer, TokenizerConfig
+from facaid.tokenizer import BOS, EOS, TokenError, TokenGrammar, Tokenizer, TokenizerConfig, peer_counts
 
 TOK = Tokenizer(TokenizerConfig(max_rects=2000, max_out=2000))
 
@@ -58,6 +58,32 @@ def test_segmentation_rows_sorted_bottom_up():
     keys = [(y, x) for _, x, y, _, _ in rows[1:].tolist()]
     assert keys == sorted(keys)
     assert rows[:, 1:].min() >= 0 and rows[1:, 1:3].max() < 128 and rows[1:, 3:].max() <= 128
+
+
+def test_peer_counts_of_a_window_grid():
+    # 3 floors of 4 windows (y down) and one door, on a wall
+    windows = [[2, 20 + 100 * c, 20 + 100 * f, 80 + 100 * c, 80 + 100 * f] for f in range(3) for c in range(4)]
+    rows = [[1, 0, 0, 400, 300], *windows, [3, 170, 240, 230, 300]]
+    counts = peer_counts(np.array(rows))
+    assert counts[0].tolist() == [1, 0, 1, 0]  # the wall, alone
+    assert counts[-1].tolist() == [1, 0, 1, 0]  # the door: not a peer of the windows
+    for i, (f, c) in enumerate((f, c) for f in range(3) for c in range(4)):
+        # 4 in its floor, c-th from the left; 3 in its column, floor 0 is the top so it ranks 2 from the bottom
+        assert counts[1 + i].tolist() == [4, c, 3, 2 - f]
+    # edges moved by up to 12 px (a fifth of a window): peers by overlap, so the same counts
+    moved = np.array(rows) + np.random.default_rng(0).integers(-12, 13, (len(rows), 5)) * [0, 1, 1, 1, 1]
+    assert (peer_counts(moved) == counts).all()
+
+
+def test_peer_counts_ride_on_the_rows():
+    seg = generate(5).segmentation
+    counting = Tokenizer(TokenizerConfig(max_rects=2000, max_out=2000, count_features=True))
+    rows = counting.encode_segmentation(seg)
+    assert rows.shape[1] == 9 and (rows[:, :5] == TOK.encode_segmentation(seg)).all()
+    assert rows[0, 5:].tolist() == [0, 0, 0, 0]
+    assert (rows[1:, 5] >= 1).all() and (rows[1:, 6] < rows[1:, 5]).all() and (rows[1:, 8] < rows[1:, 7]).all()
+    with pytest.raises(ValueError, match="count_features need rect_tokens = 1"):
+        TokenizerConfig(rect_tokens=5, count_features=True)
 
 
 def test_too_many_rectangles_is_a_clear_error():

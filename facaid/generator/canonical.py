@@ -6,7 +6,9 @@ reliably (the model reads coordinates in 128 steps of the image side), so one pi
 and no model could tell which one to write. `canonical` removes such leaves: wall and background (which the
 model never sees as rectangles of their own) narrower than `MIN_GAP` of the image side along their parent's axis,
 and any leaf under one pixel (rounding drops it from the segmentation). A split or centred mirror left with one
-child gives way to that child, which takes over its role if it has none.
+child gives way to that child, which takes over its role if it has none, and always takes over a `SLOT_ROLES`
+role: the builder gives a floor or a ground floor without margins that role itself, so a floor whose margins
+are too thin to see must get it too (it kept its row's ``bay`` before, and the same picture had two trees).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from facaid.grammar.procedure import Node, Procedure, Size, validate
 
 MIN_GAP = 1 / 128  # of the image side: narrower wall or background is invisible in the model's input
 IMPLICIT = ("facade", "background")
+SLOT_ROLES = ("floor", "ground")  # roles of a slot in the facade's layout, whatever node fills it
 
 
 def canonical(proc: Procedure) -> Procedure:
@@ -43,7 +46,7 @@ def canonical(proc: Procedure) -> Procedure:
             merge_floor_runs(node)
         if len(node.children) == 1 and (node.rule == "split" or node.center):
             child = node.children[0]
-            if child.role is None:
+            if child.role is None or node.role in SLOT_ROLES:
                 child.role = node.role
             return child
         return node
