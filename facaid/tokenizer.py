@@ -132,7 +132,8 @@ def peer_counts(arr: np.ndarray) -> np.ndarray:
     in the row's row (vertical overlap >= half the lower height, itself included) and its rank in it from the
     left, then the same for its column (horizontal overlap, rank from the bottom). A window in a grid of 5 floors
     by 6 bays gets (6, bay, 5, floor): the counts a repeat needs, which the model would otherwise have to count
-    by attention. Overlap rather than equal edges, so that a jittered segmentation keeps its counts."""
+    by attention. Peers by overlap rather than equal edges, so that edges moved a little keep the counts (a
+    rectangle that noise breaks into pieces changes them)."""
     if len(arr) == 0:
         return np.zeros((0, 4), dtype=np.int64)
     a = np.asarray(arr, dtype=np.float64)
