@@ -138,6 +138,7 @@ def peer_counts(arr: np.ndarray) -> np.ndarray:
         return np.zeros((0, 4), dtype=np.int64)
     a = np.asarray(arr, dtype=np.float64)
     same = a[:, 0][:, None] == a[:, 0][None, :]
+    order = np.arange(len(a))  # ties in position rank by row order
     out = []
     for lo, hi, rank_lo, rank_hi, sign in ((2, 4, 1, 3, 1.0), (1, 3, 2, 4, -1.0)):
         # peers overlap on the (lo, hi) axis; rank on the other axis (x from the left, y from the bottom)
@@ -145,7 +146,6 @@ def peer_counts(arr: np.ndarray) -> np.ndarray:
         extent = a[:, hi] - a[:, lo]
         peers = same & (overlap >= 0.5 * np.minimum(extent[:, None], extent[None, :])) & (overlap > 0)
         centre = sign * (a[:, rank_lo] + a[:, rank_hi])
-        order = np.arange(len(a))
         before = peers & ((centre[None, :] < centre[:, None])
                           | ((centre[None, :] == centre[:, None]) & (order[None, :] < order[:, None])))
         out += [np.minimum(peers.sum(1), MAX_PEERS), np.minimum(before.sum(1), MAX_PEERS - 1)]
