@@ -119,6 +119,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     rows = tokenizer.encode_segmentation(seg)
     rects, mask = batch_inputs([rows], device)
     memory, memory_mask = model.encode(rects, mask)  # one row: the K candidates read the same input
+    memory_boxes = model.memory_boxes(rects) if model.box_scale is not None else None
     start = [BOS] + [t for t in (prefix or []) if t != BOS]
     processor = GrammarLogitsProcessor(tokenizer, [(seg.width, seg.height)] * k, max_len)
     seqs = [list(start) for _ in range(k)]
@@ -131,18 +132,20 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     past = None
     fast = None
     if incremental and not model.training:
-        fast = IncrementalDecoder(model, memory, memory_mask, max_len, rows=k)
+        fast = IncrementalDecoder(model, memory, memory_mask, max_len, rows=k, memory_boxes=memory_boxes)
     else:
         memory, memory_mask = memory.expand(k, -1, -1).contiguous(), memory_mask.expand(k, -1).contiguous()
+        if memory_boxes is not None:
+            memory_boxes = memory_boxes.expand(k, -1, -1)
     errors: list[str | None] = [None] * k
     while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
         if fast is not None:  # the same logits without the Hugging Face modules' per-call overhead
             x = model.embed_outputs(ids, local.clamp(max=MAX_LOCAL - 1), boxes)
             for i in range(x.shape[1]):
-                last = fast.step(x[:, i])
+                last = fast.step(x[:, i], boxes[:, i])
         else:
             logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past,
-                                        use_cache=True, boxes=boxes)
+                                        use_cache=True, boxes=boxes, memory_boxes=memory_boxes)
             last = logits[:, -1]
         scores = last.float() / temperature  # (K, V)
         if constrained:

@@ -54,9 +54,10 @@ class _Block(NamedTuple):
 
 class IncrementalDecoder:
     def __init__(self, model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor, max_len: int,
-                 rows: int | None = None):
+                 rows: int | None = None, memory_boxes: torch.Tensor | None = None):
         """memory (B, M, d) and memory_mask (B, M) bool from `model.encode`: one memory row per decoded row, or
-        one memory row shared by ``rows`` decoded rows."""
+        one memory row shared by ``rows`` decoded rows; with ``config.box_bias``, memory_boxes (B, M, 5)
+        (`FacaidModel.memory_boxes`), and `step` takes each row's node box."""
         dec = model.decoder
         cfg = dec.config
         if cfg.activation_function not in ("gelu_new", "gelu_pytorch_tanh"):
@@ -71,6 +72,9 @@ class IncrementalDecoder:
         self.t = 0
         self.max_len = min(max_len, cfg.n_positions)
         self.mask = None if bool(memory_mask.all()) else memory_mask[:, None, None, :]
+        self.model, self.memory_mask, self.memory_boxes = model, memory_mask, memory_boxes
+        if model.box_scale is not None and memory_boxes is None:
+            raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
         self.wpe = dec.wpe.weight
         self.ln_f = (dec.ln_f.weight, dec.ln_f.bias)
         self.head = (model.lm_head.weight, model.lm_head.bias)
@@ -91,23 +95,34 @@ class IncrementalDecoder:
     def _ln(self, x: torch.Tensor, ln: tuple[torch.Tensor, torch.Tensor]) -> torch.Tensor:
         return F.layer_norm(x, (self.d,), ln[0], ln[1], self.eps)
 
-    def _cross(self, q: torch.Tensor, ck: torch.Tensor, cv: torch.Tensor) -> torch.Tensor:
+    def _cross(self, q: torch.Tensor, ck: torch.Tensor, cv: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
         """q (K, d) -> the cross-attention output (K, d)."""
         k, heads, dh = self.k, self.heads, self.dh
         if self.shared:  # (1, H, K, dh): the K rows are K queries on the one memory
-            o = F.scaled_dot_product_attention(q.view(k, heads, dh).transpose(0, 1)[None], ck, cv,
-                                               attn_mask=self.mask)
+            o = F.scaled_dot_product_attention(q.view(k, heads, dh).transpose(0, 1)[None], ck, cv, attn_mask=mask)
             return o[0].transpose(0, 1).reshape(k, self.d)
-        o = F.scaled_dot_product_attention(q.view(k, heads, 1, dh), ck, cv, attn_mask=self.mask)
+        o = F.scaled_dot_product_attention(q.view(k, heads, 1, dh), ck, cv, attn_mask=mask)
         return o.reshape(k, self.d)
 
+    def _cross_mask(self, boxes: torch.Tensor | None) -> torch.Tensor | None:
+        """The cross-attention mask of this step: the padding, and with the box bias each row's node box."""
+        if self.model.box_scale is None:
+            return self.mask
+        if boxes is None:
+            raise ValueError("this model biases cross-attention by the node box: pass each row's box")
+        if self.shared:  # (1, H, K, M): the K rows' boxes as K positions of the one memory row
+            return self.model.cross_bias(self.memory_boxes, self.memory_mask, boxes[None])
+        return self.model.cross_bias(self.memory_boxes, self.memory_mask, boxes[:, None])  # (K, H, 1, M)
+
     @torch.no_grad()
-    def step(self, x: torch.Tensor) -> torch.Tensor:
-        """x (K, d): the embedded newest token of each row -> logits (K, V) for the token after it."""
+    def step(self, x: torch.Tensor, boxes: torch.Tensor | None = None) -> torch.Tensor:
+        """x (K, d): the embedded newest token of each row -> logits (K, V) for the token after it. ``boxes``
+        (K, 4): the quantized node box each row's next token belongs to (what `FacaidModel.embed_outputs` got)."""
         if self.t >= self.max_len:
             raise ValueError(f"the decoder holds at most {self.max_len} positions")
         t = self.t
         k, heads, dh = self.k, self.heads, self.dh
+        mask = self._cross_mask(boxes)
         x = x + self.wpe[t]
         for w, (ck, cv), (kc, vc) in zip(self.blocks, self.cross, self.cache, strict=True):
             q, key, value = torch.addmm(w.attn_b, self._ln(x, w.ln_1), w.attn_w).split(self.d, -1)
@@ -116,7 +131,7 @@ class IncrementalDecoder:
             o = F.scaled_dot_product_attention(q.view(k, heads, 1, dh), kc[:, :, : t + 1], vc[:, :, : t + 1])
             x = x + torch.addmm(w.attn_proj_b, o.reshape(k, self.d), w.attn_proj_w)
             q = torch.addmm(w.cross_q_b, self._ln(x, w.ln_cross), w.cross_q_w)
-            x = x + torch.addmm(w.cross_proj_b, self._cross(q, ck, cv), w.cross_proj_w)
+            x = x + torch.addmm(w.cross_proj_b, self._cross(q, ck, cv, mask), w.cross_proj_w)
             hidden = F.gelu(torch.addmm(w.fc_b, self._ln(x, w.ln_2), w.fc_w), approximate="tanh")
             x = x + torch.addmm(w.mlp_proj_b, hidden, w.mlp_proj_w)
         self.t += 1

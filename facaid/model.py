@@ -30,12 +30,15 @@ class FacaidConfig(PretrainedConfig):
 
     def __init__(self, d_model: int = 128, encoder_layers: int = 3, decoder_layers: int = 3, heads: int = 4,
                  ffn: int = 512, dropout: float = 0.0, encoder: str = "bidirectional", node_boxes: bool = False,
-                 tokenizer: dict | None = None, grammar: str = GRAMMAR_VERSION, **kwargs):
+                 box_bias: bool = False, tokenizer: dict | None = None, grammar: str = GRAMMAR_VERSION, **kwargs):
         super().__init__(**kwargs)
         if encoder not in ("bidirectional", "causal"):
             raise ValueError(f"encoder must be 'bidirectional' (BERT) or 'causal' (GPT-2), got {encoder!r}")
         self.encoder = encoder
         self.node_boxes = node_boxes  # the decoder also sees the box of the node it is writing
+        if box_bias and not node_boxes:
+            raise ValueError("box_bias needs node_boxes: the bias is the share of each rectangle inside the node box")
+        self.box_bias = box_bias  # cross-attention leans, per head, towards the rectangles inside that box
         self.d_model = d_model
         self.encoder_layers = encoder_layers
         self.decoder_layers = decoder_layers
@@ -89,9 +92,14 @@ class FacaidModel(PreTrainedModel):
             embd_pdrop=config.dropout, attn_pdrop=config.dropout, bos_token_id=None, eos_token_id=None,
         ))
         self.lm_head = nn.Linear(d, len(tok.vocab), bias=False)
+        # per head, the cross-attention logit added per unit of a rectangle's share inside the node box; zero at
+        # first, so that a model given it (`with_box_bias`) computes what it computed without it
+        self.box_scale = nn.Parameter(torch.zeros(config.heads)) if config.box_bias else None
         self.post_init()
         for emb in self.count_fields:
             nn.init.zeros_(emb.weight)
+        if self.box_scale is not None:
+            nn.init.zeros_(self.box_scale)
 
     def _init_weights(self, module: nn.Module) -> None:
         if isinstance(module, nn.Linear):
@@ -131,15 +139,46 @@ class FacaidModel(PreTrainedModel):
             x = x + sum(emb(boxes[..., f]) for f, emb in enumerate(self.fields[1:]))
         return x
 
+    def memory_boxes(self, rects: torch.Tensor) -> torch.Tensor:
+        """(B, N, F) encoded rectangles -> (B, M, 5) float (x0, y0, x1, y1, is a rectangle) per memory position, in
+        the quantized coordinates of the node boxes; the image row is not a rectangle."""
+        q = rects[..., 1:5].float()
+        real = (rects[..., 0] < self.fields[0].num_embeddings - 1).float()  # the image row has label len(LABELS)
+        out = torch.stack([q[..., 0], q[..., 1], q[..., 0] + q[..., 2], q[..., 1] + q[..., 3], real], -1)
+        return out if self.rect_tokens == 1 else out.repeat_interleave(5, dim=1)
+
+    def cross_bias(self, memory_boxes: torch.Tensor, memory_mask: torch.Tensor, boxes: torch.Tensor) -> torch.Tensor:
+        """The additive cross-attention mask (B, H, T, M): per head, ``box_scale`` times the share of each memory
+        rectangle's area inside the node box at each position (`memory_boxes`; boxes (B, T, 4) quantized x, y,
+        w, h, all zero where there is no node), and the padding masked out. A row of zero boxes gets the same
+        bias everywhere, which changes nothing."""
+        m = memory_boxes[:, None]  # (B, 1, M, 5)
+        b = boxes.float()[:, :, None]  # (B, T, 1, 4)
+        ix = (torch.minimum(m[..., 2], b[..., 0] + b[..., 2]) - torch.maximum(m[..., 0], b[..., 0])).clamp(min=0)
+        iy = (torch.minimum(m[..., 3], b[..., 1] + b[..., 3]) - torch.maximum(m[..., 1], b[..., 1])).clamp(min=0)
+        area = ((m[..., 2] - m[..., 0]) * (m[..., 3] - m[..., 1])).clamp(min=1)
+        share = ix * iy / area * m[..., 4]  # (B, T, M)
+        bias = self.box_scale.view(1, -1, 1, 1) * share[:, None]  # (B, H, T, M)
+        masked = torch.finfo(bias.dtype).min
+        return bias.masked_fill(~memory_mask[:, None, None, :], masked)
+
     def decode(self, ids: torch.Tensor, local: torch.Tensor, memory: torch.Tensor, memory_mask: torch.Tensor,
-               past=None, use_cache: bool = False, boxes: torch.Tensor | None = None):
+               past=None, use_cache: bool = False, boxes: torch.Tensor | None = None,
+               memory_boxes: torch.Tensor | None = None):
         """ids, local (B, T) and, with ``config.node_boxes``, boxes (B, T, 4) -> logits (B, T, V) and the cache.
 
         ``boxes`` hold at each position the quantized (x, y, w, h) of the node the next token belongs to
-        (`Tokenizer.node_boxes`); they are embedded with the same tables as the input rectangles."""
+        (`Tokenizer.node_boxes`); they are embedded with the same tables as the input rectangles. With
+        ``config.box_bias`` the cross-attention also leans towards the rectangles inside them: pass
+        ``memory_boxes`` (`memory_boxes` of the encoded rectangles)."""
         x = self.embed_outputs(ids, local, boxes)
+        mask = memory_mask.long()
+        if self.box_scale is not None:
+            if memory_boxes is None:
+                raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
+            mask = self.cross_bias(memory_boxes, memory_mask, boxes).to(x.dtype)
         out = self.decoder(inputs_embeds=x, encoder_hidden_states=memory,
-                           encoder_attention_mask=memory_mask.long(), past_key_values=past, use_cache=use_cache)
+                           encoder_attention_mask=mask, past_key_values=past, use_cache=use_cache)
         return self.lm_head(out.last_hidden_state), out.past_key_values  # (B, T, V)
 
     def forward(self, rects: torch.Tensor, rect_mask: torch.Tensor, ids: torch.Tensor, local: torch.Tensor,
@@ -147,7 +186,8 @@ class FacaidModel(PreTrainedModel):
                 ) -> tuple[torch.Tensor, torch.Tensor | None]:
         """Teacher-forced logits (B, T, V) and, given targets (B, T) with -100 for ignored, the mean loss."""
         memory, memory_mask = self.encode(rects, rect_mask)
-        logits, _ = self.decode(ids, local, memory, memory_mask, boxes=boxes)
+        memory_boxes = self.memory_boxes(rects) if self.box_scale is not None else None
+        logits, _ = self.decode(ids, local, memory, memory_mask, boxes=boxes, memory_boxes=memory_boxes)
         loss = None
         if targets is not None:
             loss = F.cross_entropy(logits.reshape(-1, logits.shape[-1]), targets.reshape(-1), ignore_index=-100)
@@ -185,6 +225,21 @@ def widen_for_counts(model: FacaidModel, tokenizer: Tokenizer) -> tuple[FacaidMo
         raise ValueError(f"cannot widen: unexpected {unexpected}, missing {missing}")
     wide.train(model.training)
     return wide, tok
+
+
+def with_box_bias(model: FacaidModel) -> FacaidModel:
+    """The same model with ``box_bias`` (its scales zero): the same logits until training moves them. The start
+    of a fine-tune that adds the bias."""
+    if model.config.box_bias:
+        raise ValueError("this model has the box bias already")
+    config = copy.deepcopy(model.config)
+    config.box_bias = True
+    biased = FacaidModel(config).to(next(model.parameters()).device)
+    missing, unexpected = biased.load_state_dict(model.state_dict(), strict=False)
+    if unexpected or missing != ["box_scale"]:
+        raise ValueError(f"cannot add the box bias: unexpected {unexpected}, missing {missing}")
+    biased.train(model.training)
+    return biased
 
 
 def save_model(model: FacaidModel, tokenizer: Tokenizer, path: str | Path) -> None:

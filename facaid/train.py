@@ -33,6 +33,7 @@ from facaid.model import (
     load_model,
     save_model,
     widen_for_counts,
+    with_box_bias,
 )
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
@@ -61,6 +62,7 @@ class TrainConfig:
     init: str = ""  # a checkpoint directory whose weights start the run (fine-tuning); fresh optimizer and schedule
     count_lr_scale: float = 1.0  # the peer counts' embeddings learn at this multiple of the learning rate (a
     # model widened for them starts them at zero while the rest is trained already)
+    box_lr_scale: float = 1.0  # the same for the box bias's per-head scales (`FacaidConfig.box_bias`)
 
 
 def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
@@ -81,7 +83,8 @@ def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainC
     tok = build(TokenizerConfig, "tokenizer")
     train = build(TrainConfig, "train")
     model_values = raw.get("model", {})
-    allowed = {"d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder", "node_boxes"}
+    allowed = {"d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder", "node_boxes",
+               "box_bias"}
     bad = set(model_values) - allowed
     if bad:
         raise ValueError(f"{path}: unknown key(s) in [model]: {', '.join(sorted(bad))}")
@@ -240,16 +243,19 @@ def validation_loss(model: FacaidModel, examples: list, batch_size: int, device)
     return total / count
 
 
-_ARCHITECTURE = ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder", "node_boxes")
+_ARCHITECTURE = ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "dropout", "encoder", "node_boxes",
+                 "box_bias")
 
 
 def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig, device) -> FacaidModel:
     """The weights of checkpoint ``path`` for a fine-tuning run; its architecture and tokenizer must be the
-    config's, except that a config with ``count_features`` may start from a checkpoint without them
-    (`widen_for_counts`: their embeddings start at zero)."""
+    config's, except that a config with ``count_features`` or ``box_bias`` may start from a checkpoint without
+    them (`widen_for_counts`, `with_box_bias`: what they add starts at zero)."""
     model, tokenizer = load_model(path, device)
     if tok_cfg.count_features and not tokenizer.config.count_features:
         model, tokenizer = widen_for_counts(model, tokenizer)
+    if model_cfg.box_bias and not model.config.box_bias:
+        model = with_box_bias(model)
     if tokenizer.config != tok_cfg:
         raise ValueError(f"train.init {path} was trained with another tokenizer config")
     differ = [k for k in _ARCHITECTURE if getattr(model.config, k) != getattr(model_cfg, k)]
@@ -293,11 +299,14 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         saved = None
     model.train()
     counts = [p for n, p in model.named_parameters() if n.startswith("count_fields.")]
-    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith("count_fields.")]
+    box = [p for n, p in model.named_parameters() if n == "box_scale"]
+    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith("count_fields.") and n != "box_scale"]
     groups = [{"params": [p for n, p in rest if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": 1.0},
               {"params": [p for n, p in rest if p.dim() < 2], "weight_decay": 0.0, "scale": 1.0}]
     if counts:
         groups.append({"params": counts, "weight_decay": 0.0, "scale": cfg.count_lr_scale})
+    if box:
+        groups.append({"params": box, "weight_decay": 0.0, "scale": cfg.box_lr_scale})
     opt = torch.optim.AdamW(groups, lr=cfg.lr, betas=(0.9, 0.98))
     if saved is not None:
         opt.load_state_dict(saved["optimizer"])

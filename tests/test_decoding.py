@@ -156,6 +156,46 @@ def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k,
                            max_len=8, rows=3)
 
 
+@pytest.fixture(scope="module")
+def biased_model(tiny_model):
+    from facaid.model import with_box_bias
+
+    model = with_box_bias(tiny_model)
+    model.box_scale.data = torch.tensor([3.0, -2.0])
+    return model
+
+
+@pytest.mark.parametrize("k, shared", [(1, False), (3, True)])
+def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, shared):
+    from facaid.incremental import IncrementalDecoder
+    from facaid.model import batch_inputs, batch_outputs
+
+    sample = generate(4)
+    rects, mask = batch_inputs([TOK.encode_segmentation(sample.segmentation)] * k)
+    ids, local, _, boxes = batch_outputs([TOK.encode_target(sample.procedure)] * k)
+    ids, local, boxes = ids[:, :40], local[:, :40], boxes[:, :40]
+    with torch.no_grad():
+        memory, memory_mask = biased_model.encode(rects, mask)
+        memory_boxes = biased_model.memory_boxes(rects)
+        full, _ = biased_model.decode(ids, local, memory, memory_mask, boxes=boxes, memory_boxes=memory_boxes)
+        plain, _ = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
+        assert not torch.allclose(full, plain, atol=1e-3)  # the same weights but the bias
+        rows = 1 if shared else k
+        fast = IncrementalDecoder(biased_model, memory[:rows], memory_mask[:rows], max_len=64, rows=k,
+                                  memory_boxes=memory_boxes[:rows])
+        x = biased_model.embed_outputs(ids, local, boxes)
+        steps = torch.stack([fast.step(x[:, i], boxes[:, i]) for i in range(x.shape[1])], 1)
+        with pytest.raises(ValueError, match="pass each row's box"):
+            fast.step(x[:, 0])
+    assert torch.allclose(steps, full, atol=1e-5)
+    with pytest.raises(ValueError, match="pass memory_boxes"):
+        IncrementalDecoder(biased_model, memory, memory_mask, max_len=8)
+    seg = generate(6).segmentation
+    a = decode(biased_model, TOK, seg, k=3, sample=True, seed=2, greedy=1)
+    b = decode(biased_model, TOK, seg, k=3, sample=True, seed=2, greedy=1, incremental=False)
+    assert [c.ids for c in a] == [c.ids for c in b]
+
+
 def test_incremental_and_module_decoding_agree(tiny_model):
     seg = generate(6).segmentation
     a = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1)

@@ -5,7 +5,7 @@ import pytest
 from facaid.cli import main
 from facaid.decoding import decode
 from facaid.evaluation.noise import changed_fraction, perturb
-from facaid.evaluation.synthetic import evaluate_synthetic, nll, write_report
+from facaid.evaluation.synthetic import by_style, evaluate_synthetic, nll, write_report
 from facaid.generator import generate
 from facaid.model import save_model
 from facaid.segmentation import flatten
@@ -59,6 +59,19 @@ def test_evaluate_and_report(tiny, tmp_path):
     assert "exact structure (TED = 0), best of 3" in text and "Mean TED under noise, best of 3" in text
     for png in ("ted.png", "productions.png", "noise.png"):
         assert (tmp_path / "report" / png).stat().st_size > 1000
+    styles = result["by_style"]
+    assert sum(st["count"] for st in styles.values()) == 3
+    assert all(set(st) == {"count", "greedy", "best_of"} for st in styles.values())
+    assert "## By style" in text and "best of 3: exact" in text
+
+
+def test_figures_by_style():
+    figures = by_style(["wings", "house", "wings", "house"], [0, 3, 12, 0], [0, 0, 6, 0])
+    assert list(figures) == ["house", "wings"]
+    assert figures["house"] == {"count": 2, "greedy": {"exact_structure_rate": 0.5, "ted_le5": 1.0, "ted_mean": 1.5},
+                                "best_of": {"exact_structure_rate": 1.0, "ted_le5": 1.0, "ted_mean": 0.0}}
+    assert figures["wings"]["greedy"] == {"exact_structure_rate": 0.5, "ted_le5": 0.5, "ted_mean": 6.0}
+    assert "best_of" not in by_style(["house"], [1])["house"]
 
 
 def test_cli_evaluate(tiny, tmp_path, capsys):
@@ -70,5 +83,7 @@ def test_cli_evaluate(tiny, tmp_path, capsys):
                  "--quiet"]) == 0
     figures = json.loads(out.read_text())
     assert figures["count"] == 2 and figures["best_of"]["k"] == 2
+    text = (tmp_path / "rep" / "report.md").read_text()
+    assert "Not measured (`--noise-count 0`)." in text and "Mean TED under noise" not in text
     assert main(["evaluate", "--checkpoint", str(tmp_path / "missing"), "--count", "2"]) == 2
     assert "no checkpoint" in capsys.readouterr().err

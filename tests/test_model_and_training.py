@@ -5,6 +5,7 @@ import pytest
 import torch
 
 from facaid.generator import generate
+from facaid.labels import LABELS
 from facaid.model import (
     FacaidConfig,
     FacaidModel,
@@ -13,6 +14,7 @@ from facaid.model import (
     load_model,
     save_model,
     widen_for_counts,
+    with_box_bias,
 )
 from facaid.paths import DEFAULT_CHECKPOINT, ROOT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
@@ -68,6 +70,50 @@ def test_widening_for_peer_counts_keeps_the_logits_until_trained(tmp_path):
         again.encode(narrow_batch[0], narrow_batch[1])
     with pytest.raises(ValueError, match="reads the peer counts already"):
         widen_for_counts(again, again_tok)
+
+
+def test_box_bias_starts_at_zero_and_leans_on_the_rectangles_in_the_node_box(tmp_path):
+    model, tok = tiny()
+    model.eval()
+    biased = with_box_bias(model)
+    assert biased.config.box_bias and biased.box_scale.shape == (2,) and not biased.box_scale.any()
+    rects, mask, ids, local, targets, boxes = batch(tok, [4, 5])
+    with torch.no_grad():
+        a, _ = model(rects, mask, ids, local, boxes=boxes)
+        b, _ = biased(rects, mask, ids, local, boxes=boxes)
+    assert torch.equal(a, b)
+    # the bias per head is the scale times the share of each rectangle's area inside the node box
+    image, label = len(LABELS), 2  # the image row's label is len(LABELS)
+    geometry = torch.tensor([[[image, 3, 0, 9, 9], [label, 10, 10, 4, 4], [label, 11, 10, 2, 2], [label, 40, 40, 2, 2],
+                              [label, 10, 10, 4, 4]]])
+    padding = torch.tensor([[True, True, True, True, False]])
+    node = torch.tensor([[[10, 10, 4, 2], [0, 0, 0, 0]]])  # a box, then no node (EOS)
+    biased.box_scale.data = torch.tensor([2.0, -1.0])
+    bias = biased.cross_bias(biased.memory_boxes(geometry), padding, node)
+    assert bias.shape == (1, 2, 2, 5)
+    assert bias[0, 0, 0, :4].tolist() == [0.0, 1.0, 2.0, 0.0]  # half of rectangle 1 is inside, all of rectangle 2
+    assert bias[0, 1, 0, :4].tolist() == [0.0, -0.5, -1.0, 0.0]
+    assert bias[0, :, 1, :4].eq(0).all()  # no node: the same bias everywhere, no change
+    assert bias[0, :, :, 4].eq(torch.finfo(bias.dtype).min).all()  # padding stays masked
+    # with scales, the logits move and the scales get gradients; they survive save and load
+    biased.train()
+    changed, loss = biased(rects, mask, ids, local, targets, boxes)
+    assert not torch.allclose(changed, a)
+    loss.backward()
+    assert biased.box_scale.grad.abs().sum() > 0
+    save_model(biased, tok, tmp_path / "biased")
+    again, _ = load_model(tmp_path / "biased")
+    assert torch.equal(again.box_scale, biased.box_scale)
+    with pytest.raises(ValueError, match="has the box bias already"):
+        with_box_bias(again)
+    with pytest.raises(ValueError, match="pass memory_boxes"):
+        memory, memory_mask = again.encode(rects, mask)
+        again.decode(ids, local, memory, memory_mask, boxes=boxes)
+    with pytest.raises(ValueError, match="box_bias needs node_boxes"):
+        FacaidConfig(box_bias=True, node_boxes=False)
+    five, five_tok = tiny(rect_tokens=5)
+    rects5 = batch(five_tok, [4])[0]
+    assert with_box_bias(five).memory_boxes(rects5).shape == (1, rects5.shape[1] * 5, 5)
 
 
 def test_padding_does_not_change_a_sequence():
@@ -256,6 +302,18 @@ def test_fine_tuning_starts_from_a_checkpoint(tmp_path):
         tuned_counts, _ = load_model(train(cfg, progress=False))
         moved[scale] = max(e.weight.abs().max().item() for e in tuned_counts.count_fields)
     assert 5 < moved[10.0] / moved[1.0] < 15
+    # a config that adds the box bias starts from the same weights, its scales at zero; they learn at
+    # train.box_lr_scale
+    box = {}
+    for scale in (0.0, 1.0, 10.0):
+        steps = 0 if scale == 0.0 else 2
+        write_config(cfg, tmp_path / f"box-{scale}", steps=steps, extra=f'init = "{base}"\nbox_lr_scale = {scale}')
+        cfg.write_text(cfg.read_text().replace("[model]", "[model]\nbox_bias = true"))
+        biased, _ = load_model(train(cfg, progress=False))
+        box[scale] = biased.box_scale.abs().max().item()
+        if scale == 0.0:
+            assert all(torch.equal(p, a.state_dict()[n]) for n, p in biased.state_dict().items() if n != "box_scale")
+    assert box[0.0] == 0.0 and 5 < box[10.0] / box[1.0] < 15
     write_config(cfg, tmp_path / "tuned", steps=0, extra=f'noise = 0.5\ninit = "{base}"')
     text = cfg.read_text()
     cfg.write_text(text.replace("d_model = 16", "d_model = 8"))

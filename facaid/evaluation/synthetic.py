@@ -130,6 +130,7 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
                     best_noise[level].append(tree_edit_distance(s.procedure.root, p.procedure.root))
 
     teds_arr = np.array(teds)
+    styles = [ex["sample"].style for ex in examples]
     hist = Counter(min(int(t), 20) for t in teds)
     norm_hist = Counter(min(int(x * 20), 20) for x in norm)  # bins of 0.05
     n_unconstrained = min(unconstrained_count, len(examples))
@@ -163,7 +164,25 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
                        "p90": 1000 * float(np.percentile(latency, 90))},
         "productions": {"truth": dict(truth_counts.most_common()), "predicted": dict(pred_counts.most_common())},
         "best_of": best,
+        "by_style": by_style(styles, teds, best_teds),
     }
+
+
+def _ted_figures(teds: list[int]) -> dict:
+    t = np.array(teds)
+    return {"exact_structure_rate": float((t == 0).mean()), "ted_le5": float((t <= 5).mean()),
+            "ted_mean": float(t.mean())}
+
+
+def by_style(styles: list[str], teds: list[int], best_teds: list[int] | None = None) -> dict:
+    """Exact structure rate, TED <= 5 and mean TED per generator style (greedy, and best of K when given)."""
+    out = {}
+    for name in sorted(set(styles)):
+        pick = [i for i, st in enumerate(styles) if st == name]
+        out[name] = {"count": len(pick), "greedy": _ted_figures([teds[i] for i in pick])}
+        if best_teds:
+            out[name]["best_of"] = _ted_figures([best_teds[i] for i in pick])
+    return out
 
 
 def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on generated facades") -> Path:
@@ -236,13 +255,13 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
         "",
         "## Noise robustness",
         "",
-        "| target | pixels changed | mean TED | facades |",
-        "| --- | --- | --- | --- |",
     ]
-    for p in r["noise"]:
-        if p["mean_ted"] is not None:
-            lines.append(f"| {100 * p['level']:.0f} % | {100 * p['measured']:.1f} % | {p['mean_ted']:.2f} | "
-                         f"{p['count']} |")
+    if any(p["mean_ted"] is not None for p in r["noise"]):
+        lines += ["| target | pixels changed | mean TED | facades |", "| --- | --- | --- | --- |"]
+        lines += [f"| {100 * p['level']:.0f} % | {100 * p['measured']:.1f} % | {p['mean_ted']:.2f} | {p['count']} |"
+                  for p in r["noise"] if p["mean_ted"] is not None]
+    else:
+        lines.append("Not measured (`--noise-count 0`).")
     if r.get("best_of"):
         b = r["best_of"]
         k = b["k"]
@@ -260,10 +279,28 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
             f"| inference latency, best of {k}, batch 1 (median / p90) | {b['latency_ms']['median']:.0f} / "
             f"{b['latency_ms']['p90']:.0f} ms |",
         ]
-        lines += ["", f"Mean TED under noise, best of {k}: " + ", ".join(
-            f"{100 * p['level']:.0f} %: {p['mean_ted']:.2f}" for p in b["noise"] if p["mean_ted"] is not None) + "."]
-    lines += ["", "![noise](noise.png)", "", "## Tree edit distance", "", "![ted](ted.png)", "",
-              "## Productions", "", "![productions](productions.png)", ""]
+        noisy = [p for p in b["noise"] if p["mean_ted"] is not None]
+        if noisy:
+            lines += ["", f"Mean TED under noise, best of {k}: " + ", ".join(
+                f"{100 * p['level']:.0f} %: {p['mean_ted']:.2f}" for p in noisy) + "."]
+    lines += ["", "![noise](noise.png)", "", "## Tree edit distance", "", "![ted](ted.png)", ""]
+    if r.get("by_style"):
+        best_k = r["best_of"]["k"] if r.get("best_of") else None
+        head = "| style | facades | exact | TED ≤ 5 | mean TED |"
+        if best_k:
+            head += f" best of {best_k}: exact | TED ≤ 5 | mean TED |"
+        lines += ["## By style", "", head, "|" + " --- |" * (head.count("|") - 1)]
+        for name, st in r["by_style"].items():
+            g = st["greedy"]
+            row = (f"| {name} | {st['count']} | {100 * g['exact_structure_rate']:.1f} % | "
+                   f"{100 * g['ted_le5']:.1f} % | {g['ted_mean']:.2f} |")
+            if best_k and "best_of" in st:
+                b = st["best_of"]
+                row += (f" {100 * b['exact_structure_rate']:.1f} % | {100 * b['ted_le5']:.1f} % | "
+                        f"{b['ted_mean']:.2f} |")
+            lines.append(row)
+        lines.append("")
+    lines += ["## Productions", "", "![productions](productions.png)", ""]
     path = out / "report.md"
     path.write_text("\n".join(lines))
     return path
