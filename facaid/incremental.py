@@ -72,9 +72,19 @@ class IncrementalDecoder:
         self.t = 0
         self.max_len = min(max_len, cfg.n_positions)
         self.mask = None if bool(memory_mask.all()) else memory_mask[:, None, None, :]
-        self.model, self.memory_mask, self.memory_boxes = model, memory_mask, memory_boxes
-        if model.box_scale is not None and memory_boxes is None:
-            raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
+        self.box_scale = model.box_scale
+        if self.box_scale is not None:
+            if memory_boxes is None:
+                raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
+            # `FacaidModel.cross_bias` split into what the memory fixes once and what each step's boxes add
+            mb = memory_boxes.float()
+            self.m_lo, self.m_hi = mb[..., 0:2], mb[..., 2:4]  # (B, M, 2)
+            area = (self.m_hi - self.m_lo).prod(-1).clamp(min=1)
+            self.m_weight = mb[..., 4] / area  # (B, M): share per unit of area inside; 0 for the image row
+            self.scale = self.box_scale.detach().view(1, -1, 1, 1)
+            self.pad = None if self.mask is None else torch.zeros(memory_mask.shape).masked_fill(
+                ~memory_mask, torch.finfo(torch.float32).min)[:, None, None, :]
+            self.last_boxes = self.last_mask = None
         self.wpe = dec.wpe.weight
         self.ln_f = (dec.ln_f.weight, dec.ln_f.bias)
         self.head = (model.lm_head.weight, model.lm_head.bias)
@@ -105,14 +115,26 @@ class IncrementalDecoder:
         return o.reshape(k, self.d)
 
     def _cross_mask(self, boxes: torch.Tensor | None) -> torch.Tensor | None:
-        """The cross-attention mask of this step: the padding, and with the box bias each row's node box."""
-        if self.model.box_scale is None:
+        """The cross-attention mask of this step: the padding, and with the box bias each row's node box (the
+        same as `FacaidModel.cross_bias`; kept while the boxes stay, as they do for the tokens of one node)."""
+        if self.box_scale is None:
             return self.mask
         if boxes is None:
             raise ValueError("this model biases cross-attention by the node box: pass each row's box")
+        if self.last_boxes is not None and torch.equal(boxes, self.last_boxes):
+            return self.last_mask
+        b = boxes.float()
+        lo, hi = b[:, None, 0:2], b[:, None, 0:2] + b[:, None, 2:4]  # (K, 1, 2)
+        inter = (torch.minimum(self.m_hi, hi) - torch.maximum(self.m_lo, lo)).clamp_(min=0)  # (K, M, 2)
+        share = inter[..., 0] * inter[..., 1] * self.m_weight  # (K, M)
         if self.shared:  # (1, H, K, M): the K rows' boxes as K positions of the one memory row
-            return self.model.cross_bias(self.memory_boxes, self.memory_mask, boxes[None])
-        return self.model.cross_bias(self.memory_boxes, self.memory_mask, boxes[:, None])  # (K, H, 1, M)
+            mask = self.scale * share[None, None]
+        else:  # (K, H, 1, M)
+            mask = self.scale * share[:, None, None, :]
+        if self.pad is not None:
+            mask = mask + self.pad
+        self.last_boxes, self.last_mask = boxes, mask
+        return mask
 
     @torch.no_grad()
     def step(self, x: torch.Tensor, boxes: torch.Tensor | None = None) -> torch.Tensor:

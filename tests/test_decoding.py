@@ -165,17 +165,18 @@ def biased_model(tiny_model):
     return model
 
 
-@pytest.mark.parametrize("k, shared", [(1, False), (3, True)])
-def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, shared):
+@pytest.mark.parametrize("k, shared, padded", [(1, False, False), (3, True, False), (2, False, True)])
+def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, shared, padded):
     from facaid.incremental import IncrementalDecoder
     from facaid.model import batch_inputs, batch_outputs
 
-    sample = generate(4)
-    rects, mask = batch_inputs([TOK.encode_segmentation(sample.segmentation)] * k)
-    ids, local, _, boxes = batch_outputs([TOK.encode_target(sample.procedure)] * k)
+    samples = [generate(4), generate(5)] if padded else [generate(4)] * k
+    rects, mask = batch_inputs([TOK.encode_segmentation(s.segmentation) for s in samples])
+    ids, local, _, boxes = batch_outputs([TOK.encode_target(s.procedure) for s in samples])
     ids, local, boxes = ids[:, :40], local[:, :40], boxes[:, :40]
     with torch.no_grad():
         memory, memory_mask = biased_model.encode(rects, mask)
+        assert bool(memory_mask.all()) != padded
         memory_boxes = biased_model.memory_boxes(rects)
         full, _ = biased_model.decode(ids, local, memory, memory_mask, boxes=boxes, memory_boxes=memory_boxes)
         plain, _ = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
@@ -185,8 +186,8 @@ def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, s
                                   memory_boxes=memory_boxes[:rows])
         x = biased_model.embed_outputs(ids, local, boxes)
         steps = torch.stack([fast.step(x[:, i], boxes[:, i]) for i in range(x.shape[1])], 1)
-        with pytest.raises(ValueError, match="pass each row's box"):
-            fast.step(x[:, 0])
+    with pytest.raises(ValueError, match="pass each row's box"):
+        fast.step(x[:, 0])
     assert torch.allclose(steps, full, atol=1e-5)
     with pytest.raises(ValueError, match="pass memory_boxes"):
         IncrementalDecoder(biased_model, memory, memory_mask, max_len=8)
