@@ -82,7 +82,7 @@ class IncrementalDecoder:
             area = (self.m_hi - self.m_lo).prod(-1).clamp(min=1)
             self.m_weight = mb[..., 4] / area  # (B, M): share per unit of area inside; 0 for the image row
             self.scale = self.box_scale.detach().view(1, -1, 1, 1)
-            self.pad = None if self.mask is None else torch.zeros(memory_mask.shape).masked_fill(
+            self.pad = None if self.mask is None else mb.new_zeros(memory_mask.shape).masked_fill(
                 ~memory_mask, torch.finfo(torch.float32).min)[:, None, None, :]
             self.last_boxes = self.last_mask = None
         self.wpe = dec.wpe.weight
