@@ -9,6 +9,9 @@ key/value buffers, with the cross-attention keys and values computed once. It gi
 Best-of-K decodes K rows against one input: given that input's memory once and ``rows=K``, the rows share its
 cross-attention keys and values, and a step attends with the K queries of a head in one matrix product
 instead of K vector products over K copies of the memory.
+
+With the box bias (`FacaidConfig.box_bias`) each step also gets each row's node box and adds the same
+cross-attention bias as `FacaidModel.cross_bias`, computed once per node rather than once per token.
 """
 
 from __future__ import annotations
