@@ -80,12 +80,9 @@ class IncrementalDecoder:
             if memory_boxes is None:
                 raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
             # `FacaidModel.cross_bias` split into what the memory fixes once and what each step's boxes add
-            mb = memory_boxes.float()
-            self.m_lo, self.m_hi = mb[..., 0:2], mb[..., 2:4]  # (B, M, 2)
-            area = (self.m_hi - self.m_lo).prod(-1).clamp(min=1)
-            self.m_weight = mb[..., 4] / area  # (B, M): share per unit of area inside; 0 for the image row
+            self.box_terms = model.box_terms(memory_boxes)
             self.scale = self.box_scale.detach().view(1, -1, 1, 1)
-            self.pad = None if self.mask is None else mb.new_zeros(memory_mask.shape).masked_fill(
+            self.pad = None if self.mask is None else self.box_terms[2].new_zeros(memory_mask.shape).masked_fill(
                 ~memory_mask, torch.finfo(torch.float32).min)[:, None, None, :]
             self.last_boxes = self.last_mask = None
         self.wpe = dec.wpe.weight
@@ -126,14 +123,10 @@ class IncrementalDecoder:
             raise ValueError("this model biases cross-attention by the node box: pass each row's box")
         if self.last_boxes is not None and torch.equal(boxes, self.last_boxes):
             return self.last_mask
-        b = boxes.float()
-        lo, hi = b[:, None, 0:2], b[:, None, 0:2] + b[:, None, 2:4]  # (K, 1, 2)
-        inter = (torch.minimum(self.m_hi, hi) - torch.maximum(self.m_lo, lo)).clamp_(min=0)  # (K, M, 2)
-        share = inter[..., 0] * inter[..., 1] * self.m_weight  # (K, M)
         if self.shared:  # (1, H, K, M): the K rows' boxes as K positions of the one memory row
-            mask = self.scale * share[None, None]
-        else:  # (K, H, 1, M)
-            mask = self.scale * share[:, None, None, :]
+            mask = self.scale * FacaidModel.box_share(self.box_terms, boxes[None])[:, None]
+        else:  # (K, H, 1, M): one position per row
+            mask = self.scale * FacaidModel.box_share(self.box_terms, boxes[:, None])[:, None]
         if self.pad is not None:
             mask = mask + self.pad
         self.last_boxes, self.last_mask = boxes, mask

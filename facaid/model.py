@@ -147,17 +147,28 @@ class FacaidModel(PreTrainedModel):
         out = torch.stack([q[..., 0], q[..., 1], q[..., 0] + q[..., 2], q[..., 1] + q[..., 3], real], -1)
         return out if self.rect_tokens == 1 else out.repeat_interleave(5, dim=1)
 
-    def cross_bias(self, memory_boxes: torch.Tensor, memory_mask: torch.Tensor, boxes: torch.Tensor) -> torch.Tensor:
-        """The additive cross-attention mask (B, H, T, M): per head, ``box_scale`` times the share of each memory
-        rectangle's area inside the node box at each position (`memory_boxes`; boxes (B, T, 4) quantized x, y,
-        w, h, all zero where there is no node), and the padding masked out. A row of zero boxes gets the same
-        bias everywhere, which changes nothing."""
-        m = memory_boxes[:, None]  # (B, 1, M, 5)
+    @staticmethod
+    def box_terms(memory_boxes: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+        """What `box_share` needs of the memory, fixed for a whole decode: (lo, hi) corners (B, M, 2) and the
+        weight (B, M) that turns an overlap area into a share (zero for the image row)."""
+        mb = memory_boxes.float()
+        lo, hi = mb[..., 0:2], mb[..., 2:4]
+        return lo, hi, mb[..., 4] / (hi - lo).prod(-1).clamp(min=1)
+
+    @staticmethod
+    def box_share(terms: tuple[torch.Tensor, torch.Tensor, torch.Tensor], boxes: torch.Tensor) -> torch.Tensor:
+        """Each memory rectangle's share of area inside each node box: boxes (B, T, 4) quantized x, y, w, h
+        (all zero where there is no node) and `box_terms` of (B or 1, M) -> (B, T, M)."""
+        lo, hi, weight = (t[:, None] for t in terms)  # (B, 1, M, ...)
         b = boxes.float()[:, :, None]  # (B, T, 1, 4)
-        ix = (torch.minimum(m[..., 2], b[..., 0] + b[..., 2]) - torch.maximum(m[..., 0], b[..., 0])).clamp(min=0)
-        iy = (torch.minimum(m[..., 3], b[..., 1] + b[..., 3]) - torch.maximum(m[..., 1], b[..., 1])).clamp(min=0)
-        area = ((m[..., 2] - m[..., 0]) * (m[..., 3] - m[..., 1])).clamp(min=1)
-        share = ix * iy / area * m[..., 4]  # (B, T, M)
+        inter = (torch.minimum(hi, b[..., 0:2] + b[..., 2:4]) - torch.maximum(lo, b[..., 0:2])).clamp(min=0)
+        return inter[..., 0] * inter[..., 1] * weight
+
+    def cross_bias(self, memory_boxes: torch.Tensor, memory_mask: torch.Tensor, boxes: torch.Tensor) -> torch.Tensor:
+        """The additive cross-attention mask (B, H, T, M): per head, ``box_scale`` times `box_share` at each
+        position, and the padding masked out. A row of zero boxes gets the same bias everywhere, which changes
+        nothing."""
+        share = self.box_share(self.box_terms(memory_boxes), boxes)  # (B, T, M)
         bias = self.box_scale.view(1, -1, 1, 1) * share[:, None]  # (B, H, T, M)
         masked = torch.finfo(bias.dtype).min
         return bias.masked_fill(~memory_mask[:, None, None, :], masked)
