@@ -298,15 +298,15 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         model = FacaidModel(model_cfg).to(device)
         saved = None
     model.train()
-    counts = [p for n, p in model.named_parameters() if n.startswith("count_fields.")]
-    box = [p for n, p in model.named_parameters() if n == "box_scale"]
-    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith("count_fields.") and n != "box_scale"]
+    # parameters added to a trained model (at zero) learn at their own multiple of the rate, without decay
+    added = (("count_fields.", cfg.count_lr_scale), ("box_scale", cfg.box_lr_scale))
+    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith(tuple(a for a, _ in added))]
     groups = [{"params": [p for n, p in rest if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": 1.0},
               {"params": [p for n, p in rest if p.dim() < 2], "weight_decay": 0.0, "scale": 1.0}]
-    if counts:
-        groups.append({"params": counts, "weight_decay": 0.0, "scale": cfg.count_lr_scale})
-    if box:
-        groups.append({"params": box, "weight_decay": 0.0, "scale": cfg.box_lr_scale})
+    for prefix, scale in added:
+        params = [p for n, p in model.named_parameters() if n.startswith(prefix)]
+        if params:
+            groups.append({"params": params, "weight_decay": 0.0, "scale": scale})
     opt = torch.optim.AdamW(groups, lr=cfg.lr, betas=(0.9, 0.98))
     if saved is not None:
         opt.load_state_dict(saved["optimizer"])
