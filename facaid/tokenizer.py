@@ -4,8 +4,9 @@ Input: each rectangle of the flattened segmentation (footprint layer plus elemen
 (label, x, y, w, h), quantized at ``coord_bins`` steps of the image size, with a bottom-left origin and sorted
 by y then x; a first row carries the image's aspect ratio. The model embeds a row either as five tokens or as
 one token whose five field embeddings are summed (``TokenizerConfig.rect_tokens``). With
-``TokenizerConfig.count_features`` a row has four more fields, its peer counts (`peer_counts`): how many
-rectangles of its label share its row and its column, and its rank among them, which repeat counts follow.
+``TokenizerConfig.count_features`` a row has four more fields per peer rule (``peer_rule``), its peer counts
+(`peer_counts`): how many rectangles of its label share its row and its column, and its rank among them, which
+repeat counts follow.
 
 Output: the derivation tree in breadth-first order, each node a group of tokens:
 
@@ -63,14 +64,24 @@ class TokenizerConfig:
     max_out: int = 1024
     rect_tokens: int = 1  # 1: one token per rectangle (summed field embeddings); 5: one per field
     count_features: bool = False  # four more input fields per rectangle: `peer_counts`
+    peer_rule: str = "overlap"  # who is a peer (`peer_counts`): "overlap", "shape", or both, "overlap+shape"
 
     def __post_init__(self) -> None:
         if self.count_features and self.rect_tokens != 1:
             raise ValueError("count_features need rect_tokens = 1 (the fields of a rectangle summed in one token)")
+        rules = self.peer_rules
+        if any(r not in PEER_RULES for r in rules) or len(set(rules)) != len(rules):
+            raise ValueError(f"peer_rule must be one or more of {', '.join(PEER_RULES)} joined by '+', "
+                             f"got {self.peer_rule!r}")
+
+    @property
+    def peer_rules(self) -> tuple[str, ...]:
+        """The peer rules whose counts the rows carry, four fields each (with ``count_features``)."""
+        return tuple(self.peer_rule.split("+"))
 
     @property
     def input_fields(self) -> int:
-        return 9 if self.count_features else 5
+        return 5 + 4 * len(self.peer_rules) if self.count_features else 5
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -125,26 +136,45 @@ class Vocabulary:
 # --- quantization -------------------------------------------------------------------------------------------------
 
 MAX_PEERS = 64  # peer counts and ranks are clipped here
+PEER_RULES = ("overlap", "shape")
+SHAPE_TOLERANCE = 0.25  # "shape" peers: edges and sizes agree within this share of the larger extent
 
 
-def peer_counts(arr: np.ndarray) -> np.ndarray:
+def peer_counts(arr: np.ndarray, rule: str = "overlap") -> np.ndarray:
     """(N, 4) int64 for int rows (label, x0, y0, x1, y1), y down: the number of rectangles of the same label
-    in the row's row (vertical overlap >= half the lower height, itself included) and its rank in it from the
-    left, then the same for its column (horizontal overlap, rank from the bottom). A window in a grid of 5 floors
-    by 6 bays gets (6, bay, 5, floor): the counts a repeat needs, which the model would otherwise have to count
-    by attention. Peers by overlap rather than equal edges, so that edges moved a little keep the counts (a
-    rectangle that noise breaks into pieces changes them)."""
+    in the row's row, itself included, and its rank in it from the left, then the same for its column (rank
+    from the bottom). A window in a grid of 5 floors by 6 bays gets (6, bay, 5, floor): the counts a repeat
+    needs, which the model would otherwise have to count by attention.
+
+    ``rule`` says who is in a row (a column likewise, the axes swapped):
+    - "overlap": vertical overlap >= half the lower height. Peers by overlap rather than equal edges, so that
+      edges moved a little keep the counts (a rectangle that noise breaks into pieces changes them).
+    - "shape": a translate along the row, within `SHAPE_TOLERANCE`: top and bottom edges and width agree to a
+      quarter of the larger height or width. The copies of one repeat are peers, the windows of the next
+      building in the same row (another floor height, another window size) are not, nor a floor's windows
+      and the taller ones of the floor below, which a repeat of floors does not count either."""
     if len(arr) == 0:
         return np.zeros((0, 4), dtype=np.int64)
+    if rule not in PEER_RULES:
+        raise ValueError(f"peer rule must be one of {', '.join(PEER_RULES)}, got {rule!r}")
     a = np.asarray(arr, dtype=np.float64)
     same = a[:, 0][:, None] == a[:, 0][None, :]
     order = np.arange(len(a))  # ties in position rank by row order
     out = []
     for lo, hi, rank_lo, rank_hi, sign in ((2, 4, 1, 3, 1.0), (1, 3, 2, 4, -1.0)):
-        # peers overlap on the (lo, hi) axis; rank on the other axis (x from the left, y from the bottom)
-        overlap = np.minimum(a[:, hi][:, None], a[:, hi][None, :]) - np.maximum(a[:, lo][:, None], a[:, lo][None, :])
+        # peers share the (lo, hi) axis's span; rank on the other axis (x from the left, y from the bottom)
         extent = a[:, hi] - a[:, lo]
-        peers = same & (overlap >= 0.5 * np.minimum(extent[:, None], extent[None, :])) & (overlap > 0)
+        if rule == "overlap":
+            overlap = (np.minimum(a[:, hi][:, None], a[:, hi][None, :])
+                       - np.maximum(a[:, lo][:, None], a[:, lo][None, :]))
+            peers = same & (overlap >= 0.5 * np.minimum(extent[:, None], extent[None, :])) & (overlap > 0)
+        else:
+            length = a[:, rank_hi] - a[:, rank_lo]  # the size along the row
+
+            def near(v: np.ndarray, scale: np.ndarray) -> np.ndarray:
+                return np.abs(v[:, None] - v[None, :]) <= SHAPE_TOLERANCE * np.maximum(scale[:, None], scale[None, :])
+
+            peers = same & near(a[:, lo], extent) & near(a[:, hi], extent) & near(length, length)
         centre = sign * (a[:, rank_lo] + a[:, rank_hi])
         before = peers & ((centre[None, :] < centre[:, None])
                           | ((centre[None, :] == centre[:, None]) & (order[None, :] < order[:, None])))
@@ -372,11 +402,11 @@ class Tokenizer:
     @property
     def input_vocab_sizes(self) -> tuple[int, ...]:
         """Sizes of the field embeddings: label (incl. the <image> row), x, y, w, h, and with
-        ``count_features`` the four `peer_counts`."""
+        ``count_features`` the four `peer_counts` of each peer rule."""
         c = self.config
         sizes = (len(LABELS) + 1, max(c.coord_bins, c.aspect_bins), c.coord_bins, c.coord_bins + 1,
                  c.coord_bins + 1)
-        return sizes + (MAX_PEERS + 1, MAX_PEERS) * 2 if c.count_features else sizes
+        return sizes + (MAX_PEERS + 1, MAX_PEERS) * 2 * len(c.peer_rules) if c.count_features else sizes
 
     def encode_segmentation(self, seg: Segmentation) -> np.ndarray:
         """(N + 1, F) int64 rows (label, x, y, w, h[, peer counts]); row 0 is the <image> row with the aspect
@@ -392,7 +422,7 @@ class Tokenizer:
         c = self.config
         rows = np.concatenate([arr[:, :1].astype(np.int64), self.quantize_boxes(arr[:, 1:], width, height)], 1)
         if c.count_features:
-            rows = np.concatenate([rows, peer_counts(arr)], 1)
+            rows = np.concatenate([rows, *(peer_counts(arr, rule) for rule in c.peer_rules)], 1)
         rows = rows[np.lexsort((rows[:, 1], rows[:, 2]))]
         aspect = math.log(width / height)  # in [-log 16, log 16] for sane images
         qa = min(c.aspect_bins - 1, max(0, round((aspect / math.log(16) + 1) / 2 * (c.aspect_bins - 1))))

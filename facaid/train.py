@@ -15,7 +15,7 @@ import multiprocessing
 import random
 import time
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
@@ -23,16 +23,16 @@ import torch
 from tqdm import tqdm
 
 from facaid.evaluation.noise import jitter
-from facaid.generator import generate
+from facaid.generator import STYLE_NAMES, generate
 from facaid.generator.dataset import sample_seed
 from facaid.model import (
     FacaidConfig,
     FacaidModel,
+    adapt_to_tokenizer,
     batch_inputs,
     batch_outputs,
     load_model,
     save_model,
-    widen_for_counts,
     with_box_bias,
 )
 from facaid.tokenizer import Tokenizer, TokenizerConfig
@@ -63,6 +63,26 @@ class TrainConfig:
     count_lr_scale: float = 1.0  # the peer counts' embeddings learn at this multiple of the learning rate (a
     # model widened for them starts them at zero while the rest is trained already)
     box_lr_scale: float = 1.0  # the same for the box bias's per-head scales (`FacaidConfig.box_bias`)
+    style_weights: dict[str, float] = field(default_factory=dict)  # relative weight of generator styles in the
+    # training samples (a style not named weighs 1; empty: the generator's own choice, each style alike)
+
+    def __post_init__(self) -> None:
+        unknown = set(self.style_weights) - set(STYLE_NAMES)
+        if unknown:
+            raise ValueError(f"style_weights: unknown style(s) {', '.join(sorted(unknown))}; expected some of "
+                             f"{', '.join(STYLE_NAMES)}")
+        weights = self.style_weights.values()
+        if not all(isinstance(w, int | float) and math.isfinite(w) and w >= 0 for w in weights):
+            raise ValueError(f"style_weights must be finite numbers >= 0, got {self.style_weights}")
+        if self.style_weights and sum(self.styles) <= 0:
+            raise ValueError("style_weights: at least one style must weigh more than 0")
+
+    @property
+    def styles(self) -> tuple[float, ...] | None:
+        """The weight of each of `STYLE_NAMES` in order, or None for the generator's own choice."""
+        if not self.style_weights:
+            return None
+        return tuple(float(self.style_weights.get(name, 1.0)) for name in STYLE_NAMES)
 
 
 def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
@@ -94,16 +114,26 @@ def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainC
 _worker: dict = {}
 
 
-def _init_worker(tok_config: dict, noise: tuple[float, float]) -> None:
+def _init_worker(tok_config: dict, noise: tuple[float, float], styles: tuple[float, ...] | None) -> None:
     torch.set_num_threads(1)
-    _worker.update(tokenizer=Tokenizer(TokenizerConfig(**tok_config)), noise=noise)
+    _worker.update(tokenizer=Tokenizer(TokenizerConfig(**tok_config)), noise=noise, styles=styles)
 
 
-def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float, float] = (0.0, 0.0)):
+def sample_style(seed: int, index: int, styles: tuple[float, ...] | None) -> str | None:
+    """The style of sample ``index`` of dataset ``seed`` drawn with weights ``styles`` (one per `STYLE_NAMES`),
+    seeded by the sample; None (the generator's own choice) without weights."""
+    if styles is None:
+        return None
+    return random.Random(f"facaid-style:{seed}:{index}").choices(STYLE_NAMES, weights=styles)[0]
+
+
+def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float, float] = (0.0, 0.0),
+                 styles: tuple[float, ...] | None = None):
     """The training example of sample ``index`` of dataset ``seed``: (rows, (ids, local, boxes)), or None when
     the facade is too long for the model. ``noise`` = (share, sigma): that share of the inputs get their edges
-    jittered (`facaid.evaluation.noise.jitter`, sigma uniform in [0, sigma]), seeded by the sample."""
-    s = generate(sample_seed(seed, index))
+    jittered (`facaid.evaluation.noise.jitter`, sigma uniform in [0, sigma]), seeded by the sample. ``styles``:
+    weights of the generator styles (`sample_style`)."""
+    s = generate(sample_seed(seed, index), sample_style(seed, index, styles))
     c = tokenizer.config
     target = tokenizer.encode_target(s.procedure)
     if len(target[0]) > c.max_out:
@@ -122,7 +152,7 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
 
 
 def _worker_example(args: tuple[int, int]):
-    return make_example(_worker["tokenizer"], *args, noise=_worker["noise"])
+    return make_example(_worker["tokenizer"], *args, noise=_worker["noise"], styles=_worker["styles"])
 
 
 class SampleStream:
@@ -132,8 +162,9 @@ class SampleStream:
     order, as in one process."""
 
     def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0, workers: int = 0,
-                 noise: tuple[float, float] = (0.0, 0.0)):
+                 noise: tuple[float, float] = (0.0, 0.0), styles: tuple[float, ...] | None = None):
         self.tokenizer = tokenizer
+        self.styles = styles
         self.seed = seed
         self.index = start
         self.skipped = 0
@@ -142,10 +173,11 @@ class SampleStream:
         self.pool = None
         if workers > 0:
             ctx = multiprocessing.get_context("spawn")  # no fork after CUDA or torch threads have started
-            self.pool = ctx.Pool(workers, initializer=_init_worker, initargs=(tokenizer.config.to_dict(), noise))
+            self.pool = ctx.Pool(workers, initializer=_init_worker,
+                                 initargs=(tokenizer.config.to_dict(), noise, styles))
 
     def example(self, index: int):
-        return make_example(self.tokenizer, self.seed, index, self.noise)
+        return make_example(self.tokenizer, self.seed, index, self.noise, self.styles)
 
     def __next__(self):
         while True:
@@ -249,15 +281,15 @@ _ARCHITECTURE = ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", 
 
 def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig, device) -> FacaidModel:
     """The weights of checkpoint ``path`` for a fine-tuning run; its architecture and tokenizer must be the
-    config's, except that a config with ``count_features`` or ``box_bias`` may start from a checkpoint without
-    them (`widen_for_counts`, `with_box_bias`: what they add starts at zero)."""
+    config's, except that the config may add what starts out computing what the checkpoint computed: peer
+    counts, finer coordinates (`adapt_to_tokenizer`) and the box bias (`with_box_bias`)."""
     model, tokenizer = load_model(path, device)
-    if tok_cfg.count_features and not tokenizer.config.count_features:
-        model, tokenizer = widen_for_counts(model, tokenizer)
+    try:
+        model, tokenizer = adapt_to_tokenizer(model, tokenizer, tok_cfg)
+    except ValueError as e:
+        raise ValueError(f"train.init {path} was trained with another tokenizer config: {e}") from e
     if model_cfg.box_bias and not model.config.box_bias:
         model = with_box_bias(model)
-    if tokenizer.config != tok_cfg:
-        raise ValueError(f"train.init {path} was trained with another tokenizer config")
     differ = [k for k in _ARCHITECTURE if getattr(model.config, k) != getattr(model_cfg, k)]
     if differ:
         raise ValueError(f"train.init {path} has another architecture ({', '.join(differ)} differ from [model])")
@@ -317,7 +349,7 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     # clean inputs, in this process (a second or two): the loss stays comparable across runs
     val = SampleStream(tokenizer, cfg.val_seed).take(cfg.val_count)
     stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"], workers=cfg.workers,
-                          noise=(cfg.noise, cfg.noise_sigma))
+                          noise=(cfg.noise, cfg.noise_sigma), styles=cfg.styles)
     stream.skipped = state["skipped"]
     batches = PooledBatches(stream, cfg.batch_size, cfg.pool_batches, cfg.seed, state["batches"])
     stop = min(cfg.steps, until) if until is not None else cfg.steps

@@ -1,14 +1,17 @@
 import json
 from dataclasses import replace
 
+import numpy as np
 import pytest
 import torch
 
 from facaid.generator import generate
+from facaid.generator.dataset import sample_seed
 from facaid.labels import LABELS
 from facaid.model import (
     FacaidConfig,
     FacaidModel,
+    adapt_to_tokenizer,
     batch_inputs,
     batch_outputs,
     load_model,
@@ -114,6 +117,71 @@ def test_box_bias_starts_at_zero_and_leans_on_the_rectangles_in_the_node_box(tmp
     five, five_tok = tiny(rect_tokens=5)
     rects5 = batch(five_tok, [4])[0]
     assert with_box_bias(five).memory_boxes(rects5).shape == (1, rects5.shape[1] * 5, 5)
+
+
+def test_finer_coordinates_read_positions_as_before_and_sizes_between_two_steps_as_their_mean():
+    model, tok = tiny()
+    model.eval()
+    fine_cfg = replace(tok.config, coord_bins=256, aspect_bins=128)
+    fine, fine_tok = adapt_to_tokenizer(model, tok, fine_cfg)
+    assert fine_tok.config == fine_cfg and fine.config.tokenizer_config == fine_cfg
+    x, fx = model.fields[1].weight, fine.fields[1].weight
+    assert fx.shape[0] == 256 and all(torch.equal(fx[j], x[j // 2]) for j in range(256))
+    w, fw = model.fields[3].weight, fine.fields[3].weight
+    assert fw.shape[0] == 257 and torch.equal(fw[0], w[0]) and torch.equal(fw[1], w[1])
+    assert all(torch.equal(fw[2 * n], w[n]) for n in range(1, 129))
+    assert all(torch.allclose(fw[2 * n + 1], (w[n] + w[n + 1]) / 2) for n in range(1, 128))
+    # with the size tables blanked, a square image's rectangles give the same memory at 128 and 256 steps
+    for m in (model, fine):
+        for f in (3, 4):
+            torch.nn.init.zeros_(m.fields[f].weight)
+    arr = np.array([[1, 0, 0, 300, 300], [2, 37, 41, 95, 120], [2, 151, 41, 209, 120], [3, 120, 200, 180, 300]])
+    coarse_rows, fine_rows = tok.encode_rect_array(300, 300, arr), fine_tok.encode_rect_array(300, 300, arr)
+    assert not (coarse_rows[1:, 1:3] == fine_rows[1:, 1:3]).all()
+    with torch.no_grad():
+        a, _ = model.encode(*batch_inputs([coarse_rows]))
+        b, _ = fine.encode(*batch_inputs([fine_rows]))
+    assert torch.allclose(a, b, atol=1e-6)
+
+
+def test_added_peer_rules_start_at_zero_and_what_cannot_be_adapted_is_refused():
+    tc = TokenizerConfig(max_rects=1000, count_features=True)
+    torch.manual_seed(0)
+    model, tok = FacaidModel(FacaidConfig(tokenizer=tc.to_dict(), **TINY)).eval(), Tokenizer(tc)
+    both, both_tok = adapt_to_tokenizer(model, tok, replace(tc, peer_rule="overlap+shape"))
+    rows, both_rows = batch(tok, [4, 5]), batch(both_tok, [4, 5])
+    assert rows[0].shape[-1] == 9 and both_rows[0].shape[-1] == 13
+    assert torch.equal(rows[0], both_rows[0][..., :9])
+    with torch.no_grad():
+        assert torch.equal(model(*rows[:4], boxes=rows[5])[0], both(*both_rows[:4], boxes=both_rows[5])[0])
+    assert len(both.count_fields) == 8 and not any(e.weight.any() for e in both.count_fields[4:])
+    for target, message in ((replace(tc, coord_bins=192, aspect_bins=96), "integer factor finer"),
+                            (replace(tc, coord_bins=256), "coord_bins and aspect_bins alike"),
+                            (replace(tc, peer_rule="shape"), "added after the ones read now"),
+                            (replace(tc, size_bins=64), "another size_bins")):
+        with pytest.raises(ValueError, match=message):
+            adapt_to_tokenizer(model, tok, target)
+    with pytest.raises(ValueError, match="added after the ones read now: overlap\\+shape -> overlap"):
+        adapt_to_tokenizer(both, both_tok, tc)
+
+
+def test_the_shipped_weights_adapted_to_finer_coordinates_keep_their_loss():
+    from facaid.train import SampleStream
+
+    model, tok = load_model(DEFAULT_CHECKPOINT)
+    c = tok.config
+    fine, fine_tok = adapt_to_tokenizer(model, tok, replace(c, coord_bins=2 * c.coord_bins,
+                                                            aspect_bins=2 * c.aspect_bins))
+
+    def loss(m, t):
+        examples = SampleStream(t, seed=2).take(16)
+        rects, mask = batch_inputs([e[0] for e in examples])
+        ids, local, targets, boxes = batch_outputs([e[1] for e in examples])
+        with torch.no_grad():
+            return m(rects, mask, ids, local, targets, boxes)[1].item()
+
+    before, after = loss(model, tok), loss(fine, fine_tok)
+    assert after < 1.15 * before, (before, after)
 
 
 def test_padding_does_not_change_a_sequence():
@@ -227,8 +295,11 @@ def test_committed_configs_build_the_shipped_architecture(name):
     for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes"):
         assert getattr(model_config, key) == shipped[key], key
     shipped_tok = TokenizerConfig(**shipped["tokenizer"])
-    # the configs before configs/finetune-counts.toml read no peer counts; the rest of the tokenizer is the same
-    assert replace(tok_config, count_features=shipped_tok.count_features) == shipped_tok
+    # the configs before configs/finetune-counts.toml read no peer counts, those before configs/finetune-fine.toml
+    # coarser coordinates and one peer rule (`adapt_to_tokenizer` took each to the next); the rest is the same
+    assert shipped_tok.coord_bins % tok_config.coord_bins == 0
+    assert replace(tok_config, count_features=shipped_tok.count_features, peer_rule=shipped_tok.peer_rule,
+                   coord_bins=shipped_tok.coord_bins, aspect_bins=shipped_tok.aspect_bins) == shipped_tok
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
 
 
@@ -272,6 +343,35 @@ def test_noisy_inputs_keep_the_clean_target_and_are_seeded():
         assert repr(noisy[1]) == repr(clean[1])  # the target: the clean procedure
         assert repr(noisy[0]) != repr(clean[0])  # the input: edges moved
         assert repr(make_example(tok, 3, index, noise=(0.0, 0.006))) == repr(clean)
+
+
+def test_style_weights_draw_the_styles_of_the_samples(tmp_path):
+    from facaid.generator import STYLE_NAMES
+    from facaid.train import TrainConfig, make_example, sample_style
+
+    cfg = TrainConfig(style_weights={"wings": 3.0, "house": 0.0})
+    assert cfg.styles == tuple({"wings": 3.0, "house": 0.0}.get(n, 1.0) for n in STYLE_NAMES)
+    assert TrainConfig().styles is None and sample_style(1, 0, None) is None
+    drawn = [sample_style(1, i, cfg.styles) for i in range(1600)]
+    assert drawn == [sample_style(1, i, cfg.styles) for i in range(1600)]  # seeded by the sample
+    assert "house" not in drawn and 0.30 < drawn.count("wings") / len(drawn) < 0.45  # 3/7 expected
+    # the examples follow the drawn styles
+    tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=768))
+    only_wings = tuple(1.0 if n == "wings" else 0.0 for n in STYLE_NAMES)
+    example = next(ex for i in range(8) if (ex := make_example(tok, 3, i, styles=only_wings)) is not None)
+    index = next(i for i in range(8) if make_example(tok, 3, i, styles=only_wings) is not None)
+    assert repr(example[1]) == repr(tok.encode_target(generate(sample_seed(3, index), "wings").procedure))
+    for weights, message in (({"gothic": 1.0}, "unknown style"), ({"wings": -1.0}, "finite numbers >= 0"),
+                             ({"wings": float("nan")}, "finite numbers >= 0"),
+                             ({n: 0.0 for n in STYLE_NAMES}, "at least one style")):
+        with pytest.raises(ValueError, match=message):
+            TrainConfig(style_weights=weights)
+    toml = tmp_path / "w.toml"
+    toml.write_text('[train]\nstyle_weights = { wings = 2.5 }\n')
+    assert load_config(toml)[2].style_weights == {"wings": 2.5}
+    toml.write_text('[train]\nstyle_weights = { wings = "many" }\n')
+    with pytest.raises(ValueError, match="finite numbers >= 0"):
+        load_config(toml)
 
 
 def test_fine_tuning_starts_from_a_checkpoint(tmp_path):

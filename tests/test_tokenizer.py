@@ -75,6 +75,39 @@ def test_peer_counts_of_a_window_grid():
     assert (peer_counts(moved) == counts).all()
 
 
+def test_shape_peers_leave_out_the_next_building_in_the_row():
+    # one row across two buildings: 4 windows 60 px wide from y 100 to 180, then 3 windows 40 px wide from 110
+    # to 170 (another floor height): by overlap all 7 are peers, by shape 4 and 3; an odd window among the 4
+    # (twice as wide) is a peer of none by shape
+    left = [[2, 20 + 100 * c, 100, 80 + 100 * c, 180] for c in range(4)]
+    right = [[2, 420 + 70 * c, 110, 460 + 70 * c, 170] for c in range(3)]
+    rows = np.array([*left, *right])
+    overlap, shape = peer_counts(rows, "overlap"), peer_counts(rows, "shape")
+    assert overlap[:, 0].tolist() == [7] * 7 and overlap[:, 1].tolist() == list(range(7))
+    assert shape[:, 0].tolist() == [4] * 4 + [3] * 3 and shape[:, 1].tolist() == [0, 1, 2, 3, 0, 1, 2]
+    assert shape[:, 2].tolist() == [1] * 7  # one per column
+    wide = rows.copy()
+    wide[1, 3] += 60
+    assert peer_counts(wide, "shape")[:, 0].tolist() == [3, 1, 3, 3, 3, 3, 3]
+    # edges moved by up to 8 px (a tenth of a window's height): the same counts
+    moved = rows + np.random.default_rng(1).integers(-4, 5, rows.shape) * [0, 1, 1, 1, 1]
+    assert (peer_counts(moved, "shape") == shape).all()
+    with pytest.raises(ValueError, match="peer rule must be one of overlap, shape"):
+        peer_counts(rows, "size")
+
+
+def test_two_peer_rules_give_eight_count_fields():
+    seg = generate(5).segmentation
+    both = Tokenizer(TokenizerConfig(max_rects=2000, count_features=True, peer_rule="overlap+shape"))
+    one = Tokenizer(TokenizerConfig(max_rects=2000, count_features=True))
+    rows = both.encode_segmentation(seg)
+    assert both.config.input_fields == rows.shape[1] == 13 and len(both.input_vocab_sizes) == 13
+    assert (rows[:, :9] == one.encode_segmentation(seg)).all()
+    for bad in ("shape+shape", "overlap+", "size"):
+        with pytest.raises(ValueError, match="peer_rule must be one or more of overlap, shape"):
+            TokenizerConfig(peer_rule=bad)
+
+
 def test_peer_counts_ride_on_the_rows():
     seg = generate(5).segmentation
     counting = Tokenizer(TokenizerConfig(max_rects=2000, max_out=2000, count_features=True))

@@ -2,8 +2,9 @@
 
 The builder decides in metres whether a gap of wall exists (the wall under a sill, the padding beside a window,
 a strip of sky). Once the facade is scaled to pixels many of these gaps are narrower than a segmentation shows
-reliably (the model reads coordinates in 128 steps of the image side), so one picture would come from two trees
-and no model could tell which one to write. `canonical` removes such leaves: wall and background (which the
+reliably (the first models read coordinates in 128 steps of the image side; the shipped one reads 256, so a gap
+that is kept is two steps wide at least), so one picture would come from two trees and no model could tell which
+one to write. `canonical` removes such leaves: wall and background (which the
 model never sees as rectangles of their own) narrower than `MIN_GAP` of the image side along their parent's axis,
 and any leaf under one pixel (rounding drops it from the segmentation). A split or centred mirror left with one
 child gives way to that child, which takes over its role if it has none, and always takes over a `SLOT_ROLES`
@@ -16,7 +17,7 @@ from __future__ import annotations
 from facaid.grammar.execute import first_boxes
 from facaid.grammar.procedure import Node, Procedure, Size, validate
 
-MIN_GAP = 1 / 128  # of the image side: narrower wall or background is invisible in the model's input
+MIN_GAP = 1 / 128  # of the image side: narrower wall or background is not part of the canonical tree
 IMPLICIT = ("facade", "background")
 SLOT_ROLES = ("floor", "ground")  # roles of a slot in the facade's layout, whatever node fills it
 
