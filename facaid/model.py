@@ -273,7 +273,8 @@ def adapt_to_tokenizer(model: FacaidModel, tokenizer: Tokenizer, target: Tokeniz
     rest = replace(target, coord_bins=src.coord_bins, aspect_bins=src.aspect_bins,
                    count_features=src.count_features, peer_rule=src.peer_rule)
     if rest != src:
-        differ = [f for f, v in src.to_dict().items() if rest.to_dict()[f] != v]
+        wanted = rest.to_dict()
+        differ = [f for f, v in src.to_dict().items() if wanted[f] != v]
         raise ValueError(f"cannot adapt the model to another {', '.join(differ)}")
     config = copy.deepcopy(model.config)
     config.tokenizer = target.to_dict()

@@ -140,6 +140,11 @@ PEER_RULES = ("overlap", "shape")
 SHAPE_TOLERANCE = 0.25  # "shape" peers: edges and sizes agree within this share of the larger extent
 
 
+def _near(v: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """(N, N): pairs whose values ``v`` differ by at most `SHAPE_TOLERANCE` of the larger of their ``scale``."""
+    return np.abs(v[:, None] - v[None, :]) <= SHAPE_TOLERANCE * np.maximum(scale[:, None], scale[None, :])
+
+
 def peer_counts(arr: np.ndarray, rule: str = "overlap") -> np.ndarray:
     """(N, 4) int64 for int rows (label, x0, y0, x1, y1), y down: the number of rectangles of the same label
     in the row's row, itself included, and its rank in it from the left, then the same for its column (rank
@@ -170,11 +175,7 @@ def peer_counts(arr: np.ndarray, rule: str = "overlap") -> np.ndarray:
             peers = same & (overlap >= 0.5 * np.minimum(extent[:, None], extent[None, :])) & (overlap > 0)
         else:
             length = a[:, rank_hi] - a[:, rank_lo]  # the size along the row
-
-            def near(v: np.ndarray, scale: np.ndarray) -> np.ndarray:
-                return np.abs(v[:, None] - v[None, :]) <= SHAPE_TOLERANCE * np.maximum(scale[:, None], scale[None, :])
-
-            peers = same & near(a[:, lo], extent) & near(a[:, hi], extent) & near(length, length)
+            peers = same & _near(a[:, lo], extent) & _near(a[:, hi], extent) & _near(length, length)
         centre = sign * (a[:, rank_lo] + a[:, rank_hi])
         before = peers & ((centre[None, :] < centre[:, None])
                           | ((centre[None, :] == centre[:, None]) & (order[None, :] < order[:, None])))
