@@ -15,7 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from facaid.defaults import DEFAULT_K, TEMPERATURE
+from facaid.defaults import DEFAULT_K, FLOOR_TOLERANCE, TEMPERATURE
+from facaid.generator.canonical import merge_repeated_floors
 from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.incremental import IncrementalDecoder
@@ -102,8 +103,12 @@ def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> 
 def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: int = 1, sample: bool = False,
            temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None,
            max_len: int | None = None, constrained: bool = True, greedy: int = 0,
-           incremental: bool = True) -> list[Candidate]:
+           incremental: bool = True, merge_floors: bool = True) -> list[Candidate]:
     """K candidate procedures for a segmentation (greedy when ``sample`` is False; then K copies are equal).
+
+    With ``merge_floors`` (and no ``prefix``), neighbouring floors with the same tree and sizes within
+    `FLOOR_TOLERANCE` become one repeat, as in the canonical trees (`merge_repeated_floors`); the candidate's
+    ids are then those of the merged tree, its log-probability that of the decoded sequence.
 
     With ``sample``, the first ``greedy`` rows are still decoded greedily, in the same batch as the samples.
     ``incremental`` (in eval mode) steps with `IncrementalDecoder`; False runs the Hugging Face modules.
@@ -189,6 +194,11 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
             raise RuntimeError(f"candidate {b} did not finish within {max_len} tokens")
         seq = seqs[b][: seqs[b].index(EOS) + 1]
         proc = g.procedure()
+        if merge_floors and not prefix:
+            nodes = sum(1 for _ in proc.root.bfs())
+            proc.root = merge_repeated_floors(proc.root, FLOOR_TOLERANCE)
+            if sum(1 for _ in proc.root.bfs()) != nodes:
+                seq = tokenizer.encode_procedure(proc)[0]
         proc.meta = {"source": "model"}
         out.append(Candidate(seq, float(logprob[b]), proc))
     return out

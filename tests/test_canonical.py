@@ -3,7 +3,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.generator.canonical import IMPLICIT, MIN_GAP, canonical, merge_floor_runs, structure
+from facaid.generator.canonical import IMPLICIT, MIN_GAP, canonical, merge_floor_runs, merge_repeated_floors, structure
 from facaid.grammar import Procedure, execute
 from facaid.grammar.execute import first_boxes, leaf_array
 from facaid.grammar.procedure import Node, Size
@@ -122,6 +122,58 @@ def test_runs_of_floors_that_look_alike_become_one_repeat():
     proc = canonical(Procedure(300, 900, alike))
     assert (proc.root.rule, proc.root.count, proc.root.role) == ("repeat", 3, "floors")
     assert len(execute(proc)) > 0
+
+
+def _unrolled(node):
+    """A tree drawing the same picture with every repeat of floors written out as single floors."""
+    node.children = [_unrolled(c) for c in node.children]
+    if node.rule == "split" and node.role == "floors":
+        sizes, children = [], []
+        for size, child in zip(node.sizes, node.children, strict=True):
+            if child.rule == "repeat" and child.role == "floors" and len(child.children) == 1:
+                for _ in range(child.count):
+                    sizes.append(Size("flt", size.value / child.count))
+                    copy = child.children[0].copy()
+                    copy.role = copy.role or "floor"
+                    children.append(copy)
+            else:
+                sizes.append(size)
+                children.append(child)
+        node.sizes, node.children = sizes, children
+    return node
+
+
+def test_decoded_floors_written_out_merge_back_into_the_canonical_repeat():
+    found = 0
+    for seed in range(60):
+        proc = generate_procedure(seed)
+        floors = [n for n in proc.root.bfs() if n.rule == "split" and n.role == "floors"]
+        runs = [c for n in floors for c in n.children if c.rule == "repeat" and len(c.children) == 1]
+        if not runs:
+            continue
+        found += 1
+        root = _unrolled(proc.root.copy())
+        assert structure(root) != structure(proc.root)
+        merged = merge_repeated_floors(root, tolerance=0.25)
+        assert structure(merged) == structure(proc.root), seed
+        picture = leaf_array(proc)
+        assert np.array_equal(leaf_array(Procedure(proc.width, proc.height, merged)), picture)
+    assert found >= 5
+
+
+def test_floors_of_other_sizes_stay_apart_under_a_tolerance():
+    def floor(window_h):
+        return Node.split("y", [(Size("flt", 10), wall()), (Size("abs", window_h), Node.leaf("window"))],
+                          role="floor")
+
+    def floors(*heights):
+        return Node.split("y", [(Size("flt", 30), floor(h)) for h in heights], role="floors")
+
+    lone = merge_repeated_floors(Node.split("x", [(Size("flt", 1), floors(20, 22))]), tolerance=0.25)
+    assert (lone.children[0].rule, lone.children[0].count, lone.children[0].role) == ("repeat", 2, "floors")
+    apart = merge_repeated_floors(floors(20, 30, 31), tolerance=0.25)  # 20 against 30: a third apart
+    assert [(c.rule, c.count) for c in apart.children] == [("split", None), ("repeat", 2)]
+    assert (merge_repeated_floors(floors(20, 30), tolerance=None).rule, ) == ("repeat", )  # no size check
 
 
 def test_an_entrance_in_the_middle_of_an_odd_row_is_a_mirror():

@@ -32,3 +32,22 @@ def test_a_real_annotation_takes_the_shortcut_to_the_induced_structure(cmp_recor
     longer = reconstruct(seg, k=2, induce=False)  # the model's own structure, sized: far below
     assert not longer.shortcut and longer.accuracy_decoded < FAR_OFF
     assert longer.accuracy < result.accuracy  # sizing it would not have closed the gap
+
+
+@pytest.mark.skipif(not (DEFAULT_CHECKPOINT / "model.safetensors").is_file(), reason="no shipped checkpoint")
+def test_decoded_floors_that_repeat_are_written_as_the_canonical_repeat():
+    from facaid.decoding import decode
+    from facaid.evaluation.ted import tree_edit_distance
+    from facaid.metrics import procedure_accuracy
+
+    model, tokenizer = default_model()
+    sample = generate(72)  # a commercial facade whose greedy tree writes two alike floors one by one
+    plain = decode(model, tokenizer, sample.segmentation, merge_floors=False)[0]
+    merged = decode(model, tokenizer, sample.segmentation)[0]
+    assert len(merged.ids) < len(plain.ids) and merged.logprob == plain.logprob
+    assert merged.ids == tokenizer.encode_procedure(merged.procedure)[0]  # the ids are the merged tree's
+    truth = sample.procedure.root
+    assert tree_edit_distance(truth, merged.procedure.root) < tree_edit_distance(truth, plain.procedure.root)
+    seg = sample.segmentation
+    assert procedure_accuracy(merged.procedure, seg) == pytest.approx(procedure_accuracy(plain.procedure, seg),
+                                                                      abs=0.01)
