@@ -173,7 +173,7 @@ def test_floors_of_other_sizes_stay_apart_under_a_tolerance():
     assert (lone.children[0].rule, lone.children[0].count, lone.children[0].role) == ("repeat", 2, "floors")
     apart = merge_repeated_floors(floors(20, 30, 31), tolerance=0.25)  # 20 against 30: a third apart
     assert [(c.rule, c.count) for c in apart.children] == [("split", None), ("repeat", 2)]
-    assert (merge_repeated_floors(floors(20, 30), tolerance=None).rule, ) == ("repeat", )  # no size check
+    assert merge_repeated_floors(floors(20, 30), tolerance=None).rule == "repeat"  # no size check
 
 
 def test_an_entrance_in_the_middle_of_an_odd_row_is_a_mirror():

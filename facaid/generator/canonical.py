@@ -46,10 +46,7 @@ def canonical(proc: Procedure) -> Procedure:
         if node.rule == "split" and node.role == "floors":
             merge_floor_runs(node)
         if len(node.children) == 1 and (node.rule == "split" or node.center):
-            child = node.children[0]
-            if child.role is None or node.role in SLOT_ROLES:
-                child.role = node.role
-            return child
+            return _lone_child(node)
         return node
 
     proc.root = visit(proc.root)
@@ -100,13 +97,19 @@ def merge_repeated_floors(root: Node, tolerance: float | None = None) -> Node:
         if node.rule == "split" and node.role == "floors":
             merge_floor_runs(node, tolerance)
             if len(node.children) == 1:
-                child = node.children[0]
-                if child.role is None:
-                    child.role = node.role
-                return child
+                return _lone_child(node)
         return node
 
     return visit(root)
+
+
+def _lone_child(node: Node) -> Node:
+    """The only child of a split (or centred mirror), taking its place: it takes over the node's role if it has
+    none, and always a `SLOT_ROLES` role."""
+    child = node.children[0]
+    if child.role is None or node.role in SLOT_ROLES:
+        child.role = node.role
+    return child
 
 
 def _alike(a: list[tuple[Size, Node]], b: list[tuple[Size, Node]], tolerance: float) -> bool:
