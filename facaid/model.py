@@ -306,6 +306,37 @@ def with_box_bias(model: FacaidModel) -> FacaidModel:
     return biased
 
 
+# the projections by which a GPT-2 block writes into the residual stream: zero, the block adds nothing
+_BLOCK_OUTPUTS = ("attn.c_proj.", "crossattention.c_proj.", "mlp.c_proj.")
+
+
+def deepened(model: FacaidModel, decoder_layers: int) -> FacaidModel:
+    """The same model with ``decoder_layers`` decoder blocks: the new ones are appended after the last, each a
+    copy of it whose output projections are zero. The decoder's blocks are pre-layer-norm (GPT-2), so a block
+    that writes nothing into the residual stream passes it on unchanged, and the logits are the same until
+    training moves them; its attention and MLP inputs start as the last block's, not at random. The start of a
+    fine-tune that gives a trained model more capacity."""
+    have = model.config.decoder_layers
+    if decoder_layers <= have:
+        raise ValueError(f"a deepened model needs more than the {have} decoder layers it has, got {decoder_layers}")
+    config = copy.deepcopy(model.config)
+    config.decoder_layers = decoder_layers
+    deep = FacaidModel(config).to(next(model.parameters()).device)
+    state = model.state_dict()
+    last = f"decoder.h.{have - 1}."
+    for i in range(have, decoder_layers):
+        for name, value in list(state.items()):
+            if name.startswith(last):
+                rest = name[len(last):]
+                new = value.clone()
+                if rest.startswith(_BLOCK_OUTPUTS):
+                    new.zero_()
+                state[f"decoder.h.{i}.{rest}"] = new
+    deep.load_state_dict(state, strict=True)
+    deep.train(model.training)
+    return deep
+
+
 def save_model(model: FacaidModel, tokenizer: Tokenizer, path: str | Path) -> None:
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)

@@ -31,6 +31,7 @@ from facaid.model import (
     adapt_to_tokenizer,
     batch_inputs,
     batch_outputs,
+    deepened,
     load_model,
     save_model,
     with_box_bias,
@@ -63,6 +64,8 @@ class TrainConfig:
     count_lr_scale: float = 1.0  # the peer counts' embeddings learn at this multiple of the learning rate (a
     # model widened for them starts them at zero while the rest is trained already)
     box_lr_scale: float = 1.0  # the same for the box bias's per-head scales (`FacaidConfig.box_bias`)
+    grown_lr_scale: float = 1.0  # the same for the decoder blocks appended to the ``init`` checkpoint's
+    # (`facaid.model.deepened`), with weight decay as the rest
     style_weights: dict[str, float] = field(default_factory=dict)  # relative weight of generator styles in the
     # training samples (a style not named weighs 1; empty: the generator's own choice, each style alike)
 
@@ -282,7 +285,8 @@ _ARCHITECTURE = ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", 
 def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig, device) -> FacaidModel:
     """The weights of checkpoint ``path`` for a fine-tuning run; its architecture and tokenizer must be the
     config's, except that the config may add what starts out computing what the checkpoint computed: peer
-    counts, finer coordinates (`adapt_to_tokenizer`) and the box bias (`with_box_bias`)."""
+    counts, finer coordinates (`adapt_to_tokenizer`), the box bias (`with_box_bias`) and decoder blocks
+    (`deepened`)."""
     model, tokenizer = load_model(path, device)
     try:
         model, tokenizer = adapt_to_tokenizer(model, tokenizer, tok_cfg)
@@ -290,6 +294,8 @@ def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig,
         raise ValueError(f"train.init {path} was trained with another tokenizer config: {e}") from e
     if model_cfg.box_bias and not model.config.box_bias:
         model = with_box_bias(model)
+    if model_cfg.decoder_layers > model.config.decoder_layers:
+        model = deepened(model, model_cfg.decoder_layers)
     differ = [k for k in _ARCHITECTURE if getattr(model.config, k) != getattr(model_cfg, k)]
     if differ:
         raise ValueError(f"train.init {path} has another architecture ({', '.join(differ)} differ from [model])")
@@ -316,7 +322,9 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         torch.set_num_threads(cfg.threads)
     torch.manual_seed(cfg.seed)
     tokenizer = Tokenizer(tok_cfg)
-    state = {"step": 0, "sample_index": 0, "skipped": 0, "elapsed": 0.0, "batches": None}
+    # grown_from: the decoder blocks of the init checkpoint, when the config appends more (they learn at
+    # grown_lr_scale); kept in the state so that a resumed run has the same optimizer groups
+    state = {"step": 0, "sample_index": 0, "skipped": 0, "elapsed": 0.0, "batches": None, "grown_from": None}
     if resume and (last / "state.pt").is_file():
         model, tokenizer = load_model(last, device)
         if tokenizer.config != tok_cfg:
@@ -325,6 +333,8 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         state.update(saved["state"])
     elif cfg.init:
         model = _initial_model(cfg.init, model_cfg, tok_cfg, device)
+        have = FacaidConfig.from_pretrained(cfg.init).decoder_layers
+        state["grown_from"] = have if have < model.config.decoder_layers else None
         saved = None
     else:
         model = FacaidModel(model_cfg).to(device)
@@ -332,9 +342,17 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     model.train()
     # parameters added to a trained model (at zero) learn at their own multiple of the rate, without decay
     added = (("count_fields.", cfg.count_lr_scale), ("box_scale", cfg.box_lr_scale))
-    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith(tuple(a for a, _ in added))]
+    # decoder blocks appended to a trained model learn at their own multiple of the rate, with decay
+    grown = tuple(f"decoder.h.{i}." for i in range(state["grown_from"] or model.config.decoder_layers,
+                                                    model.config.decoder_layers))
+    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith(tuple(a for a, _ in added) + grown)]
     groups = [{"params": [p for n, p in rest if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": 1.0},
               {"params": [p for n, p in rest if p.dim() < 2], "weight_decay": 0.0, "scale": 1.0}]
+    if grown:
+        new = [(n, p) for n, p in model.named_parameters() if n.startswith(grown)]
+        groups += [{"params": [p for n, p in new if p.dim() >= 2], "weight_decay": cfg.weight_decay,
+                    "scale": cfg.grown_lr_scale},
+                   {"params": [p for n, p in new if p.dim() < 2], "weight_decay": 0.0, "scale": cfg.grown_lr_scale}]
     for prefix, scale in added:
         params = [p for n, p in model.named_parameters() if n.startswith(prefix)]
         if params:

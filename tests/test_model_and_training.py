@@ -14,6 +14,7 @@ from facaid.model import (
     adapt_to_tokenizer,
     batch_inputs,
     batch_outputs,
+    deepened,
     load_model,
     save_model,
     widen_for_counts,
@@ -117,6 +118,45 @@ def test_box_bias_starts_at_zero_and_leans_on_the_rectangles_in_the_node_box(tmp
     five, five_tok = tiny(rect_tokens=5)
     rects5 = batch(five_tok, [4])[0]
     assert with_box_bias(five).memory_boxes(rects5).shape == (1, rects5.shape[1] * 5, 5)
+
+
+def test_a_deepened_decoder_keeps_the_logits_until_trained(tmp_path):
+    model, tok = with_box_bias(tiny()[0]), tiny()[1]
+    model.eval()
+    deep = deepened(model, 3)
+    assert deep.config.decoder_layers == 3 and len(deep.decoder.h) == 3
+    rects, mask, ids, local, targets, boxes = batch(tok, [4, 5])
+    with torch.no_grad():
+        a, _ = model(rects, mask, ids, local, boxes=boxes)
+        b, _ = deep(rects, mask, ids, local, boxes=boxes)
+    assert torch.equal(a, b)
+    # the new blocks copy the last one but write nothing: their output projections are zero, the rest is a copy
+    last, new = dict(deep.decoder.h[0].named_parameters()), dict(deep.decoder.h[2].named_parameters())
+    for name, p in new.items():
+        if name.startswith(("attn.c_proj.", "crossattention.c_proj.", "mlp.c_proj.")):
+            assert not p.any(), name
+        else:
+            assert torch.equal(p, last[name]) and p.data_ptr() != last[name].data_ptr(), name
+    # they learn: the zero projections get gradients, and one step changes the logits
+    deep.train()
+    _, loss = deep(rects, mask, ids, local, targets, boxes)
+    loss.backward()
+    assert deep.decoder.h[2].mlp.c_proj.weight.grad.abs().sum() > 0
+    with torch.no_grad():
+        deep.decoder.h[2].mlp.c_proj.weight -= 0.5 * deep.decoder.h[2].mlp.c_proj.weight.grad.sign()
+    deep.eval()
+    with torch.no_grad():
+        assert not torch.allclose(deep(rects, mask, ids, local, boxes=boxes)[0], a)
+    # incremental (cached) decoding runs every block
+    from facaid.decoding import decode
+    s = generate(5)
+    fast, slow = (decode(deep, tok, s.segmentation, max_len=80, incremental=flag)[0] for flag in (True, False))
+    assert fast.ids == slow.ids
+    save_model(deep, tok, tmp_path / "deep")
+    again, _ = load_model(tmp_path / "deep")
+    assert again.config.decoder_layers == 3
+    with pytest.raises(ValueError, match="more than the 3 decoder layers it has, got 3"):
+        deepened(again, 3)
 
 
 def test_finer_coordinates_read_positions_as_before_and_sizes_between_two_steps_as_their_mean():
@@ -303,6 +343,19 @@ def test_committed_configs_build_the_shipped_architecture(name):
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
 
 
+@pytest.mark.parametrize("name", sorted(path.stem for path in (ROOT / "configs" / "experiments").glob("*.toml")))
+def test_experiment_configs_start_from_the_shipped_checkpoint(name):
+    """The configs of runs that were tried and not shipped parse, and their init builds the model they train."""
+    from facaid.train import _initial_model
+
+    model_config, tok_config, train_config = load_config(ROOT / "configs" / "experiments" / f"{name}.toml")
+    assert train_config.steps > 0 and train_config.lr > train_config.min_lr
+    assert (ROOT / train_config.init).resolve() == DEFAULT_CHECKPOINT.resolve()
+    model = _initial_model(str(ROOT / train_config.init), model_config, tok_config, "cpu")
+    for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes", "box_bias"):
+        assert getattr(model.config, key) == getattr(model_config, key), key
+
+
 def test_learning_rate_schedule():
     from facaid.train import TrainConfig
 
@@ -414,6 +467,20 @@ def test_fine_tuning_starts_from_a_checkpoint(tmp_path):
         if scale == 0.0:
             assert all(torch.equal(p, a.state_dict()[n]) for n, p in biased.state_dict().items() if n != "box_scale")
     assert box[0.0] == 0.0 and 5 < box[10.0] / box[1.0] < 15
+    # a config that appends decoder blocks starts from the same logits; the new blocks learn at
+    # train.grown_lr_scale, and a resumed run keeps them in their own optimizer groups
+    grown = {}
+    for scale in (1.0, 10.0):
+        write_config(cfg, tmp_path / f"deep-{scale}", steps=2, extra=f'init = "{base}"\ngrown_lr_scale = {scale}')
+        cfg.write_text(cfg.read_text().replace("decoder_layers = 1", "decoder_layers = 2"))
+        deep, _ = load_model(train(cfg, progress=False))
+        grown[scale] = deep.decoder.h[1].mlp.c_proj.weight.abs().max().item()
+    assert 5 < grown[10.0] / grown[1.0] < 15
+    write_config(cfg, tmp_path / "deep-resumed", steps=2, extra=f'init = "{base}"\ngrown_lr_scale = 10.0')
+    cfg.write_text(cfg.read_text().replace("decoder_layers = 1", "decoder_layers = 2"))
+    train(cfg, until=1, progress=False)
+    resumed, _ = load_model(train(cfg, resume=True, progress=False))
+    assert torch.allclose(resumed.decoder.h[1].mlp.c_proj.weight, deep.decoder.h[1].mlp.c_proj.weight, atol=1e-6)
     write_config(cfg, tmp_path / "tuned", steps=0, extra=f'noise = 0.5\ninit = "{base}"')
     text = cfg.read_text()
     cfg.write_text(text.replace("d_model = 16", "d_model = 8"))
