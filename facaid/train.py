@@ -23,7 +23,7 @@ import torch
 from tqdm import tqdm
 
 from facaid.evaluation.noise import jitter
-from facaid.generator import STYLE_NAMES, generate
+from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
 from facaid.model import (
     FacaidConfig,
@@ -67,13 +67,13 @@ class TrainConfig:
     grown_lr_scale: float = 1.0  # the same for the decoder blocks appended to the ``init`` checkpoint's
     # (`facaid.model.deepened`), with weight decay as the rest
     style_weights: dict[str, float] = field(default_factory=dict)  # relative weight of generator styles in the
-    # training samples (a style not named weighs 1; empty: the generator's own choice, each style alike)
+    # training samples (a style not named weighs 1, "wing" 0; empty: the generator's own choice, each style alike)
 
     def __post_init__(self) -> None:
-        unknown = set(self.style_weights) - set(STYLE_NAMES)
+        unknown = set(self.style_weights) - set(TRAINING_STYLES)
         if unknown:
             raise ValueError(f"style_weights: unknown style(s) {', '.join(sorted(unknown))}; expected some of "
-                             f"{', '.join(STYLE_NAMES)}")
+                             f"{', '.join(TRAINING_STYLES)}")
         weights = self.style_weights.values()
         if not all(isinstance(w, int | float) and math.isfinite(w) and w >= 0 for w in weights):
             raise ValueError(f"style_weights must be finite numbers >= 0, got {self.style_weights}")
@@ -82,10 +82,11 @@ class TrainConfig:
 
     @property
     def styles(self) -> tuple[float, ...] | None:
-        """The weight of each of `STYLE_NAMES` in order, or None for the generator's own choice."""
+        """The weight of each of `TRAINING_STYLES` in order, or None for the generator's own choice. "wing" weighs 0
+        unless named: drawn last with no weight, it leaves every other draw as it was."""
         if not self.style_weights:
             return None
-        return tuple(float(self.style_weights.get(name, 1.0)) for name in STYLE_NAMES)
+        return tuple(float(self.style_weights.get(name, 0.0 if name == "wing" else 1.0)) for name in TRAINING_STYLES)
 
 
 def load_config(path: str | Path) -> tuple[FacaidConfig, TokenizerConfig, TrainConfig]:
@@ -123,11 +124,11 @@ def _init_worker(tok_config: dict, noise: tuple[float, float], styles: tuple[flo
 
 
 def sample_style(seed: int, index: int, styles: tuple[float, ...] | None) -> str | None:
-    """The style of sample ``index`` of dataset ``seed`` drawn with weights ``styles`` (one per `STYLE_NAMES`),
+    """The style of sample ``index`` of dataset ``seed`` drawn with weights ``styles`` (one per `TRAINING_STYLES`),
     seeded by the sample; None (the generator's own choice) without weights."""
     if styles is None:
         return None
-    return random.Random(f"facaid-style:{seed}:{index}").choices(STYLE_NAMES, weights=styles)[0]
+    return random.Random(f"facaid-style:{seed}:{index}").choices(TRAINING_STYLES, weights=styles)[0]
 
 
 def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float, float] = (0.0, 0.0),

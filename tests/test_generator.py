@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import facaid.grammar as grammar_pkg
-from facaid.generator import STYLE_NAMES, generate, generate_procedure
+from facaid.generator import STYLE_NAMES, TRAINING_STYLES, generate, generate_procedure
 from facaid.generator.dataset import read_dataset, sample_seed, write_dataset
 from facaid.generator.stats import class_stats, distance, format_table
 from facaid.grammar import Procedure, execute, to_segmentation, validate
@@ -17,7 +17,7 @@ from facaid.labels import LABELS
 from facaid.segmentation import Segmentation, flatten, rasterize
 
 seeds = st.integers(min_value=0, max_value=2**63)
-styles = st.sampled_from((None, *STYLE_NAMES))
+styles = st.sampled_from((None, *TRAINING_STYLES))
 
 
 @settings(max_examples=120, deadline=None)
@@ -95,6 +95,17 @@ def test_every_style_uses_its_signature_elements():
     assert {"shop", "door"} <= labels("commercial")
     roles = {node.role for seed in range(20) for _, node in generate_procedure(seed, "wings").nodes()}
     assert {"facade", "floor", "tile", "ground"} <= roles
+
+
+def test_a_wing_is_one_building_of_the_wings_preset_and_never_drawn_unasked():
+    def facades(proc):
+        return sum(1 for _, node in proc.nodes() if node.role == "facade")
+
+    wings = [generate_procedure(seed, "wings") for seed in range(20)]
+    wing = [generate_procedure(seed, "wing") for seed in range(20)]
+    assert all(facades(p) >= 3 for p in wings)  # the row of buildings and two or three buildings
+    assert all(facades(p) == 1 and p.meta["style"] == "wing" for p in wing)
+    assert {p.meta["style"] for p in map(generate_procedure, range(300))} == set(STYLE_NAMES)
 
 
 def test_unknown_style_is_rejected():

@@ -399,24 +399,32 @@ def test_noisy_inputs_keep_the_clean_target_and_are_seeded():
 
 
 def test_style_weights_draw_the_styles_of_the_samples(tmp_path):
-    from facaid.generator import STYLE_NAMES
+    import random
+
+    from facaid.generator import STYLE_NAMES, TRAINING_STYLES
     from facaid.train import TrainConfig, make_example, sample_style
 
     cfg = TrainConfig(style_weights={"wings": 3.0, "house": 0.0})
-    assert cfg.styles == tuple({"wings": 3.0, "house": 0.0}.get(n, 1.0) for n in STYLE_NAMES)
+    assert (*STYLE_NAMES, "wing") == TRAINING_STYLES
+    assert cfg.styles == (*({"wings": 3.0, "house": 0.0}.get(n, 1.0) for n in STYLE_NAMES), 0.0)
     assert TrainConfig().styles is None and sample_style(1, 0, None) is None
     drawn = [sample_style(1, i, cfg.styles) for i in range(1600)]
     assert drawn == [sample_style(1, i, cfg.styles) for i in range(1600)]  # seeded by the sample
-    assert "house" not in drawn and 0.30 < drawn.count("wings") / len(drawn) < 0.45  # 3/7 expected
+    assert "house" not in drawn and "wing" not in drawn and 0.30 < drawn.count("wings") / len(drawn) < 0.45
+    # "wing" unnamed weighs nothing and changes no draw: the configs from before it draw what they drew
+    before = [random.Random(f"facaid-style:1:{i}").choices(STYLE_NAMES, weights=cfg.styles[:-1])[0]
+              for i in range(1600)]
+    assert drawn == before
     # the examples follow the drawn styles
     tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=768))
-    only_wings = tuple(1.0 if n == "wings" else 0.0 for n in STYLE_NAMES)
-    example = next(ex for i in range(8) if (ex := make_example(tok, 3, i, styles=only_wings)) is not None)
-    index = next(i for i in range(8) if make_example(tok, 3, i, styles=only_wings) is not None)
-    assert repr(example[1]) == repr(tok.encode_target(generate(sample_seed(3, index), "wings").procedure))
+    for style in ("wings", "wing"):
+        only = tuple(1.0 if n == style else 0.0 for n in TRAINING_STYLES)
+        index = next(i for i in range(8) if make_example(tok, 3, i, styles=only) is not None)
+        example = make_example(tok, 3, index, styles=only)
+        assert repr(example[1]) == repr(tok.encode_target(generate(sample_seed(3, index), style).procedure))
     for weights, message in (({"gothic": 1.0}, "unknown style"), ({"wings": -1.0}, "finite numbers >= 0"),
                              ({"wings": float("nan")}, "finite numbers >= 0"),
-                             ({n: 0.0 for n in STYLE_NAMES}, "at least one style")):
+                             ({n: 0.0 for n in TRAINING_STYLES}, "at least one style")):
         with pytest.raises(ValueError, match=message):
             TrainConfig(style_weights=weights)
     toml = tmp_path / "w.toml"

@@ -14,9 +14,14 @@ from facaid.grammar.execute import execute, leaf_array
 from facaid.grammar.procedure import Procedure
 from facaid.segmentation import Segmentation, flatten_array
 
-__all__ = ["PRESETS", "STYLE_NAMES", "Sample", "Style", "generate", "generate_procedure", "sample_style"]
+__all__ = ["PRESETS", "STYLE_NAMES", "TRAINING_STYLES", "Sample", "Style", "generate", "generate_procedure",
+           "sample_style"]
 
 WING_STYLES = ("tenement", "modernist", "commercial", "house", "wings")
+# "wing": one building of the `wings` preset drawn as a facade of its own. Never the generator's own choice (held-out
+# facades keep their distribution); training may draw it (`train.style_weights`) to learn the buildings that
+# `wings` facades are made of, half of them of this preset, which no other style draws alone.
+TRAINING_STYLES = (*STYLE_NAMES, "wing")
 
 
 @dataclass
@@ -28,10 +33,12 @@ class Sample:
 
 
 def generate_procedure(seed: int, style: str | None = None) -> Procedure:
-    """A facade procedure for the seed; ``style`` picks a preset (random per seed when None)."""
+    """A facade procedure for the seed; ``style`` picks a preset (random per seed when None) or "wing"."""
     rng = random.Random(f"facaid-generator:{seed}")
     name = style if style is not None else rng.choice(STYLE_NAMES)
-    main = sample_style(rng, name)
+    main = sample_style(rng, "wings" if name == "wing" else name)
+    if name == "wing":
+        main.wings = 1
     styles = [main]
     if main.wings > 1:
         for _ in range(main.wings - 1):
