@@ -324,14 +324,10 @@ def deepened(model: FacaidModel, decoder_layers: int) -> FacaidModel:
     deep = FacaidModel(config).to(next(model.parameters()).device)
     state = model.state_dict()
     last = f"decoder.h.{have - 1}."
+    block = {name[len(last):]: value for name, value in state.items() if name.startswith(last)}
     for i in range(have, decoder_layers):
-        for name, value in list(state.items()):
-            if name.startswith(last):
-                rest = name[len(last):]
-                new = value.clone()
-                if rest.startswith(_BLOCK_OUTPUTS):
-                    new.zero_()
-                state[f"decoder.h.{i}.{rest}"] = new
+        for name, value in block.items():
+            state[f"decoder.h.{i}.{name}"] = value.clone().zero_() if name.startswith(_BLOCK_OUTPUTS) else value.clone()
     deep.load_state_dict(state, strict=True)
     deep.train(model.training)
     return deep

@@ -346,14 +346,15 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     # decoder blocks appended to a trained model learn at their own multiple of the rate, with decay
     grown = tuple(f"decoder.h.{i}." for i in range(state["grown_from"] or model.config.decoder_layers,
                                                     model.config.decoder_layers))
-    rest = [(n, p) for n, p in model.named_parameters() if not n.startswith(tuple(a for a, _ in added) + grown)]
-    groups = [{"params": [p for n, p in rest if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": 1.0},
-              {"params": [p for n, p in rest if p.dim() < 2], "weight_decay": 0.0, "scale": 1.0}]
+
+    def decayed(params: list, scale: float) -> list[dict]:  # weight decay on matrices only
+        return [{"params": [p for p in params if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": scale},
+                {"params": [p for p in params if p.dim() < 2], "weight_decay": 0.0, "scale": scale}]
+
+    skip = tuple(a for a, _ in added) + grown
+    groups = decayed([p for n, p in model.named_parameters() if not n.startswith(skip)], 1.0)
     if grown:
-        new = [(n, p) for n, p in model.named_parameters() if n.startswith(grown)]
-        groups += [{"params": [p for n, p in new if p.dim() >= 2], "weight_decay": cfg.weight_decay,
-                    "scale": cfg.grown_lr_scale},
-                   {"params": [p for n, p in new if p.dim() < 2], "weight_decay": 0.0, "scale": cfg.grown_lr_scale}]
+        groups += decayed([p for n, p in model.named_parameters() if n.startswith(grown)], cfg.grown_lr_scale)
     for prefix, scale in added:
         params = [p for n, p in model.named_parameters() if n.startswith(prefix)]
         if params:

@@ -121,7 +121,8 @@ def test_box_bias_starts_at_zero_and_leans_on_the_rectangles_in_the_node_box(tmp
 
 
 def test_a_deepened_decoder_keeps_the_logits_until_trained(tmp_path):
-    model, tok = with_box_bias(tiny()[0]), tiny()[1]
+    base, tok = tiny()
+    model = with_box_bias(base)
     model.eval()
     deep = deepened(model, 3)
     assert deep.config.decoder_layers == 3 and len(deep.decoder.h) == 3
