@@ -344,15 +344,29 @@ def test_committed_configs_build_the_shipped_architecture(name):
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
 
 
-@pytest.mark.parametrize("name", sorted(path.stem for path in (ROOT / "configs" / "experiments").glob("*.toml")))
+EXPERIMENTS = ROOT / "configs" / "experiments"
+
+
+@pytest.mark.parametrize("name", sorted(path.stem for path in EXPERIMENTS.glob("*.toml")))
 def test_experiment_configs_start_from_the_shipped_checkpoint(name):
-    """The configs of runs that were tried and not shipped parse, and their init builds the model they train."""
+    """The configs of runs that were tried and not shipped parse, and their init builds the model they train:
+    the shipped checkpoint, or the last weights of another experiment's run (same model and tokenizer) that
+    starts from it in turn."""
     from facaid.train import _initial_model
 
-    model_config, tok_config, train_config = load_config(ROOT / "configs" / "experiments" / f"{name}.toml")
+    model_config, tok_config, train_config = load_config(EXPERIMENTS / f"{name}.toml")
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
-    assert (ROOT / train_config.init).resolve() == DEFAULT_CHECKPOINT.resolve()
-    model = _initial_model(str(ROOT / train_config.init), model_config, tok_config, "cpu")
+    runs = {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in EXPERIMENTS.glob("*.toml")}
+    first_model, first_tok, init = model_config, tok_config, (ROOT / train_config.init).resolve()
+    for _ in range(len(runs)):
+        if init == DEFAULT_CHECKPOINT.resolve():
+            break
+        assert init in runs, f"{name}: init {init} is neither the shipped checkpoint nor an experiment's run"
+        first_model, first_tok, parent = load_config(runs[init])
+        assert (first_model, first_tok) == (model_config, tok_config), f"{runs[init].stem} trains another model"
+        init = (ROOT / parent.init).resolve()
+    assert init == DEFAULT_CHECKPOINT.resolve()
+    model = _initial_model(str(init), first_model, first_tok, "cpu")
     for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes", "box_bias"):
         assert getattr(model.config, key) == getattr(model_config, key), key
 
