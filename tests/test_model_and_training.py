@@ -357,16 +357,16 @@ def test_experiment_configs_start_from_the_shipped_checkpoint(name):
     model_config, tok_config, train_config = load_config(EXPERIMENTS / f"{name}.toml")
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
     runs = {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in EXPERIMENTS.glob("*.toml")}
-    first_model, first_tok, init = model_config, tok_config, (ROOT / train_config.init).resolve()
+    init = (ROOT / train_config.init).resolve()
     for _ in range(len(runs)):
         if init == DEFAULT_CHECKPOINT.resolve():
             break
         assert init in runs, f"{name}: init {init} is neither the shipped checkpoint nor an experiment's run"
-        first_model, first_tok, parent = load_config(runs[init])
-        assert (first_model, first_tok) == (model_config, tok_config), f"{runs[init].stem} trains another model"
+        parent_model, parent_tok, parent = load_config(runs[init])
+        assert (parent_model, parent_tok) == (model_config, tok_config), f"{runs[init].stem} trains another model"
         init = (ROOT / parent.init).resolve()
     assert init == DEFAULT_CHECKPOINT.resolve()
-    model = _initial_model(str(init), first_model, first_tok, "cpu")
+    model = _initial_model(str(init), model_config, tok_config, "cpu")  # every run of the chain trains this model
     for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes", "box_bias"):
         assert getattr(model.config, key) == getattr(model_config, key), key
 
