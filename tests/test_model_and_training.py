@@ -330,11 +330,13 @@ def test_config_errors(tmp_path):
 
 @pytest.mark.parametrize("name", sorted(path.stem for path in (ROOT / "configs").glob("*.toml")))
 def test_committed_configs_build_the_shipped_architecture(name):
-    """The configs that made the shipped checkpoint (and the CPU recipe) parse and describe its model."""
+    """The configs that made the shipped checkpoint (and the CPU recipe) parse and describe its model; those before
+    configs/finetune-deep.toml, which appended two decoder blocks (`facaid.model.deepened`), with fewer blocks."""
     model_config, tok_config, train_config = load_config(ROOT / "configs" / f"{name}.toml")
     shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
-    for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes"):
+    for key in ("d_model", "encoder_layers", "heads", "ffn", "encoder", "node_boxes"):
         assert getattr(model_config, key) == shipped[key], key
+    assert model_config.decoder_layers <= shipped["decoder_layers"]
     shipped_tok = TokenizerConfig(**shipped["tokenizer"])
     # the configs before configs/finetune-counts.toml read no peer counts, those before configs/finetune-fine.toml
     # coarser coordinates and one peer rule (`adapt_to_tokenizer` took each to the next); the rest is the same
@@ -344,27 +346,57 @@ def test_committed_configs_build_the_shipped_architecture(name):
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
 
 
+def test_the_shipped_checkpoint_is_the_last_committed_run():
+    """The shipped checkpoint is the model and tokenizer of the committed config that the others lead to: the one
+    whose run no other committed config starts from, and every committed run that starts from another's run
+    trains that run's model, or adds to it what `cfg.init` may add (decoder blocks, the box bias)."""
+    configs = {p.stem: load_config(p) for p in (ROOT / "configs").glob("*.toml")}
+    runs = {(ROOT / cfg.out / "last").resolve(): name for name, (_, _, cfg) in configs.items()}
+    started = {runs[(ROOT / cfg.init).resolve()] for _, (_, _, cfg) in configs.items()
+               if (ROOT / cfg.init).resolve() in runs}
+    for name, (model_config, _, cfg) in configs.items():
+        parent = runs.get((ROOT / cfg.init).resolve())
+        if parent is not None:
+            parent_model = configs[parent][0]  # the tokenizer may read more (checked against the shipped one above)
+            for key in ("d_model", "encoder_layers", "heads", "ffn", "encoder", "node_boxes"):
+                assert getattr(parent_model, key) == getattr(model_config, key), (name, key)
+            assert parent_model.decoder_layers <= model_config.decoder_layers, name  # `deepened`
+            assert parent_model.box_bias <= model_config.box_bias, name  # `with_box_bias`
+    chained = [name for name, (_, _, cfg) in configs.items() if (ROOT / cfg.init).resolve() in runs]
+    last = [name for name in chained if name not in started]
+    assert len(last) == 1, last
+    model_config, tok_config, _ = configs[last[0]]
+    shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
+    assert TokenizerConfig(**shipped.pop("tokenizer")) == tok_config
+    for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes", "box_bias"):
+        assert shipped[key] == getattr(model_config, key), key
+
+
 EXPERIMENTS = ROOT / "configs" / "experiments"
 
 
 @pytest.mark.parametrize("name", sorted(path.stem for path in EXPERIMENTS.glob("*.toml")))
-def test_experiment_configs_start_from_the_shipped_checkpoint(name):
-    """The configs of runs that were tried and not shipped parse, and their init builds the model they train:
-    the shipped checkpoint, or the last weights of another experiment's run (same model and tokenizer) that
-    starts from it in turn."""
+def test_experiment_configs_start_from_a_committed_run(name):
+    """The configs of runs that were tried and not shipped parse, and their init is the shipped checkpoint (whose
+    weights then build the model they train), the run of a committed config, or the last weights of another
+    experiment's run that leads to one of these in turn; each link trains the same model and tokenizer."""
     from facaid.train import _initial_model
 
     model_config, tok_config, train_config = load_config(EXPERIMENTS / f"{name}.toml")
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
-    runs = {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in EXPERIMENTS.glob("*.toml")}
+    experiments = {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in EXPERIMENTS.glob("*.toml")}
+    committed = {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in (ROOT / "configs").glob("*.toml")}
     init = (ROOT / train_config.init).resolve()
-    for _ in range(len(runs)):
-        if init == DEFAULT_CHECKPOINT.resolve():
+    for _ in range(len(experiments)):
+        if init == DEFAULT_CHECKPOINT.resolve() or init in committed:
             break
-        assert init in runs, f"{name}: init {init} is neither the shipped checkpoint nor an experiment's run"
-        parent_model, parent_tok, parent = load_config(runs[init])
-        assert (parent_model, parent_tok) == (model_config, tok_config), f"{runs[init].stem} trains another model"
+        assert init in experiments, f"{name}: init {init} is neither the shipped checkpoint nor a committed run"
+        parent_model, parent_tok, parent = load_config(experiments[init])
+        assert (parent_model, parent_tok) == (model_config, tok_config), f"{experiments[init].stem} trains another"
         init = (ROOT / parent.init).resolve()
+    if init in committed:  # its weights are not committed; its config must train the same model
+        assert load_config(committed[init])[:2] == (model_config, tok_config), f"{committed[init].stem} trains another"
+        return
     assert init == DEFAULT_CHECKPOINT.resolve()
     model = _initial_model(str(init), model_config, tok_config, "cpu")  # every run of the chain trains this model
     for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes", "box_bias"):

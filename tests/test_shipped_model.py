@@ -41,7 +41,7 @@ def test_decoded_floors_that_repeat_are_written_as_the_canonical_repeat():
     from facaid.metrics import procedure_accuracy
 
     model, tokenizer = default_model()
-    sample = generate(135)  # a commercial facade whose greedy tree writes alike floors one by one
+    sample = generate(72)  # a commercial facade whose greedy tree writes alike floors one by one
     plain = decode(model, tokenizer, sample.segmentation, merge_floors=False)[0]
     merged = decode(model, tokenizer, sample.segmentation)[0]
     assert len(merged.ids) < len(plain.ids) and merged.logprob == plain.logprob
