@@ -1,5 +1,6 @@
 import json
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -346,24 +347,26 @@ def test_committed_configs_build_the_shipped_architecture(name):
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
 
 
+def _runs(directory: Path) -> dict[Path, Path]:
+    """The configs of a directory by the weights their runs leave (``train.out``/last, resolved)."""
+    return {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in directory.glob("*.toml")}
+
+
 def test_the_shipped_checkpoint_is_the_last_committed_run():
     """The shipped checkpoint is the model and tokenizer of the committed config that the others lead to: the one
     whose run no other committed config starts from, and every committed run that starts from another's run
-    trains that run's model, or adds to it what `cfg.init` may add (decoder blocks, the box bias)."""
+    trains that run's model, or adds to it what `train.init` may add (decoder blocks, the box bias)."""
     configs = {p.stem: load_config(p) for p in (ROOT / "configs").glob("*.toml")}
-    runs = {(ROOT / cfg.out / "last").resolve(): name for name, (_, _, cfg) in configs.items()}
-    started = {runs[(ROOT / cfg.init).resolve()] for _, (_, _, cfg) in configs.items()
+    runs = {run: path.stem for run, path in _runs(ROOT / "configs").items()}
+    parents = {name: runs[(ROOT / cfg.init).resolve()] for name, (_, _, cfg) in configs.items()
                if (ROOT / cfg.init).resolve() in runs}
-    for name, (model_config, _, cfg) in configs.items():
-        parent = runs.get((ROOT / cfg.init).resolve())
-        if parent is not None:
-            parent_model = configs[parent][0]  # the tokenizer may read more (checked against the shipped one above)
-            for key in ("d_model", "encoder_layers", "heads", "ffn", "encoder", "node_boxes"):
-                assert getattr(parent_model, key) == getattr(model_config, key), (name, key)
-            assert parent_model.decoder_layers <= model_config.decoder_layers, name  # `deepened`
-            assert parent_model.box_bias <= model_config.box_bias, name  # `with_box_bias`
-    chained = [name for name, (_, _, cfg) in configs.items() if (ROOT / cfg.init).resolve() in runs]
-    last = [name for name in chained if name not in started]
+    for name, parent in parents.items():
+        model_config, parent_model = configs[name][0], configs[parent][0]  # the tokenizer may read more (above)
+        for key in ("d_model", "encoder_layers", "heads", "ffn", "encoder", "node_boxes"):
+            assert getattr(parent_model, key) == getattr(model_config, key), (name, key)
+        assert parent_model.decoder_layers <= model_config.decoder_layers, name  # `deepened`
+        assert parent_model.box_bias <= model_config.box_bias, name  # `with_box_bias`
+    last = [name for name in parents if name not in parents.values()]
     assert len(last) == 1, last
     model_config, tok_config, _ = configs[last[0]]
     shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
@@ -384,8 +387,7 @@ def test_experiment_configs_start_from_a_committed_run(name):
 
     model_config, tok_config, train_config = load_config(EXPERIMENTS / f"{name}.toml")
     assert train_config.steps > 0 and train_config.lr > train_config.min_lr
-    experiments = {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in EXPERIMENTS.glob("*.toml")}
-    committed = {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in (ROOT / "configs").glob("*.toml")}
+    experiments, committed = _runs(EXPERIMENTS), _runs(ROOT / "configs")
     init = (ROOT / train_config.init).resolve()
     for _ in range(len(experiments)):
         if init == DEFAULT_CHECKPOINT.resolve() or init in committed:
