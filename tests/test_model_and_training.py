@@ -23,8 +23,12 @@ from facaid.model import (
 )
 from facaid.paths import DEFAULT_CHECKPOINT, ROOT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
-from facaid.train import load_config, lr_at, train
+from facaid.train import _ARCHITECTURE, load_config, lr_at, train
 
+# what `train.init` may add to a checkpoint's model (`deepened`, `with_box_bias`), and what it must keep (dropout is a
+# training setting, not compared)
+GROWN = ("decoder_layers", "box_bias")
+FIXED = tuple(k for k in _ARCHITECTURE if k not in (*GROWN, "dropout"))
 TINY = {"d_model": 16, "encoder_layers": 1, "decoder_layers": 1, "heads": 2, "ffn": 32, "node_boxes": True}
 
 
@@ -335,7 +339,7 @@ def test_committed_configs_build_the_shipped_architecture(name):
     configs/finetune-deep.toml, which appended two decoder blocks (`facaid.model.deepened`), with fewer blocks."""
     model_config, tok_config, train_config = load_config(ROOT / "configs" / f"{name}.toml")
     shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
-    for key in ("d_model", "encoder_layers", "heads", "ffn", "encoder", "node_boxes"):
+    for key in FIXED:
         assert getattr(model_config, key) == shipped[key], key
     assert model_config.decoder_layers <= shipped["decoder_layers"]
     shipped_tok = TokenizerConfig(**shipped["tokenizer"])
@@ -362,16 +366,16 @@ def test_the_shipped_checkpoint_is_the_last_committed_run():
                if (ROOT / cfg.init).resolve() in runs}
     for name, parent in parents.items():
         model_config, parent_model = configs[name][0], configs[parent][0]  # the tokenizer may read more (above)
-        for key in ("d_model", "encoder_layers", "heads", "ffn", "encoder", "node_boxes"):
+        for key in FIXED:
             assert getattr(parent_model, key) == getattr(model_config, key), (name, key)
-        assert parent_model.decoder_layers <= model_config.decoder_layers, name  # `deepened`
-        assert parent_model.box_bias <= model_config.box_bias, name  # `with_box_bias`
+        for key in GROWN:
+            assert getattr(parent_model, key) <= getattr(model_config, key), (name, key)
     last = [name for name in parents if name not in parents.values()]
     assert len(last) == 1, last
     model_config, tok_config, _ = configs[last[0]]
     shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
     assert TokenizerConfig(**shipped.pop("tokenizer")) == tok_config
-    for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes", "box_bias"):
+    for key in (*FIXED, *GROWN):
         assert shipped[key] == getattr(model_config, key), key
 
 
@@ -401,7 +405,7 @@ def test_experiment_configs_start_from_a_committed_run(name):
         return
     assert init == DEFAULT_CHECKPOINT.resolve()
     model = _initial_model(str(init), model_config, tok_config, "cpu")  # every run of the chain trains this model
-    for key in ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", "encoder", "node_boxes", "box_bias"):
+    for key in (*FIXED, *GROWN):
         assert getattr(model.config, key) == getattr(model_config, key), key
 
 
