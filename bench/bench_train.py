@@ -4,7 +4,9 @@ the model's forward/backward/optimizer step (CUDA when present, bf16 autocast th
     .venv/bin/python bench/bench_train.py [--config configs/gpu.toml] [--workers 14] [--steps 20]
 
 Prints medians per step of the config's batch size; the data rate needed per step is compared with the model's
-step time, which says what bounds the run.
+step time, which says what bounds the run. With the box bias (``model.box_bias``) each batch is also stepped with
+the box scales frozen (``train.box_lr_scale = 0``, the cross-attention in the fused kernel), alternating with the
+learned ones on the same batches so that the ratio is measured under the same load.
 """
 
 from __future__ import annotations
@@ -59,31 +61,41 @@ def main() -> None:
     torch.manual_seed(0)
     model = FacaidModel(model_cfg).to(device).train()
     opt = torch.optim.AdamW(model.parameters(), lr=1e-4)
-    batching, stepping = [], []
     sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
+    modes = ("learned", "frozen") if model.box_scale is not None else ("learned",)
+    batching: list[float] = []
+    stepping: dict[str, list[float]] = {mode: [] for mode in modes}
     for i, batch in enumerate(batches):
         t0 = time.perf_counter()
         rects, mask = batch_inputs([ex[0] for ex in batch], device)
         ids, local, targets, boxes = batch_outputs([ex[1] for ex in batch], device)
         sync()
         t1 = time.perf_counter()
-        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=device.type == "cuda"):
-            _, loss = model(rects, mask, ids, local, targets, boxes)
-        opt.zero_grad(set_to_none=True)
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
-        opt.step()
-        loss.item()
-        sync()
-        t2 = time.perf_counter()
         if i >= 3:
             batching.append(t1 - t0)
-            stepping.append(t2 - t1)
-    b, s = statistics.median(batching), statistics.median(stepping)
-    print(f"batching (pad, to device): median {1000 * b:.1f} ms/step")
-    print(f"forward + backward + AdamW: median {1000 * s:.1f} ms/step over {len(stepping)} steps "
+        for mode in modes:
+            if model.box_scale is not None:
+                model.box_scale.requires_grad_(mode == "learned")
+            t1 = time.perf_counter()
+            with torch.autocast(device.type, dtype=torch.bfloat16, enabled=device.type == "cuda"):
+                _, loss = model(rects, mask, ids, local, targets, boxes)
+            opt.zero_grad(set_to_none=True)
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+            opt.step()
+            loss.item()
+            sync()
+            if i >= 3:
+                stepping[mode].append(time.perf_counter() - t1)
+    print(f"batching (pad, to device): median {1000 * statistics.median(batching):.1f} ms/step")
+    learned = statistics.median(stepping["learned"])
+    print(f"forward + backward + AdamW: median {1000 * learned:.1f} ms/step over {len(stepping['learned'])} steps "
           f"(output length up to {ids.shape[1]}, {rects.shape[1]} rectangles)")
-
+    if "frozen" in stepping:
+        frozen = statistics.median(stepping["frozen"])
+        total = sum(stepping["learned"]) / sum(stepping["frozen"])  # what a run of such batches gains
+        print(f"the same, box scales frozen (train.box_lr_scale = 0): median {1000 * frozen:.1f} ms/step, "
+              f"{learned / frozen:.2f}x the median, {total:.2f}x the total time of these steps")
 
 if __name__ == "__main__":
     main()

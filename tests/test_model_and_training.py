@@ -331,6 +331,10 @@ def test_config_errors(tmp_path):
     bad.write_text("[optimizer]\nlr = 3\n")
     with pytest.raises(ValueError, match="unknown table"):
         load_config(bad)
+    for value in ("-1.0", "nan", '"fast"'):
+        bad.write_text(f"[train]\nbox_lr_scale = {value}\n")
+        with pytest.raises(ValueError, match="box_lr_scale must be a finite number >= 0"):
+            load_config(bad)
 
 
 @pytest.mark.parametrize("name", sorted(path.stem for path in (ROOT / "configs").glob("*.toml")))
@@ -517,17 +521,19 @@ def test_fine_tuning_starts_from_a_checkpoint(tmp_path):
         moved[scale] = max(e.weight.abs().max().item() for e in tuned_counts.count_fields)
     assert 5 < moved[10.0] / moved[1.0] < 15
     # a config that adds the box bias starts from the same weights, its scales at zero; they learn at
-    # train.box_lr_scale
+    # train.box_lr_scale, and 0 freezes them while the rest learns
     box = {}
-    for scale in (0.0, 1.0, 10.0):
-        steps = 0 if scale == 0.0 else 2
-        write_config(cfg, tmp_path / f"box-{scale}", steps=steps, extra=f'init = "{base}"\nbox_lr_scale = {scale}')
+    for scale in ("start", 0.0, 1.0, 10.0):
+        steps = 0 if scale == "start" else 2
+        lr_scale = 1.0 if scale == "start" else scale
+        write_config(cfg, tmp_path / f"box-{scale}", steps=steps,
+                     extra=f'init = "{base}"\nbox_lr_scale = {lr_scale}')
         cfg.write_text(cfg.read_text().replace("[model]", "[model]\nbox_bias = true"))
         biased, _ = load_model(train(cfg, progress=False))
         box[scale] = biased.box_scale.abs().max().item()
-        if scale == 0.0:
-            assert all(torch.equal(p, a.state_dict()[n]) for n, p in biased.state_dict().items() if n != "box_scale")
-    assert box[0.0] == 0.0 and 5 < box[10.0] / box[1.0] < 15
+        same = [torch.equal(p, a.state_dict()[n]) for n, p in biased.state_dict().items() if n != "box_scale"]
+        assert all(same) if scale == "start" else not all(same)
+    assert box["start"] == box[0.0] == 0.0 and 5 < box[10.0] / box[1.0] < 15
     # a config that appends decoder blocks starts from the same logits; the new blocks learn at
     # train.grown_lr_scale, and a resumed run keeps them in their own optimizer groups
     grown = {}
