@@ -76,7 +76,7 @@ def main() -> None:
         for mode in modes:
             if model.box_scale is not None:
                 model.box_scale.requires_grad_(mode == "learned")
-            t1 = time.perf_counter()
+            t2 = time.perf_counter()
             with torch.autocast(device.type, dtype=torch.bfloat16, enabled=device.type == "cuda"):
                 _, loss = model(rects, mask, ids, local, targets, boxes)
             opt.zero_grad(set_to_none=True)
@@ -86,7 +86,7 @@ def main() -> None:
             loss.item()
             sync()
             if i >= 3:
-                stepping[mode].append(time.perf_counter() - t1)
+                stepping[mode].append(time.perf_counter() - t2)
     print(f"batching (pad, to device): median {1000 * statistics.median(batching):.1f} ms/step")
     learned = statistics.median(stepping["learned"])
     print(f"forward + backward + AdamW: median {1000 * learned:.1f} ms/step over {len(stepping['learned'])} steps "
@@ -96,6 +96,7 @@ def main() -> None:
         total = sum(stepping["learned"]) / sum(stepping["frozen"])  # what a run of such batches gains
         print(f"the same, box scales frozen (train.box_lr_scale = 0): median {1000 * frozen:.1f} ms/step, "
               f"{learned / frozen:.2f}x the median, {total:.2f}x the total time of these steps")
+
 
 if __name__ == "__main__":
     main()

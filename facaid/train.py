@@ -39,6 +39,11 @@ from facaid.model import (
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
 
+def _nonnegative(value) -> bool:
+    """A finite number >= 0 (a TOML string, NaN or a negative number is not)."""
+    return isinstance(value, int | float) and math.isfinite(value) and value >= 0
+
+
 @dataclass
 class TrainConfig:
     out: str = "runs/default"
@@ -78,13 +83,13 @@ class TrainConfig:
             raise ValueError(f"style_weights: unknown style(s) {', '.join(sorted(unknown))}; expected some of "
                              f"{', '.join(TRAINING_STYLES)}")
         weights = self.style_weights.values()
-        if not all(isinstance(w, int | float) and math.isfinite(w) and w >= 0 for w in weights):
+        if not all(_nonnegative(w) for w in weights):
             raise ValueError(f"style_weights must be finite numbers >= 0, got {self.style_weights}")
         if self.style_weights and sum(self.styles) <= 0:
             raise ValueError("style_weights: at least one style must weigh more than 0")
         for name in ("count_lr_scale", "box_lr_scale", "grown_lr_scale"):
             value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+            if not _nonnegative(value):
                 raise ValueError(f"{name} must be a finite number >= 0 (0 freezes those parameters), got {value!r}")
 
     @property
