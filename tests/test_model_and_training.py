@@ -23,7 +23,7 @@ from facaid.model import (
 )
 from facaid.paths import DEFAULT_CHECKPOINT, ROOT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
-from facaid.train import _ARCHITECTURE, load_config, lr_at, train
+from facaid.train import _ARCHITECTURE, load_config, lr_at, structure_weighted_loss, token_log_probs, train
 
 # what `train.init` may add to a checkpoint's model (`deepened`, `with_box_bias`), and what it must keep (dropout is a
 # training setting, not compared)
@@ -54,6 +54,26 @@ def test_forward_shapes_and_loss(rect_tokens, encoder):
     assert loss.item() == pytest.approx(torch.log(torch.tensor(float(len(tok.vocab)))).item(), rel=0.1)
     memory, memory_mask = model.encode(rects, mask)
     assert memory.shape[1] == rects.shape[1] * rect_tokens
+
+
+def test_structure_weighted_loss_splits_each_size_into_its_mode_and_value():
+    model, tok = tiny()
+    rects, mask, ids, local, targets, boxes = batch(tok, [3, 4])
+    logits, nll = model(rects, mask, ids, local, targets, boxes)
+    assert torch.allclose(structure_weighted_loss(logits, targets, tok.vocab, 1.0), nll, atol=1e-6)
+    token_lp, structure_lp = token_log_probs(logits, targets, tok.vocab)
+    valid = targets[targets != -100]
+    assert len(token_lp) == len(valid) and bool((structure_lp >= token_lp - 1e-6).all())
+    # a size's structure is its mode: log P(mode), the probability of all the values of that mode summed
+    lp = torch.log_softmax(logits, -1)[targets != -100]
+    kinds = [tok.vocab.kind(int(t)) for t in valid]
+    i = kinds.index("flt")
+    r = tok.vocab.ranges["flt"]
+    assert torch.isclose(structure_lp[i], torch.logsumexp(lp[i, r.start:r.stop], -1), atol=1e-5)
+    j = kinds.index("rule")  # every other token is structure whole
+    assert structure_lp[j] == token_lp[j]
+    assert torch.isclose(structure_weighted_loss(logits, targets, tok.vocab, 5.0),
+                         -(token_lp + 4.0 * structure_lp).mean(), atol=1e-6)
 
 
 def test_widening_for_peer_counts_keeps_the_logits_until_trained(tmp_path):
@@ -309,6 +329,7 @@ def test_training_lowers_the_loss_and_resumes_exactly(tmp_path):
     log = [json.loads(x) for x in (tmp_path / "run" / "log.jsonl").read_text().splitlines()]
     assert [r["step"] for r in log] == [3, 6]
     assert log[-1]["val_loss"] < log[0]["val_loss"]
+    assert 0 < log[-1]["val_structure"] < log[-1]["val_loss"]
     state = torch.load(last / "state.pt", weights_only=False)["state"]
     assert state["step"] == 6 and state["sample_index"] > 0
     # stopping at 6 and resuming to 9 == training 9 straight (same batches, same optimizer state)
@@ -334,6 +355,10 @@ def test_config_errors(tmp_path):
     for value in ("-1.0", "nan", '"fast"'):
         bad.write_text(f"[train]\nbox_lr_scale = {value}\n")
         with pytest.raises(ValueError, match="box_lr_scale must be a finite number >= 0"):
+            load_config(bad)
+    for value in ("0", "-2.0", "inf", '"high"'):
+        bad.write_text(f"[train]\nstructure_weight = {value}\n")
+        with pytest.raises(ValueError, match="structure_weight must be a finite number > 0"):
             load_config(bad)
 
 
@@ -490,6 +515,21 @@ def test_style_weights_draw_the_styles_of_the_samples(tmp_path):
     toml.write_text('[train]\nstyle_weights = { wings = "many" }\n')
     with pytest.raises(ValueError, match="finite numbers >= 0"):
         load_config(toml)
+
+
+def test_structure_weight_steers_training_to_the_structure(tmp_path):
+    """The same steps on the same batches lower the structure's validation NLL more when it weighs more."""
+    cfg = tmp_path / "c.toml"
+    write_config(cfg, tmp_path / "base", steps=3, extra="lr = 3e-3")
+    base = train(cfg, progress=False)
+    structure = {}
+    for weight in (1.0, 20.0):
+        write_config(cfg, tmp_path / f"w{weight}", steps=9,
+                     extra=f'lr = 1e-2\ninit = "{base}"\nstructure_weight = {weight}')
+        train(cfg, progress=False)
+        log = [json.loads(x) for x in (tmp_path / f"w{weight}" / "log.jsonl").read_text().splitlines()]
+        structure[weight] = log[-1]["val_structure"]
+    assert structure[20.0] < structure[1.0]
 
 
 def test_fine_tuning_starts_from_a_checkpoint(tmp_path):
