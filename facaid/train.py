@@ -26,6 +26,7 @@ from tqdm import tqdm
 from facaid.evaluation.noise import jitter
 from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
+from facaid.grammar.procedure import MODES
 from facaid.model import (
     FacaidConfig,
     FacaidModel,
@@ -280,9 +281,6 @@ def lr_at(step: int, cfg: TrainConfig) -> float:
     return cfg.min_lr + 0.5 * (cfg.lr - cfg.min_lr) * (1 + math.cos(math.pi * t))
 
 
-SIZE_MODES = ("abs", "flt", "rel")
-
-
 def token_log_probs(logits: torch.Tensor, targets: torch.Tensor, vocab: Vocabulary
                     ) -> tuple[torch.Tensor, torch.Tensor]:
     """log p of each target token and of its structure, both over the valid targets only (-100: ignored).
@@ -295,7 +293,7 @@ def token_log_probs(logits: torch.Tensor, targets: torch.Tensor, vocab: Vocabula
     t = targets.masked_fill(~valid, 0)
     token_lp = lp.gather(-1, t.unsqueeze(-1)).squeeze(-1)
     structure_lp = token_lp
-    for mode in SIZE_MODES:
+    for mode in MODES:  # the vocabulary's size tokens, one group a mode
         r = vocab.ranges[mode]
         in_mode = (t >= r.start) & (t < r.stop)
         structure_lp = torch.where(in_mode, torch.logsumexp(lp[..., r.start:r.stop], dim=-1), structure_lp)
