@@ -303,9 +303,9 @@ def token_log_probs(logits: torch.Tensor, targets: torch.Tensor, vocab: Vocabula
 def structure_weighted_loss(logits: torch.Tensor, targets: torch.Tensor, vocab: Vocabulary,
                             weight: float) -> torch.Tensor:
     """The mean NLL plus (weight - 1) x the mean NLL of the structure (`token_log_probs`): the structure weighs
-    ``weight`` against the sizes' values, and at weight 1 this is the NLL. Why: the values hold about 97 % of the
-    shipped model's NLL, mostly the spread of a value within a bin or two that the sizing fit makes up for
-    anyway, so their gradient drowns that of the structure, which is what the tree is."""
+    ``weight`` against the sizes' values, and at weight 1 this is the NLL. Why: the values held about 97 % of the
+    NLL of the weights before configs/finetune-structure.toml, mostly the spread of a value within a bin or two
+    that the sizing fit makes up for anyway, so their gradient drowned that of the structure, which is the tree."""
     token_lp, structure_lp = token_log_probs(logits, targets, vocab)
     return -(token_lp + (weight - 1.0) * structure_lp).mean()
 
