@@ -4,8 +4,9 @@
 ``(input_ids, scores)`` it returns a copy of the scores with every token the token grammar forbids set to
 ``-inf``. `decode` runs our own cached loop with it: greedy or sampling, K candidates in one batch, from a
 given prefix if asked. `ranked_candidates` executes the candidates and ranks them by how well they reproduce the
-input: pixel accuracy in whole points, less a point for every element too many or too few, then likelihood;
-`best_of_k` keeps the first.
+input: pixel accuracy in whole points, less a point for every element too many or too few, then likelihood,
+and puts first the best candidate composed with the others region by region (`facaid.composition`); `best_of_k`
+keeps the first.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
+from facaid.composition import compose as compose_candidates
 from facaid.defaults import DEFAULT_K, FLOOR_TOLERANCE, TEMPERATURE
 from facaid.generator.canonical import merge_repeated_floors
 from facaid.grammar.execute import execute, to_segmentation
@@ -87,6 +89,7 @@ class Candidate:
     accuracy: float | None = None  # pixel accuracy against the input, when scored
     count_error: int | None = None  # elements too many or too few against the input, when scored
     error: str | None = None  # why an unconstrained sequence is invalid
+    swaps: int = 0  # subtrees swapped in from other candidates (`facaid.composition`), 0 for a decoded one
 
 
 def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> list[int]:
@@ -231,9 +234,13 @@ def rank_key(candidate: Candidate) -> tuple[int, float]:
 
 def ranked_candidates(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, k: int = DEFAULT_K, *,
                       temperature: float = TEMPERATURE, seed: int = 0, prefix: list[int] | None = None,
-                      reference: Segmentation | None = None) -> list[Candidate]:
+                      reference: Segmentation | None = None, compose: bool = True) -> list[Candidate]:
     """The greedy candidate and K-1 samples, executed, scored against ``reference`` (default: ``seg``, what
-    the model read) and ranked by `rank_key`, best first."""
+    the model read) and ranked by `rank_key`, best first.
+
+    With ``compose`` (and K > 1, no ``prefix``), the first candidate becomes its composition with the others
+    (`facaid.composition.compose`: each region's best subtree) when that differs from it; the composition
+    carries the log-probability of the candidate it started from and ``swaps`` > 0. The candidates follow."""
     candidates = decode(model, tokenizer, seg, k=k, sample=k > 1, greedy=1, temperature=temperature, seed=seed,
                         prefix=prefix)  # one batch, sharing the cross-attention
     if reference is None:
@@ -241,10 +248,37 @@ def ranked_candidates(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentatio
     target, counts = scaled_label_map(reference, 0.25), element_counts(reference)
     for c in candidates:
         score(c, reference, target, counts=counts)
-    return sorted(candidates, key=rank_key, reverse=True)
+    ranked = sorted(candidates, key=rank_key, reverse=True)
+    if compose and k > 1 and not prefix:
+        seen: set[tuple[int, ...]] = set()
+        distinct = [c for c in ranked if not (tuple(c.ids) in seen or seen.add(tuple(c.ids)))]  # each once
+        proc, swaps = compose_candidates([c.procedure for c in distinct], [c.logprob for c in distinct],
+                                         reference.to_array(), target, valid=lambda p: _fits(tokenizer, p))
+        if swaps:
+            proc.meta = {"source": "model", "composed": swaps}
+            composed = Candidate(tokenizer.encode_procedure(proc)[0], ranked[0].logprob, proc, swaps=swaps)
+            score(composed, reference, target, counts=counts)
+            ranked.insert(0, composed)
+    return ranked
+
+
+def _fits(tokenizer: Tokenizer, proc: Procedure) -> bool:
+    """Whether the model could have decoded ``proc``: its tokens pass the token grammar (length, node, depth
+    and leaf limits)."""
+    ids = tokenizer.encode_procedure(proc)[0]
+    grammar = TokenGrammar(tokenizer.vocab, proc.width, proc.height)
+    try:
+        for t in ids[1:]:
+            grammar.step(t)
+    except TokenError:
+        return False
+    return grammar.done
 
 
 def best_of_k(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, k: int = DEFAULT_K, *,
-              temperature: float = TEMPERATURE, seed: int = 0, prefix: list[int] | None = None) -> Candidate:
-    """The candidate of `ranked_candidates` that reproduces the input best."""
-    return ranked_candidates(model, tokenizer, seg, k, temperature=temperature, seed=seed, prefix=prefix)[0]
+              temperature: float = TEMPERATURE, seed: int = 0, prefix: list[int] | None = None,
+              compose: bool = True) -> Candidate:
+    """The first of `ranked_candidates`: the candidate that reproduces the input best, composed with the others
+    region by region."""
+    return ranked_candidates(model, tokenizer, seg, k, temperature=temperature, seed=seed, prefix=prefix,
+                             compose=compose)[0]

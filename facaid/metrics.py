@@ -51,9 +51,23 @@ def element_counts(seg: Segmentation) -> np.ndarray:
     each element class's rectangles (`_regions`); the background and the wall count 0. Any cover of the same
     picture gives the same counts, so a flattened segmentation (pieces) counts like the rectangles the pieces
     came from."""
+    return _row_counts(seg.to_array())
+
+
+def element_counts_within(rows: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:
+    """`element_counts` of the rectangles ``rows`` (N, 5: label, x0, y0, x1, y1) whose centres lie in ``box``
+    (x0, y0, x1, y1, half-open). Counting by centre, not clipping, keeps an element of the next region that a
+    rough box edge grazes out of the count."""
+    rows = np.asarray(rows, dtype=np.float64).reshape(-1, 5)
+    cx, cy = (rows[:, 1] + rows[:, 3]) / 2, (rows[:, 2] + rows[:, 4]) / 2
+    x0, y0, x1, y1 = box
+    return _row_counts(rows[(cx >= x0) & (cx < x1) & (cy >= y0) & (cy < y1)])
+
+
+def _row_counts(rows: np.ndarray) -> np.ndarray:
     out = np.zeros(len(LABELS), dtype=np.int64)
-    rows = seg.to_array()
-    for label in np.unique(rows[:, 0]):
+    rows = rows[(rows[:, 3] > rows[:, 1]) & (rows[:, 4] > rows[:, 2])]  # empty leaves show nothing
+    for label in np.unique(rows[:, 0]).astype(int):
         if label not in (BACKGROUND, FACADE):
             out[label] = _regions(rows[rows[:, 0] == label, 1:])
     return out

@@ -237,7 +237,28 @@ def _fewer_possible(item) -> bool:
 
 def test_ranked_candidates_are_sorted_by_rank_key(tiny_model):
     seg = generate(4).segmentation
-    ranked = ranked_candidates(tiny_model, TOK, seg, k=5, seed=2)
-    assert len(ranked) == 5 and all(c.count_error is not None for c in ranked)
+    ranked = ranked_candidates(tiny_model, TOK, seg, k=5, seed=2, compose=False)
+    assert len(ranked) == 5 and all(c.count_error is not None and c.swaps == 0 for c in ranked)
     keys = [rank_key(c) for c in ranked]
     assert keys == sorted(keys, reverse=True)
+
+
+def test_ranked_candidates_put_a_valid_composition_first(tiny_model):
+    # (the untrained model's candidates rarely share a region; tests/test_shipped_model.py composes for sure)
+    for s in range(6):
+        seg = generate(s).segmentation
+        plain = ranked_candidates(tiny_model, TOK, seg, k=6, seed=s, compose=False)
+        ranked = ranked_candidates(tiny_model, TOK, seg, k=6, seed=s)
+        first = ranked[0]
+        if first.swaps:  # the composition, then the candidates as ranked without it
+            assert [c.ids for c in ranked[1:]] == [c.ids for c in plain]
+            assert first.procedure.meta["composed"] == first.swaps and first.logprob == plain[0].logprob
+            validate(first.procedure)
+            g = TokenGrammar(TOK.vocab, seg.width, seg.height)
+            for t in first.ids[1:]:
+                g.step(t)  # raises if the model could not have decoded it
+            assert g.done and first.accuracy is not None
+        else:
+            assert [c.ids for c in ranked] == [c.ids for c in plain]
+    prefix = prefix_from_procedure(TOK, generate(0).procedure, nodes=2)
+    assert ranked_candidates(tiny_model, TOK, generate(0).segmentation, k=6, prefix=prefix)[0].swaps == 0

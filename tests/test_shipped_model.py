@@ -51,3 +51,21 @@ def test_decoded_floors_that_repeat_are_written_as_the_canonical_repeat():
     seg = sample.segmentation
     assert procedure_accuracy(merged.procedure, seg) == pytest.approx(procedure_accuracy(plain.procedure, seg),
                                                                       abs=0.01)
+
+
+@pytest.mark.skipif(not (DEFAULT_CHECKPOINT / "model.safetensors").is_file(), reason="no shipped checkpoint")
+def test_best_of_k_composes_the_buildings_of_a_wings_facade():
+    from facaid.decoding import _fits, best_of_k, ranked_candidates
+    from facaid.evaluation.ted import tree_edit_distance
+
+    model, tokenizer = default_model()
+    sample = generate(6, "wings")  # three buildings: the best-ranked candidate gets one of them wrong
+    ranked = ranked_candidates(model, tokenizer, sample.segmentation, k=16)
+    first, plain = ranked[0], ranked[1]
+    assert first.swaps > 0 and first.procedure.meta["composed"] == first.swaps
+    validate(first.procedure)
+    assert _fits(tokenizer, first.procedure)
+    truth = sample.procedure.root
+    assert tree_edit_distance(truth, first.procedure.root) < tree_edit_distance(truth, plain.procedure.root)
+    assert best_of_k(model, tokenizer, sample.segmentation, 16).ids == first.ids
+    assert best_of_k(model, tokenizer, sample.segmentation, 16, compose=False).ids == plain.ids

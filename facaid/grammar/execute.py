@@ -197,10 +197,16 @@ def fill_counts(proc: Procedure) -> dict[int, int]:
 
 def first_boxes(proc: Procedure) -> dict[int, tuple[float, float, float, float]]:
     """The box of the first instance of every node, keyed by ``id(node)``."""
+    return execute_with_boxes(proc)[1]
+
+
+def execute_with_boxes(proc: Procedure) -> tuple[list[tuple[int, float, float, float, float]],
+                                                 dict[int, tuple[float, float, float, float]]]:
+    """`execute` and `first_boxes` in one pass."""
     ex = _Executor(proc, None)
     ex.first_boxes = {}
     ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
-    return ex.first_boxes
+    return ex.out, ex.first_boxes
 
 
 def count_leaves(proc: Procedure) -> int:
