@@ -20,14 +20,13 @@ facades either way (best of 16; figures in docs/model.md, "Composing candidates"
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 
 import numpy as np
 
 from facaid.grammar.execute import execute_with_boxes, leaf_array
 from facaid.grammar.procedure import Node, Procedure
-from facaid.metrics import element_counts_within, scaled_procedure_map
+from facaid.metrics import cell_span, element_counts_within, scaled_procedure_map
 
 DEPTH = 2  # splits below the root down to which regions are compared
 TOLERANCE = 0.01  # a region matches when every box edge agrees within this fraction of the larger image side
@@ -61,9 +60,8 @@ class _Scored:
         """`facaid.decoding.rank_key` restricted to ``box``: accuracy in whole points less the count error
         (``reference_counts``: the input's `element_counts_within` the box), then the likelihood."""
         x0, y0, x1, y1 = box
-        # the cells whose centres lie in the box, as `facaid.metrics._paint` samples them
-        c0, c1 = (max(math.ceil(v * self.sx - 0.5), 0) for v in (x0, x1))
-        r0, r1 = (max(math.ceil(v * self.sy - 0.5), 0) for v in (y0, y1))
+        c0, c1 = (max(v, 0) for v in cell_span(x0, x1, self.sx))  # the cells the label map sampled in the box
+        r0, r1 = (max(v, 0) for v in cell_span(y0, y1, self.sy))
         cells = max(r1 - r0, 0) * max(c1 - c0, 0)
         t = self.table
         correct = t[r1, c1] - t[r0, c1] - t[r1, c0] + t[r0, c0] if cells else 0

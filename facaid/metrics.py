@@ -73,6 +73,12 @@ def _row_counts(rows: np.ndarray) -> np.ndarray:
     return out
 
 
+def cell_span(lo: float, hi: float, scale: float) -> tuple[int, int]:
+    """The cells j with lo <= (j + 0.5) / scale < hi, as [start, stop): those whose centres a span covers, as
+    `_paint` samples them (start may be negative)."""
+    return math.ceil(lo * scale - 0.5), math.ceil(hi * scale - 0.5)
+
+
 def _paint(rows: list[tuple[int, float, float, float, float]], width: int, height: int, scale: float) -> np.ndarray:
     """Point-sample the label map at the centres of a (height*scale, width*scale) grid: a cell takes the label
     of the full-size pixel under its centre, so any scale samples the same picture consistently."""
@@ -80,9 +86,8 @@ def _paint(rows: list[tuple[int, float, float, float, float]], width: int, heigh
     sx, sy = w / width, h / height
     out = np.zeros((h, w), dtype=np.uint8)
     for lab, x0, y0, x1, y1 in sorted(rows, key=lambda r: PRIORITY[r[0]]):
-        # cells j with x0 <= (j + 0.5) / s < x1
-        a, b = math.ceil(x0 * sx - 0.5), math.ceil(x1 * sx - 0.5)
-        c, d = math.ceil(y0 * sy - 0.5), math.ceil(y1 * sy - 0.5)
+        a, b = cell_span(x0, x1, sx)
+        c, d = cell_span(y0, y1, sy)
         if a < b and c < d:
             out[max(c, 0) : d, max(a, 0) : b] = lab
     return out
