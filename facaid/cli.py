@@ -133,7 +133,7 @@ def cmd_evaluate(args: argparse.Namespace) -> None:
     model, tokenizer = load_model(args.checkpoint)
     result = evaluate_synthetic(model, tokenizer, args.count, args.seed, noise_count=args.noise_count,
                                 unconstrained_count=args.unconstrained_count, best_of=args.best_of,
-                                progress=not args.quiet)
+                                progress=not args.quiet, records=args.records)
     result["checkpoint"] = str(args.checkpoint)
     report = write_report(result, args.report)
     print(report.read_text().split("## Noise")[0].strip())
@@ -276,6 +276,9 @@ def build_parser() -> argparse.ArgumentParser:
                         f"(which decodes {DEFAULT_K})")
     e.add_argument("--report", default="out/evaluate", help="report directory (default out/evaluate)")
     e.add_argument("--json", help="write the figures to this JSON file")
+    e.add_argument("--records", metavar="FILE",
+                   help="append each facade's figures to FILE (JSON lines) as they are measured, and resume from "
+                        "it: a stopped run started again with the same arguments goes on where it stopped")
     e.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=cmd_evaluate)

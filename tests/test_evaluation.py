@@ -5,6 +5,7 @@ import pytest
 from facaid.cli import main
 from facaid.decoding import decode
 from facaid.evaluation.noise import changed_fraction, perturb
+from facaid.evaluation.records import RecordsError
 from facaid.evaluation.synthetic import by_style, evaluate_synthetic, nll, write_report
 from facaid.generator import generate
 from facaid.model import save_model
@@ -87,3 +88,69 @@ def test_cli_evaluate(tiny, tmp_path, capsys):
     assert "Not measured (`--noise-count 0`)." in text and "Mean TED under noise" not in text
     assert main(["evaluate", "--checkpoint", str(tmp_path / "missing"), "--count", "2"]) == 2
     assert "no checkpoint" in capsys.readouterr().err
+
+
+def _without_latency(result):
+    out = {k: v for k, v in result.items() if k != "latency_ms"}
+    out["best_of"] = {k: v for k, v in result["best_of"].items() if k != "latency_ms"}
+    return out
+
+
+def test_records_resume_a_stopped_run_with_the_figures_of_one_run(tiny, tmp_path):
+    model, tok = tiny
+    kw = dict(seed=1000, noise_count=2, unconstrained_count=1, best_of=2, progress=False)
+    whole = evaluate_synthetic(model, tok, count=4, **kw)
+    path = tmp_path / "runs" / "records.jsonl"
+    evaluate_synthetic(model, tok, count=2, records=path, **kw)
+    lines = path.read_text().splitlines()
+    assert len(lines) == 3 and json.loads(lines[0])["settings"]["best_of"] == 2
+    path.write_text("\n".join(lines[:2]) + "\n" + lines[2][: len(lines[2]) // 2])  # stopped while writing
+    resumed = evaluate_synthetic(model, tok, count=4, records=path, **kw)
+    records = [json.loads(line) for line in path.read_text().splitlines()[1:]]
+    assert [r["i"] for r in records] == [0, 1, 2, 3]
+    assert ["noise" in r for r in records] == [True, True, False, False]
+    assert _without_latency(resumed) == _without_latency(whole)
+    # the records answer a smaller count without measuring anything
+    assert evaluate_synthetic(model, tok, count=3, records=path, **kw)["count"] == 3
+    assert len(path.read_text().splitlines()) == 5
+
+
+def test_records_of_other_settings_or_weights_are_refused(tiny, tmp_path):
+    import torch
+
+    model, tok = tiny
+    path = tmp_path / "records.jsonl"
+    kw = dict(noise_count=0, unconstrained_count=0, best_of=0, progress=False, records=path)
+    evaluate_synthetic(model, tok, count=1, seed=1000, **kw)
+    before = path.read_text()
+    with pytest.raises(RecordsError, match=r"other settings \(seed differ\)"):
+        evaluate_synthetic(model, tok, count=1, seed=1001, **kw)
+    other = type(model)(model.config).eval()
+    other.load_state_dict(model.state_dict())
+    with torch.no_grad():
+        next(other.parameters()).add_(1e-3)
+    with pytest.raises(RecordsError, match=r"\(model differ\)"):
+        evaluate_synthetic(other, tok, count=1, seed=1000, **kw)
+    assert path.read_text() == before  # nothing lost
+    bad = tmp_path / "notes.txt"
+    bad.write_text("my notes\n")
+    with pytest.raises(RecordsError, match="not an evaluation records file"):
+        evaluate_synthetic(model, tok, count=1, seed=1000, **{**kw, "records": bad})
+    assert bad.read_text() == "my notes\n"
+    lines = before.splitlines()
+    path.write_text("\n".join([lines[0], "{broken", lines[1]]) + "\n")  # damage before the last line is not dropped
+    with pytest.raises(RecordsError, match="line 2 is not JSON"):
+        evaluate_synthetic(model, tok, count=2, seed=1000, **kw)
+
+
+def test_cli_evaluate_records(tiny, tmp_path, capsys):
+    model, tok = tiny
+    save_model(model, tok, tmp_path / "ckpt")
+    records = tmp_path / "records.jsonl"
+    args = ["evaluate", "--checkpoint", str(tmp_path / "ckpt"), "--count", "2", "--noise-count", "0",
+            "--unconstrained-count", "0", "--report", str(tmp_path / "rep"), "--records", str(records), "--quiet"]
+    assert main(args) == 0
+    assert len(records.read_text().splitlines()) == 3
+    capsys.readouterr()
+    assert main([*args, "--seed", "7"]) == 2
+    assert "other settings (seed differ)" in capsys.readouterr().err

@@ -11,6 +11,7 @@ from __future__ import annotations
 import statistics
 import time
 from collections import Counter
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,7 @@ from tqdm import tqdm
 from facaid.decoding import best_of_k, decode
 from facaid.defaults import FLOOR_TOLERANCE, TEMPERATURE
 from facaid.evaluation.noise import perturb
+from facaid.evaluation.records import RecordLog, model_digest
 from facaid.evaluation.ted import tree_edit_distance, tree_size
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
@@ -29,6 +31,7 @@ from facaid.pipeline import fit_to_model
 from facaid.tokenizer import TokenGrammar, Tokenizer
 
 NOISE_LEVELS = (0.0, 0.05, 0.10, 0.15, 0.20)
+NLL_BATCH = 16  # examples per forward pass of the NLL
 
 
 def production(node: Node) -> str:
@@ -36,11 +39,11 @@ def production(node: Node) -> str:
 
 
 @torch.no_grad()
-def nll(model: FacaidModel, tokenizer: Tokenizer, examples: list, batch_size: int = 16) -> tuple[float, float]:
-    """Mean per-token NLL (nats) of the true sequences: plain, and with invalid tokens nullified (the softmax
-    taken over the tokens the grammar allows)."""
-    plain_sum = null_sum = 0.0
-    tokens = 0
+def nll_sums(model: FacaidModel, tokenizer: Tokenizer, examples: list, batch_size: int = NLL_BATCH
+             ) -> list[tuple[float, float, int]]:
+    """Per example: the summed NLL (nats) of its true sequence, plain and with invalid tokens nullified (the
+    softmax taken over the tokens the grammar allows), and how many tokens were predicted."""
+    out = []
     for i in range(0, len(examples), batch_size):
         chunk = examples[i : i + batch_size]
         rects, mask = batch_inputs([ex["rows"] for ex in chunk])
@@ -57,116 +60,162 @@ def nll(model: FacaidModel, tokenizer: Tokenizer, examples: list, batch_size: in
             allowed_t = torch.from_numpy(np.stack(allowed))  # (T, V)
             n = len(seq) - 1
             tgt = targets[b, :n]
-            plain_sum -= float(logp[b, :n].gather(1, tgt[:, None]).sum())
+            plain = -float(logp[b, :n].gather(1, tgt[:, None]).sum())
             masked = logits[b, :n].float().masked_fill(~allowed_t, float("-inf"))
-            null_sum -= float(torch.log_softmax(masked, -1).gather(1, tgt[:, None]).sum())
-            tokens += n
-    return plain_sum / tokens, null_sum / tokens
+            out.append((plain, -float(torch.log_softmax(masked, -1).gather(1, tgt[:, None]).sum()), n))
+    return out
 
 
-def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, seed: int, *,
-                       noise_count: int = 100, unconstrained_count: int = 200, best_of: int = 0,
-                       progress: bool = True) -> dict:
-    """Figures of the greedy decoder; with ``best_of`` = K > 1 also of best-of-K decoding (the greedy candidate
-    and K-1 samples, the one whose execution reproduces the input best), as `facaid.reconstruct` decodes."""
-    model.eval()
-    examples, skipped, index = [], 0, 0
-    while len(examples) < count:
+def nll(model: FacaidModel, tokenizer: Tokenizer, examples: list, batch_size: int = NLL_BATCH) -> tuple[float, float]:
+    """Mean per-token NLL (nats) of the true sequences: plain, and with invalid tokens nullified."""
+    sums = nll_sums(model, tokenizer, examples, batch_size)
+    tokens = sum(n for _, _, n in sums)
+    return sum(p for p, _, _ in sums) / tokens, sum(q for _, q, _ in sums) / tokens
+
+
+def held_out(tokenizer: Tokenizer, seed: int, start: int = 0) -> Iterator[dict]:
+    """The held-out facades of dataset ``seed`` from dataset index ``start`` on, as examples (``index``,
+    ``sample``, ``rows``, ``tokens``, ``width``, ``height``); facades the model cannot read or write (too many
+    rectangles, too long a sequence) are passed over."""
+    index = start
+    while True:
         s = generate(sample_seed(seed, index))
         index += 1
         tokens = tokenizer.encode_target(s.procedure)
         try:
             rows = tokenizer.encode_segmentation(s.segmentation)
         except ValueError:
-            skipped += 1
             continue
         if len(tokens[0]) > tokenizer.config.max_out:
-            skipped += 1
             continue
-        examples.append({"sample": s, "rows": rows, "tokens": tokens, "width": s.procedure.width,
-                         "height": s.procedure.height})
+        yield {"index": index - 1, "sample": s, "rows": rows, "tokens": tokens, "width": s.procedure.width,
+               "height": s.procedure.height}
 
-    nll_plain, nll_null = nll(model, tokenizer, examples)
-    teds, norm, latency = [], [], []
+
+def measure(model: FacaidModel, tokenizer: Tokenizer, ex: dict, i: int, sums: tuple[float, float, int], *,
+            noise_count: int, unconstrained_count: int, best_of: int) -> dict:
+    """The figures of the ``i``-th held-out example as one JSON-ready record (`summarize` adds them up).
+    Sampling and noise are seeded by ``i``, so a record does not depend on the run that made it, but for its
+    latencies."""
+    s = ex["sample"]
+    truth = s.procedure.root
+    t0 = time.perf_counter()
+    pred = decode(model, tokenizer, s.segmentation)[0]
+    rec: dict = {"i": i, "index": ex["index"], "style": s.style, "nll": list(sums),
+                 "latency": time.perf_counter() - t0, "ted": tree_edit_distance(truth, pred.procedure.root),
+                 "size": tree_size(truth),
+                 "truth": dict(Counter(production(n) for _, n in s.procedure.nodes())),
+                 "predicted": dict(Counter(production(n) for _, n in pred.procedure.nodes()))}
+    if best_of > 1:
+        t0 = time.perf_counter()
+        best = best_of_k(model, tokenizer, s.segmentation, best_of, seed=i)
+        rec["best"] = {"latency": time.perf_counter() - t0, "ted": tree_edit_distance(truth, best.procedure.root)}
+    if i < unconstrained_count:
+        free = decode(model, tokenizer, s.segmentation, constrained=False)[0]
+        rec["unconstrained_valid"] = free.procedure is not None
+    if i < noise_count:
+        rec["noise"] = []  # per level of NOISE_LEVELS[1:]: [TED, pixels changed, TED best of K or None]
+        for level in NOISE_LEVELS[1:]:
+            noisy, measured = perturb(s.segmentation, level, seed=i)
+            noisy = fit_to_model(noisy, tokenizer)  # noise can add pieces
+            d = tree_edit_distance(truth, decode(model, tokenizer, noisy)[0].procedure.root)
+            b = (tree_edit_distance(truth, best_of_k(model, tokenizer, noisy, best_of, seed=i).procedure.root)
+                 if best_of > 1 else None)
+            rec["noise"].append([d, measured, b])
+    return rec
+
+
+def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, seed: int, *,
+                       noise_count: int = 100, unconstrained_count: int = 200, best_of: int = 0,
+                       progress: bool = True, records: str | Path | None = None) -> dict:
+    """Figures of the greedy decoder; with ``best_of`` = K > 1 also of best-of-K decoding (the greedy candidate
+    and K-1 samples, the one whose execution reproduces the input best), as `facaid.reconstruct` decodes.
+
+    With ``records`` (a JSON-lines file), each facade's figures are appended to it as they are measured, and a
+    run started again on the same file with the same settings and weights goes on where the last one stopped
+    (`facaid.evaluation.records`); the figures are then those of one uninterrupted run, but for latency."""
+    model.eval()
+    settings = {"seed": seed, "noise_count": noise_count, "unconstrained_count": unconstrained_count,
+                "best_of": best_of, "temperature": TEMPERATURE, "floor_tolerance": FLOOR_TOLERANCE,
+                "model": model_digest(model, tokenizer)}
+    log = RecordLog(records, settings) if records is not None else None
+    done = log.records[:count] if log else []
+    examples = held_out(tokenizer, seed, start=done[-1]["index"] + 1 if done else 0)
+    bar = tqdm(total=count, initial=len(done), desc="evaluate", disable=not progress)
+    while len(done) < count:
+        chunk = [next(examples) for _ in range(min(NLL_BATCH, count - len(done)))]
+        for ex, sums in zip(chunk, nll_sums(model, tokenizer, chunk), strict=True):
+            rec = measure(model, tokenizer, ex, len(done), sums, noise_count=noise_count,
+                          unconstrained_count=unconstrained_count, best_of=best_of)
+            if log:
+                log.append(rec)
+            done.append(rec)
+            bar.update()
+    bar.close()
+    return summarize(done, seed, best_of)
+
+
+def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
+    """The figures of `evaluate_synthetic` from the records of `measure`, in order."""
+    if not records:
+        raise ValueError("no facades measured")
+    teds = np.array([r["ted"] for r in records])
+    norm = [r["ted"] / r["size"] for r in records]
+    tokens = sum(r["nll"][2] for r in records)
     truth_counts: Counter[str] = Counter()
     pred_counts: Counter[str] = Counter()
-    valid_unconstrained = 0
-    noise_teds: dict[float, list[int]] = {lv: [] for lv in NOISE_LEVELS}
-    noise_measured: dict[float, list[float]] = {lv: [] for lv in NOISE_LEVELS}
-    best_teds: list[int] = []
-    best_latency: list[float] = []
-    best_noise: dict[float, list[int]] = {lv: [] for lv in NOISE_LEVELS}
-    for i, ex in enumerate(tqdm(examples, desc="evaluate", disable=not progress)):
-        s = ex["sample"]
-        t0 = time.perf_counter()
-        pred = decode(model, tokenizer, s.segmentation)[0]
-        latency.append(time.perf_counter() - t0)
-        d = tree_edit_distance(s.procedure.root, pred.procedure.root)
-        teds.append(d)
-        if best_of > 1:
-            t0 = time.perf_counter()
-            best = best_of_k(model, tokenizer, s.segmentation, best_of, seed=i)
-            best_latency.append(time.perf_counter() - t0)
-            best_teds.append(tree_edit_distance(s.procedure.root, best.procedure.root))
-        norm.append(d / tree_size(s.procedure.root))
-        truth_counts.update(production(n) for _, n in s.procedure.nodes())
-        pred_counts.update(production(n) for _, n in pred.procedure.nodes())
-        if i < unconstrained_count:
-            free = decode(model, tokenizer, s.segmentation, constrained=False)[0]
-            valid_unconstrained += free.procedure is not None
-        if i < noise_count:
-            noise_teds[0.0].append(d)
-            noise_measured[0.0].append(0.0)
-            if best_of > 1:
-                best_noise[0.0].append(best_teds[-1])
-            for level in NOISE_LEVELS[1:]:
-                noisy, measured = perturb(s.segmentation, level, seed=i)
-                noisy = fit_to_model(noisy, tokenizer)  # noise can add pieces
-                p = decode(model, tokenizer, noisy)[0]
-                noise_teds[level].append(tree_edit_distance(s.procedure.root, p.procedure.root))
-                noise_measured[level].append(measured)
-                if best_of > 1:
-                    p = best_of_k(model, tokenizer, noisy, best_of, seed=i)
-                    best_noise[level].append(tree_edit_distance(s.procedure.root, p.procedure.root))
-
-    teds_arr = np.array(teds)
-    styles = [ex["sample"].style for ex in examples]
+    for r in records:
+        truth_counts.update(r["truth"])
+        pred_counts.update(r["predicted"])
+    noisy = [r for r in records if "noise" in r]
+    free = [r["unconstrained_valid"] for r in records if "unconstrained_valid" in r]
     hist = Counter(min(int(t), 20) for t in teds)
     norm_hist = Counter(min(int(x * 20), 20) for x in norm)  # bins of 0.05
-    n_unconstrained = min(unconstrained_count, len(examples))
+    latency = [r["latency"] for r in records]
+    best_teds = [r["best"]["ted"] for r in records] if best_of > 1 else []
+
+    def noise_curve(column: int) -> list[list[float]]:  # per level, the TEDs (column 0 greedy, 2 best of K)
+        clean = [r["ted"] if column == 0 else r["best"]["ted"] for r in noisy]
+        return [clean] + [[r["noise"][j][column] for r in noisy] for j in range(len(NOISE_LEVELS) - 1)]
+
+    measured = [[0.0] * len(noisy)] + [[r["noise"][j][1] for r in noisy] for j in range(len(NOISE_LEVELS) - 1)]
     best = None
     if best_of > 1:
         b = np.array(best_teds)
+        blat = [r["best"]["latency"] for r in records]
+        curve = noise_curve(2)
         best = {"k": best_of, "temperature": TEMPERATURE, "composed": True,  # `facaid.composition`
                 "exact_structure_rate": float((b == 0).mean()),
                 "ted_mean": float(b.mean()),
                 "ted_le5": float((b <= 5).mean()),
-                "latency_ms": {"median": 1000 * statistics.median(best_latency),
-                               "p90": 1000 * float(np.percentile(best_latency, 90))},
-                "noise": [{"level": lv, "mean_ted": float(np.mean(best_noise[lv])) if best_noise[lv] else None,
-                           "count": len(best_noise[lv])} for lv in NOISE_LEVELS]}
+                "latency_ms": {"median": 1000 * statistics.median(blat),
+                               "p90": 1000 * float(np.percentile(blat, 90))},
+                "noise": [{"level": lv, "mean_ted": float(np.mean(t)) if t else None, "count": len(t)}
+                          for lv, t in zip(NOISE_LEVELS, curve, strict=True)]}
+    curve = noise_curve(0)
     return {
-        "count": len(examples),
+        "count": len(records),
         "seed": seed,
-        "skipped_too_long": skipped,
+        "skipped_too_long": records[-1]["index"] + 1 - len(records),
         "floor_tolerance": FLOOR_TOLERANCE,  # decoded floors alike within it are merged (`decode`)
-        "nll_per_token": {"plain": nll_plain, "nullified": nll_null},
-        "validity": {"constrained": 1.0, "unconstrained": valid_unconstrained / max(1, n_unconstrained),
-                     "unconstrained_count": n_unconstrained},
-        "exact_structure_rate": float((teds_arr == 0).mean()),
-        "ted": {"mean": float(teds_arr.mean()), "median": float(np.median(teds_arr)),
-                "le5": float((teds_arr <= 5).mean()),
+        "nll_per_token": {"plain": sum(r["nll"][0] for r in records) / tokens,
+                          "nullified": sum(r["nll"][1] for r in records) / tokens},
+        "validity": {"constrained": 1.0, "unconstrained": sum(free) / max(1, len(free)),
+                     "unconstrained_count": len(free)},
+        "exact_structure_rate": float((teds == 0).mean()),
+        "ted": {"mean": float(teds.mean()), "median": float(np.median(teds)),
+                "le5": float((teds <= 5).mean()),
                 "histogram": {("20+" if k == 20 else str(k)): hist[k] for k in sorted(hist)}},
         "ted_normalized": {"mean": float(np.mean(norm)),
                            "histogram": {f"{k * 0.05:.2f}": norm_hist[k] for k in sorted(norm_hist)}},
-        "noise": [{"level": lv, "measured": float(np.mean(noise_measured[lv])) if noise_measured[lv] else None,
-                   "mean_ted": float(np.mean(noise_teds[lv])) if noise_teds[lv] else None,
-                   "count": len(noise_teds[lv])} for lv in NOISE_LEVELS],
+        "noise": [{"level": lv, "measured": float(np.mean(m)) if t else None,
+                   "mean_ted": float(np.mean(t)) if t else None, "count": len(t)}
+                  for lv, t, m in zip(NOISE_LEVELS, curve, measured, strict=True)],
         "latency_ms": {"median": 1000 * statistics.median(latency),
                        "p90": 1000 * float(np.percentile(latency, 90))},
         "productions": {"truth": dict(truth_counts.most_common()), "predicted": dict(pred_counts.most_common())},
         "best_of": best,
-        "by_style": by_style(styles, teds, best_teds),
+        "by_style": by_style([r["style"] for r in records], teds.tolist(), best_teds),
     }
 
 
