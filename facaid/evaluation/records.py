@@ -52,9 +52,6 @@ class RecordLog:
 
     def _read(self) -> None:
         raw = self.path.read_bytes()
-        if not raw.endswith(b"\n"):  # a record cut off (or complete but for its newline): end the line
-            raw += b"\n"
-            self.path.write_bytes(raw)
         lines = raw.split(b"\n")
         try:
             header = json.loads(lines[0])
@@ -70,18 +67,21 @@ class RecordLog:
                                "give another file, or delete this one to start over")
         body = lines[1:]
         last = max((k for k, line in enumerate(body) if line.strip()), default=-1)
-        for k, line in enumerate(body[: last + 1]):
+        kept = last + 1
+        for k, line in enumerate(body[:kept]):
             try:
                 rec = json.loads(line)
             except (json.JSONDecodeError, UnicodeDecodeError):
                 if k < last:
                     raise RecordsError(f"{self.path}: line {k + 2} is not JSON") from None
-                # the line a stopped run was cut off writing: drop it before appending
-                self.path.write_bytes(b"\n".join([lines[0], *body[:k]]) + b"\n")
+                kept = k  # the line a stopped run was cut off writing
                 break
             if not isinstance(rec, dict) or rec.get("i") != len(self.records):
                 raise RecordsError(f"{self.path}: line {k + 2} is not record {len(self.records)} in order")
             self.records.append(rec)
+        whole = b"\n".join([lines[0], *body[:kept]]) + b"\n"
+        if whole != raw:  # drop a cut-off record, end the last line, before appending
+            self.path.write_bytes(whole)
 
     def append(self, record: dict) -> None:
         with self.path.open("a") as f:
