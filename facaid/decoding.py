@@ -102,7 +102,7 @@ def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> 
     return ids[: starts[nodes]]
 
 
-@torch.no_grad()
+@torch.inference_mode()
 def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: int = 1, sample: bool = False,
            temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None,
            max_len: int | None = None, constrained: bool = True, greedy: int = 0,
@@ -132,7 +132,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     processor = GrammarLogitsProcessor(tokenizer, [(seg.width, seg.height)] * k, max_len)
     seqs = [list(start) for _ in range(k)]
     processor.advance(torch.tensor(seqs))  # a prefix that breaks the grammar raises TokenError here
-    logprob = torch.zeros(k, dtype=torch.float64)
+    logprob = [0.0] * k  # float64 sums, in Python: a tensor element update per token costs more
     gen = torch.Generator().manual_seed(seed)
     ids = torch.tensor(seqs, device=device)
     local = torch.tensor([tokenizer.local_indices(s, tokenizer.vocab) for s in seqs], device=device)
@@ -146,11 +146,16 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
         if memory_boxes is not None:
             memory_boxes = memory_boxes.expand(k, -1, -1)
     errors: list[str | None] = [None] * k
+    last_boxes: list[tuple | None] | None = None  # the rows' node boxes (unquantized) of the newest token
+    box_embedding = None  # of ``boxes``, kept while they stay (the tokens of one node)
+    row_boxes = boxes[:, -1]
     while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
         if fast is not None:  # the same logits without the Hugging Face modules' per-call overhead
-            x = model.embed_outputs(ids, local.clamp(max=MAX_LOCAL - 1), boxes)
-            for i in range(x.shape[1]):
-                last = fast.step(x[:, i], boxes[:, i])
+            if box_embedding is None and model.config.node_boxes:
+                box_embedding = model.embed_boxes(boxes)
+            x = model.embed_outputs(ids, local.clamp(max=MAX_LOCAL - 1), boxes, box_embedding)
+            for i in range(x.shape[1]):  # one new token a step after the first (BOS and any prefix)
+                last = fast.step(x[:, i], boxes[:, i] if x.shape[1] > 1 else row_boxes)
         else:
             logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past,
                                         use_cache=True, boxes=boxes, memory_boxes=memory_boxes)
@@ -164,13 +169,14 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
             u = torch.rand(k - greedy, logp.shape[1], generator=gen)
             nxt[greedy:] = (logp[greedy:].cpu() - torch.log(-torch.log(u))).argmax(-1)
         prev_local = local[:, -1].tolist()
-        new_local, new_boxes, none = [], [], []
+        picked = logp.gather(1, nxt.view(k, 1).to(logp.device)).view(k).tolist()  # log p of each row's token
+        new_local, new_boxes = [], []
         for b, t in enumerate(nxt.tolist()):
             g = processor.grammars[b]
             if g.done or errors[b]:
                 t = PAD
             else:
-                logprob[b] += float(logp[b, t])
+                logprob[b] += picked[b]
                 try:
                     g.step(t, check=not constrained)  # a masked choice is allowed already
                 except TokenError as exc:
@@ -178,20 +184,25 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
             seqs[b].append(t)
             new_local.append(tokenizer.vocab.next_local(t, prev_local[b]))
             box = None if errors[b] else g.next_box()
-            new_boxes.append([0.0, 0.0, seg.width, seg.height] if box is None else box)
-            none.append(box is None)
+            new_boxes.append(None if box is None else tuple(box))
         processor.seen = [len(s) for s in seqs]
         ids = nxt.view(k, 1).to(device)
         local = torch.tensor(new_local, device=device).view(k, 1)
-        q = tokenizer.quantize_boxes(np.array(new_boxes), seg.width, seg.height)
-        q[none] = 0
-        boxes = torch.as_tensor(q, device=device).view(k, 1, 4)
+        if new_boxes != last_boxes:  # a new node in some row: its box
+            none = [box is None for box in new_boxes]
+            full = (0.0, 0.0, seg.width, seg.height)
+            q = tokenizer.quantize_boxes(np.array([full if box is None else box for box in new_boxes]),
+                                         seg.width, seg.height)
+            q[none] = 0
+            boxes = torch.as_tensor(q, device=device).view(k, 1, 4)
+            row_boxes = boxes[:, 0]  # the same tensor each step while it stays: `fast` keeps its mask
+            last_boxes, box_embedding = new_boxes, None
     out = []
     for b, g in enumerate(processor.grammars):
         if not g.done:
             if not constrained:
                 error = errors[b] or f"no <eos> within {max_len} tokens"
-                out.append(Candidate([t for t in seqs[b] if t != PAD], float(logprob[b]), None, error=error))
+                out.append(Candidate([t for t in seqs[b] if t != PAD], logprob[b], None, error=error))
                 continue
             # the length budget guarantees this never happens; kept as a loud check
             raise RuntimeError(f"candidate {b} did not finish within {max_len} tokens")
@@ -203,7 +214,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
             if sum(1 for _ in proc.root.bfs()) != nodes:
                 seq = tokenizer.encode_procedure(proc)[0]
         proc.meta = {"source": "model"}
-        out.append(Candidate(seq, float(logprob[b]), proc))
+        out.append(Candidate(seq, logprob[b], proc))
     return out
 
 

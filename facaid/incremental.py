@@ -90,20 +90,21 @@ class IncrementalDecoder:
         self.head = (model.lm_head.weight, model.lm_head.bias)
         self.blocks, self.cross, self.cache = [], [], []
         b = memory.shape[0]
-        with torch.no_grad():
+        with torch.inference_mode():
             for block in dec.h:
                 self.blocks.append(_Block.of(block))
                 c = block.crossattention
                 ck, cv = torch.addmm(c.c_attn.bias, memory.reshape(-1, self.d), c.c_attn.weight).split(self.d, -1)
                 self.cross.append((self._heads(ck.reshape(b, -1, self.d)), self._heads(cv.reshape(b, -1, self.d))))
-                shape = (self.k, self.heads, self.max_len, self.dh)
-                self.cache.append((memory.new_empty(shape), memory.new_empty(shape)))
+                # keys and values in one buffer, so that a step writes both with one copy; and views of each
+                kv = memory.new_empty((2, self.k, self.heads, self.max_len, self.dh))
+                self.cache.append((kv, kv[0], kv[1]))
 
     def _heads(self, x: torch.Tensor) -> torch.Tensor:  # (B, T, d) -> (B, H, T, dh)
         return x.view(x.shape[0], -1, self.heads, self.dh).transpose(1, 2)
 
     def _ln(self, x: torch.Tensor, ln: tuple[torch.Tensor, torch.Tensor]) -> torch.Tensor:
-        return F.layer_norm(x, (self.d,), ln[0], ln[1], self.eps)
+        return torch.layer_norm(x, (self.d,), ln[0], ln[1], self.eps)  # F.layer_norm's kernel, without its checks
 
     def _cross(self, q: torch.Tensor, ck: torch.Tensor, cv: torch.Tensor, mask: torch.Tensor | None) -> torch.Tensor:
         """q (K, d) -> the cross-attention output (K, d)."""
@@ -121,7 +122,7 @@ class IncrementalDecoder:
             return self.mask
         if boxes is None:
             raise ValueError("this model biases cross-attention by the node box: pass each row's box")
-        if self.last_boxes is not None and torch.equal(boxes, self.last_boxes):
+        if self.last_boxes is not None and (boxes is self.last_boxes or torch.equal(boxes, self.last_boxes)):
             return self.last_mask
         if self.shared:  # (1, H, K, M): the K rows' boxes as K positions of the one memory row
             mask = self.scale * FacaidModel.box_share(self.box_terms, boxes[None])[:, None]
@@ -132,7 +133,7 @@ class IncrementalDecoder:
         self.last_boxes, self.last_mask = boxes, mask
         return mask
 
-    @torch.no_grad()
+    @torch.inference_mode()
     def step(self, x: torch.Tensor, boxes: torch.Tensor | None = None) -> torch.Tensor:
         """x (K, d): the embedded newest token of each row -> logits (K, V) for the token after it. ``boxes``
         (K, 4): the quantized node box each row's next token belongs to (what `FacaidModel.embed_outputs` got)."""
@@ -142,11 +143,10 @@ class IncrementalDecoder:
         k, heads, dh = self.k, self.heads, self.dh
         mask = self._cross_mask(boxes)
         x = x + self.wpe[t]
-        for w, (ck, cv), (kc, vc) in zip(self.blocks, self.cross, self.cache, strict=True):
-            q, key, value = torch.addmm(w.attn_b, self._ln(x, w.ln_1), w.attn_w).split(self.d, -1)
-            kc[:, :, t] = key.view(k, heads, dh)
-            vc[:, :, t] = value.view(k, heads, dh)
-            o = F.scaled_dot_product_attention(q.view(k, heads, 1, dh), kc[:, :, : t + 1], vc[:, :, : t + 1])
+        for w, (ck, cv), (kv, kc, vc) in zip(self.blocks, self.cross, self.cache, strict=True):
+            qkv = torch.addmm(w.attn_b, self._ln(x, w.ln_1), w.attn_w).view(k, 3, heads, dh)
+            kv[:, :, :, t] = qkv[:, 1:].transpose(0, 1)
+            o = F.scaled_dot_product_attention(qkv[:, 0, :, None], kc[:, :, : t + 1], vc[:, :, : t + 1])
             x = x + torch.addmm(w.attn_proj_b, o.reshape(k, self.d), w.attn_proj_w)
             q = torch.addmm(w.cross_q_b, self._ln(x, w.ln_cross), w.cross_q_w)
             x = x + torch.addmm(w.cross_proj_b, self._cross(q, ck, cv, mask), w.cross_proj_w)

@@ -130,14 +130,23 @@ class FacaidModel(PreTrainedModel):
         h = self.encoder(inputs_embeds=x, attention_mask=mask.long()).last_hidden_state  # (B, M, d)
         return h, mask
 
-    def embed_outputs(self, ids: torch.Tensor, local: torch.Tensor, boxes: torch.Tensor | None = None) -> torch.Tensor:
-        """The decoder's input embeddings (B, T, d) of output tokens, their local indices and node boxes."""
+    def embed_outputs(self, ids: torch.Tensor, local: torch.Tensor, boxes: torch.Tensor | None = None,
+                      box_embedding: torch.Tensor | None = None) -> torch.Tensor:
+        """The decoder's input embeddings (B, T, d) of output tokens, their local indices and node boxes
+        (``box_embedding``: `embed_boxes` of the boxes, when already computed)."""
         x = self.token_embedding(ids) + self.local_embedding(local)  # (B, T, d)
         if self.config.node_boxes:
-            if boxes is None:
-                raise ValueError("this model reads node boxes: pass boxes (B, T, 4) to decode")
-            x = x + sum(emb(boxes[..., f]) for f, emb in enumerate(self.fields[1:]))
+            if box_embedding is None:
+                if boxes is None:
+                    raise ValueError("this model reads node boxes: pass boxes (B, T, 4) to decode")
+                box_embedding = self.embed_boxes(boxes)
+            x = x + box_embedding
         return x
+
+    def embed_boxes(self, boxes: torch.Tensor) -> torch.Tensor:
+        """The node boxes' part of `embed_outputs`: (..., 4) quantized x, y, w, h -> (..., d), embedded with the
+        input rectangles' tables. Decoding reuses it for all the tokens of a node."""
+        return sum(emb(boxes[..., f]) for f, emb in enumerate(self.fields[1:]))
 
     def memory_boxes(self, rects: torch.Tensor) -> torch.Tensor:
         """(B, N, F) encoded rectangles -> (B, M, 5) float (x0, y0, x1, y1, is a rectangle) per memory position, in
@@ -189,8 +198,8 @@ class FacaidModel(PreTrainedModel):
                 raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
             mask = self.cross_bias(memory_boxes, memory_mask, boxes).to(x.dtype)
         out = self.decoder(inputs_embeds=x, encoder_hidden_states=memory,
-                           encoder_attention_mask=mask, past_key_values=past, use_cache=use_cache)
-        return self.lm_head(out.last_hidden_state), out.past_key_values  # (B, T, V)
+                           encoder_attention_mask=mask, cache=past, use_cache=use_cache)
+        return self.lm_head(out.last_hidden_state), out.cache  # (B, T, V)
 
     def forward(self, rects: torch.Tensor, rect_mask: torch.Tensor, ids: torch.Tensor, local: torch.Tensor,
                 targets: torch.Tensor | None = None, boxes: torch.Tensor | None = None

@@ -197,6 +197,36 @@ def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, s
     assert [c.ids for c in a] == [c.ids for c in b]
 
 
+@pytest.mark.parametrize("incremental", [True, False])
+def test_decoded_log_probability_is_the_teacher_forced_one(biased_model, incremental):
+    """`decode` keeps a node's box, its embedding and its cross-attention bias while the node's tokens last;
+    teacher forcing the decoded sequence recomputes all of them at every position and must give the same
+    masked log-probability."""
+    from facaid.model import MAX_LOCAL, batch_inputs
+
+    seg = generate(6).segmentation
+    rects, mask = batch_inputs([TOK.encode_segmentation(seg)])
+    candidates = decode(biased_model, TOK, seg, k=3, sample=True, seed=2, greedy=1, merge_floors=False,
+                        incremental=incremental)
+    for c in candidates:
+        inputs = c.ids[:-1]
+        local = torch.tensor([TOK.local_indices(inputs, TOK.vocab)]).clamp(max=MAX_LOCAL - 1)
+        boxes = torch.as_tensor(TOK.node_boxes(inputs, seg.width, seg.height))[None]
+        with torch.no_grad():
+            memory, memory_mask = biased_model.encode(rects, mask)
+            logits, _ = biased_model.decode(torch.tensor([inputs]), local, memory, memory_mask, boxes=boxes,
+                                            memory_boxes=biased_model.memory_boxes(rects))
+        grammar = TokenGrammar(TOK.vocab, seg.width, seg.height, CONFIG.max_out)
+        total = 0.0
+        for t, token in enumerate(c.ids[1:]):
+            allowed = torch.from_numpy(grammar.allowed())
+            total += float(torch.log_softmax(logits[0, t].masked_fill(~allowed, float("-inf")), -1)[token])
+            grammar.step(token)
+        assert grammar.done
+        assert total == pytest.approx(c.logprob, abs=1e-4)
+    assert len({tuple(c.ids) for c in candidates}) > 1  # the samples differ: more than one path was checked
+
+
 def test_incremental_and_module_decoding_agree(tiny_model):
     seg = generate(6).segmentation
     a = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1)
