@@ -141,6 +141,14 @@ def cmd_evaluate(args: argparse.Namespace) -> None:
     _write_json(args.json, result)
 
 
+def cmd_compare(args: argparse.Namespace) -> None:
+    from facaid.evaluation.compare import compare_records, format_comparison
+
+    result = compare_records(args.a, args.b)
+    print(format_comparison(result))
+    _write_json(args.json, result)
+
+
 def cmd_reconstruct(args: argparse.Namespace) -> None:
     from facaid.grammar.execute import to_segmentation
     from facaid.model import load_model
@@ -282,6 +290,16 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=cmd_evaluate)
+
+    p = sub.add_parser("compare", help="compare two evaluation runs facade by facade",
+                       description="Paired comparison of two `evaluate --records` files of the same held-out "
+                                   "facades (same --seed): per figure, how many facades B decodes better and "
+                                   "worse than A, and the mean change of the tree edit distance (B - A) with a "
+                                   "bootstrap 95 % interval.")
+    p.add_argument("a", help="records file of run A (the reference)")
+    p.add_argument("b", help="records file of run B")
+    p.add_argument("--json", help="write the figures to this JSON file")
+    p.set_defaults(func=cmd_compare)
 
     c = sub.add_parser("reconstruct", help="reconstruct a procedure from a segmentation JSON",
                        description="Flatten, decode with the grammar-constrained transformer (best of K), fit the "

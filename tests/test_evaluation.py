@@ -154,3 +154,62 @@ def test_cli_evaluate_records(tiny, tmp_path, capsys):
     capsys.readouterr()
     assert main([*args, "--seed", "7"]) == 2
     assert "other settings (seed differ)" in capsys.readouterr().err
+
+
+def _records(path, seed, teds, best=None, noise=None, styles=None):
+    from facaid.evaluation.records import RecordLog
+
+    log = RecordLog(path, {"seed": seed, "noise_count": len(noise or []), "model": f"m{len(teds)}{best}"})
+    for i, t in enumerate(teds):
+        rec = {"i": i, "index": 2 * i, "style": (styles or ["house"] * len(teds))[i], "ted": t}
+        if best is not None:
+            rec["best"] = {"ted": best[i]}
+        if noise and i < len(noise):
+            rec["noise"] = [[n, 0.05 * (j + 1), None] for j, n in enumerate(noise[i])]
+        log.append(rec)
+    return path
+
+
+def test_compare_pairs_two_runs_facade_by_facade(tmp_path):
+    from facaid.evaluation.compare import compare_records, format_comparison
+
+    a = _records(tmp_path / "a.jsonl", 7, [0, 2, 6, 0], best=[0, 0, 4, 0], noise=[[1, 2, 3, 4], [0, 0, 0, 0]],
+                 styles=["house", "wings", "wings", "house"])
+    b = _records(tmp_path / "b.jsonl", 7, [0, 0, 8, 1, 5], best=[0, 1, 2, 0, 0], noise=[[0, 2, 5, 4], [0, 1, 0, 0]],
+                 styles=["house", "wings", "wings", "house", "house"])
+    with b.open("a") as f:
+        f.write('{"i": 5, "index"')  # cut off by a stopped run: left out, the file left as it is
+    before = b.read_bytes()
+    result = compare_records(a, b)
+    assert b.read_bytes() == before
+    assert result["count"] == 4 and result["seed"] == 7 and not result["same_model"]  # facade 5 is B's alone
+    g = result["figures"]["greedy"]
+    assert (g["better"], g["worse"], g["mean_change"]) == (1, 2, pytest.approx(0.25))
+    assert g["a"] == {"exact": 0.5, "le5": 0.75, "mean_ted": 2.0} and g["b"]["mean_ted"] == 2.25
+    assert g["interval"][0] <= 0.25 <= g["interval"][1]
+    best = result["figures"]["best"]
+    assert (best["better"], best["worse"], best["mean_change"]) == (1, 1, pytest.approx(-0.25))
+    wings = result["figures"]["best, wings"]
+    assert (wings["count"], wings["better"], wings["worse"]) == (2, 1, 1)
+    ten = result["figures"]["10 % noise, greedy"]
+    assert (ten["count"], ten["better"], ten["worse"], ten["mean_change"]) == (2, 0, 1, pytest.approx(0.5))
+    assert "10 % noise, best" not in result["figures"]  # the noise curve had no best of K
+    table = format_comparison(result)
+    assert "| greedy | 4 | 50.0 % / 75.0 % / 2.00 | 50.0 % / 75.0 % / 2.25 | 1 | 2 | +0.25 (" in table
+
+
+def test_compare_refuses_runs_of_other_facades(tmp_path, capsys):
+    a = _records(tmp_path / "a.jsonl", 7, [0, 1])
+    b = _records(tmp_path / "b.jsonl", 8, [0, 1])
+    assert main(["compare", str(a), str(b)]) == 2
+    assert "different facades (seed 7 and 8)" in capsys.readouterr().err
+    notes = tmp_path / "notes.txt"
+    notes.write_text("not records\n")
+    assert main(["compare", str(a), str(notes)]) == 2
+    assert "not an evaluation records file" in capsys.readouterr().err
+    assert main(["compare", str(a), str(tmp_path / "missing.jsonl")]) == 2
+    assert "no records file" in capsys.readouterr().err
+    out = tmp_path / "cmp.json"
+    assert main(["compare", str(a), str(_records(tmp_path / "c.jsonl", 7, [1, 1])), "--json", str(out)]) == 0
+    assert "| greedy | 2 |" in capsys.readouterr().out
+    assert json.loads(out.read_text())["figures"]["greedy"]["worse"] == 1

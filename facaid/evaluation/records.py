@@ -52,34 +52,12 @@ class RecordLog:
 
     def _read(self) -> None:
         raw = self.path.read_bytes()
-        lines = raw.split(b"\n")
-        try:
-            header = json.loads(lines[0])
-        except (json.JSONDecodeError, UnicodeDecodeError):
-            raise RecordsError(f"{self.path} is not an evaluation records file (its first line is not JSON)") \
-                from None
-        if not isinstance(header, dict) or "settings" not in header:
-            raise RecordsError(f"{self.path} is not an evaluation records file (no settings on its first line)")
+        header, self.records, whole = _parse(self.path, raw)
         if header["settings"] != self.settings:
             differ = sorted(k for k in set(header["settings"]) | set(self.settings)
                             if header["settings"].get(k) != self.settings.get(k))
             raise RecordsError(f"{self.path} holds records of other settings ({', '.join(differ)} differ); "
                                "give another file, or delete this one to start over")
-        body = lines[1:]
-        last = max((k for k, line in enumerate(body) if line.strip()), default=-1)
-        kept = last + 1
-        for k, line in enumerate(body[:kept]):
-            try:
-                rec = json.loads(line)
-            except (json.JSONDecodeError, UnicodeDecodeError):
-                if k < last:
-                    raise RecordsError(f"{self.path}: line {k + 2} is not JSON") from None
-                kept = k  # the line a stopped run was cut off writing
-                break
-            if not isinstance(rec, dict) or rec.get("i") != len(self.records):
-                raise RecordsError(f"{self.path}: line {k + 2} is not record {len(self.records)} in order")
-            self.records.append(rec)
-        whole = b"\n".join([lines[0], *body[:kept]]) + b"\n"
         if whole != raw:  # drop a cut-off record, end the last line, before appending
             self.path.write_bytes(whole)
 
@@ -89,3 +67,40 @@ class RecordLog:
             f.flush()
             os.fsync(f.fileno())
         self.records.append(record)
+
+
+def read_records(path: str | Path) -> tuple[dict, list[dict]]:
+    """The settings and records of a records file, read only: a record cut off by a stopped run is left out."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no records file at {path}")
+    header, records, _ = _parse(path, path.read_bytes())
+    return header["settings"], records
+
+
+def _parse(path: Path, raw: bytes) -> tuple[dict, list[dict], bytes]:
+    """The file ``path`` read as ``raw``: (header, records, its bytes without a cut-off last record and with the
+    last line ended)."""
+    lines = raw.split(b"\n")
+    try:
+        header = json.loads(lines[0])
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise RecordsError(f"{path} is not an evaluation records file (its first line is not JSON)") from None
+    if not isinstance(header, dict) or not isinstance(header.get("settings"), dict):
+        raise RecordsError(f"{path} is not an evaluation records file (no settings on its first line)")
+    body = lines[1:]
+    last = max((k for k, line in enumerate(body) if line.strip()), default=-1)
+    kept = last + 1
+    records: list[dict] = []
+    for k, line in enumerate(body[:kept]):
+        try:
+            rec = json.loads(line)
+        except (json.JSONDecodeError, UnicodeDecodeError):
+            if k < last:
+                raise RecordsError(f"{path}: line {k + 2} is not JSON") from None
+            kept = k  # the line a stopped run was cut off writing
+            break
+        if not isinstance(rec, dict) or rec.get("i") != len(records):
+            raise RecordsError(f"{path}: line {k + 2} is not record {len(records)} in order")
+        records.append(rec)
+    return header, records, b"\n".join([lines[0], *body[:kept]]) + b"\n"
