@@ -185,7 +185,7 @@ def test_compare_pairs_two_runs_facade_by_facade(tmp_path):
     assert result["count"] == 4 and result["seed"] == 7 and not result["same_model"]  # facade 5 is B's alone
     g = result["figures"]["greedy"]
     assert (g["better"], g["worse"], g["mean_change"]) == (1, 2, pytest.approx(0.25))
-    assert g["a"] == {"exact": 0.5, "le5": 0.75, "mean_ted": 2.0} and g["b"]["mean_ted"] == 2.25
+    assert g["a"] == {"exact_structure_rate": 0.5, "ted_le5": 0.75, "ted_mean": 2.0} and g["b"]["ted_mean"] == 2.25
     assert g["interval"][0] <= 0.25 <= g["interval"][1]
     best = result["figures"]["best"]
     assert (best["better"], best["worse"], best["mean_change"]) == (1, 1, pytest.approx(-0.25))

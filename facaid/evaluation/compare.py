@@ -14,23 +14,18 @@ from pathlib import Path
 import numpy as np
 
 from facaid.evaluation.records import RecordsError, read_records
-from facaid.evaluation.synthetic import NOISE_LEVELS
+from facaid.evaluation.synthetic import NOISE_LEVELS, ted_figures
 
 BOOTSTRAP = 2000
 
 
-def _rates(teds: np.ndarray) -> dict:
-    return {"exact": float(np.mean(teds == 0)), "le5": float(np.mean(teds <= 5)), "mean_ted": float(np.mean(teds))}
-
-
 def paired(a: list[float], b: list[float], seed: int = 0) -> dict:
     """Figures of A and B on the same facades (TED lists in the same order) and the paired change B − A."""
-    ta, tb = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    d = tb - ta
+    d = np.asarray(b, dtype=float) - np.asarray(a, dtype=float)
     rng = np.random.default_rng(seed)
     means = d[rng.integers(0, len(d), size=(BOOTSTRAP, len(d)))].mean(1)
     lo, hi = np.quantile(means, [0.025, 0.975])
-    return {"count": len(d), "a": _rates(ta), "b": _rates(tb), "better": int((d < 0).sum()),
+    return {"count": len(d), "a": ted_figures(a), "b": ted_figures(b), "better": int((d < 0).sum()),
             "worse": int((d > 0).sum()), "mean_change": float(d.mean()), "interval": [float(lo), float(hi)]}
 
 
@@ -56,9 +51,7 @@ def compare_records(path_a: str | Path, path_b: str | Path) -> dict:
             rows = [i for i in best if a[i]["style"] == style]
             figures[f"best, {style}"] = paired([a[i]["best"]["ted"] for i in rows], [b[i]["best"]["ted"] for i in rows])
     noisy = [i for i in common if a[i].get("noise") and b[i].get("noise")]
-    for j, level in enumerate(NOISE_LEVELS[1:]):
-        if not noisy:
-            break
+    for j, level in enumerate(NOISE_LEVELS[1:] if noisy else ()):
         name = f"{round(100 * level)} % noise"
         figures[f"{name}, greedy"] = paired([a[i]["noise"][j][0] for i in noisy], [b[i]["noise"][j][0] for i in noisy])
         if all(a[i]["noise"][j][2] is not None and b[i]["noise"][j][2] is not None for i in noisy):
@@ -75,7 +68,7 @@ def format_comparison(result: dict) -> str:
              "| mean TED change (95 % interval) |", "| --- | --- | --- | --- | --- | --- | --- |"]
 
     def rates(r: dict) -> str:
-        return f"{100 * r['exact']:.1f} % / {100 * r['le5']:.1f} % / {r['mean_ted']:.2f}"
+        return f"{100 * r['exact_structure_rate']:.1f} % / {100 * r['ted_le5']:.1f} % / {r['ted_mean']:.2f}"
 
     for name, f in result["figures"].items():
         lo, hi = f["interval"]

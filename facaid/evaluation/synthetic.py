@@ -181,13 +181,10 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
     measured = [[0.0] * len(noisy)] + [[r["noise"][j][1] for r in noisy] for j in range(len(NOISE_LEVELS) - 1)]
     best = None
     if best_of > 1:
-        b = np.array(best_teds)
         blat = [r["best"]["latency"] for r in records]
         curve = noise_curve(2)
         best = {"k": best_of, "temperature": TEMPERATURE, "composed": True,  # `facaid.composition`
-                "exact_structure_rate": float((b == 0).mean()),
-                "ted_mean": float(b.mean()),
-                "ted_le5": float((b <= 5).mean()),
+                **ted_figures(best_teds),
                 "latency_ms": {"median": 1000 * statistics.median(blat),
                                "p90": 1000 * float(np.percentile(blat, 90))},
                 "noise": [{"level": lv, "mean_ted": float(np.mean(t)) if t else None, "count": len(t)}
@@ -219,7 +216,8 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
     }
 
 
-def _ted_figures(teds: list[int]) -> dict:
+def ted_figures(teds: list[int]) -> dict:
+    """Exact structure rate, TED <= 5 and mean TED of a list of tree edit distances."""
     t = np.array(teds)
     return {"exact_structure_rate": float((t == 0).mean()), "ted_le5": float((t <= 5).mean()),
             "ted_mean": float(t.mean())}
@@ -230,9 +228,9 @@ def by_style(styles: list[str], teds: list[int], best_teds: list[int] | None = N
     out = {}
     for name in sorted(set(styles)):
         pick = [i for i, st in enumerate(styles) if st == name]
-        out[name] = {"count": len(pick), "greedy": _ted_figures([teds[i] for i in pick])}
+        out[name] = {"count": len(pick), "greedy": ted_figures([teds[i] for i in pick])}
         if best_teds:
-            out[name]["best_of"] = _ted_figures([best_teds[i] for i in pick])
+            out[name]["best_of"] = ted_figures([best_teds[i] for i in pick])
     return out
 
 
