@@ -58,6 +58,7 @@ class GrammarLogitsProcessor:
             self.seen[b] = len(row)
 
     def mask(self) -> np.ndarray:
+        """(B, V) bool: the tokens each row's grammar allows next."""
         masks = []
         for b, g in enumerate(self.grammars):
             if g.done:
@@ -68,7 +69,7 @@ class GrammarLogitsProcessor:
                 if not m.any():
                     raise ValueError(f"constraint is unsatisfiable for row {b} after {g.length} tokens")
             masks.append(m)
-        return np.stack(masks)
+        return masks[0][None] if len(masks) == 1 else np.stack(masks)  # one row (greedy): no copy
 
     def __call__(self, input_ids: torch.Tensor, scores: torch.Tensor) -> torch.Tensor:
         if scores.dim() != 2 or scores.shape[1] != len(self.tokenizer.vocab):
@@ -135,7 +136,9 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     logprob = [0.0] * k  # float64 sums, in Python: a tensor element update per token costs more
     gen = torch.Generator().manual_seed(seed)
     ids = torch.tensor(seqs, device=device)
-    local = torch.tensor([tokenizer.local_indices(s, tokenizer.vocab) for s in seqs], device=device)
+    prev_local = [tokenizer.local_indices(s, tokenizer.vocab) for s in seqs]
+    local = torch.tensor(prev_local, device=device).clamp(max=MAX_LOCAL - 1)
+    prev_local = [row[-1] for row in prev_local]  # each row's newest local index, not clamped
     boxes = torch.as_tensor(tokenizer.node_boxes(start, seg.width, seg.height), device=device).expand(k, -1, -1)
     past = None
     fast = None
@@ -146,30 +149,35 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
         if memory_boxes is not None:
             memory_boxes = memory_boxes.expand(k, -1, -1)
     errors: list[str | None] = [None] * k
+    vocab = tokenizer.vocab
     last_boxes: list[tuple | None] | None = None  # the rows' node boxes (unquantized) of the newest token
     box_embedding = None  # of ``boxes``, kept while they stay (the tokens of one node)
     row_boxes = boxes[:, -1]
     while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
         if fast is not None:  # the same logits without the Hugging Face modules' per-call overhead
-            if box_embedding is None and model.config.node_boxes:
+            if box_embedding is None and model.node_boxes:
                 box_embedding = model.embed_boxes(boxes)
-            x = model.embed_outputs(ids, local.clamp(max=MAX_LOCAL - 1), boxes, box_embedding)
+            x = model.embed_outputs(ids, local, boxes, box_embedding)
             for i in range(x.shape[1]):  # one new token a step after the first (BOS and any prefix)
                 last = fast.step(x[:, i], boxes[:, i] if x.shape[1] > 1 else row_boxes)
         else:
-            logits, past = model.decode(ids, local.clamp(max=MAX_LOCAL - 1), memory, memory_mask, past,
+            logits, past = model.decode(ids, local, memory, memory_mask, past,
                                         use_cache=True, boxes=boxes, memory_boxes=memory_boxes)
             last = logits[:, -1]
-        scores = last.float() / temperature  # (K, V)
+        scores = last if last.dtype == torch.float32 else last.float()  # (K, V)
+        if temperature != 1.0:
+            scores = scores / temperature
         if constrained:
-            scores = scores.masked_fill(~torch.from_numpy(processor.mask()).to(device), float("-inf"))
+            scores = scores.masked_fill(torch.from_numpy(~processor.mask()).to(device), float("-inf"))
         logp = torch.log_softmax(scores, dim=-1)
-        nxt = logp.argmax(-1).cpu()
         if sample and greedy < k:  # Gumbel-max: argmax(log p + G) is a draw from p, cheaper than multinomial
+            nxt = logp.argmax(-1).cpu()
             u = torch.rand(k - greedy, logp.shape[1], generator=gen)
             nxt[greedy:] = (logp[greedy:].cpu() - torch.log(-torch.log(u))).argmax(-1)
-        prev_local = local[:, -1].tolist()
-        picked = logp.gather(1, nxt.view(k, 1).to(logp.device)).view(k).tolist()  # log p of each row's token
+            picked = logp.gather(1, nxt.view(k, 1).to(logp.device)).view(k).tolist()  # log p of each row's token
+        else:  # the largest log p and where it is (the first of equal ones, as argmax) in one operation
+            top, nxt = logp.max(-1)
+            picked, nxt = top.tolist(), nxt.cpu()
         new_local, new_boxes = [], []
         for b, t in enumerate(nxt.tolist()):
             g = processor.grammars[b]
@@ -182,12 +190,13 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
                 except TokenError as exc:
                     errors[b] = str(exc)
             seqs[b].append(t)
-            new_local.append(tokenizer.vocab.next_local(t, prev_local[b]))
+            new_local.append(vocab.next_local(t, prev_local[b]))
             box = None if errors[b] else g.next_box()
             new_boxes.append(None if box is None else tuple(box))
         processor.seen = [len(s) for s in seqs]
         ids = nxt.view(k, 1).to(device)
-        local = torch.tensor(new_local, device=device).view(k, 1)
+        prev_local = new_local
+        local = torch.tensor([min(i, MAX_LOCAL - 1) for i in new_local], device=device).view(k, 1)
         if new_boxes != last_boxes:  # a new node in some row: its box
             none = [box is None for box in new_boxes]
             full = (0.0, 0.0, seg.width, seg.height)

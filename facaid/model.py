@@ -64,6 +64,7 @@ class FacaidModel(PreTrainedModel):
         tc = config.tokenizer_config
         d = config.d_model
         self.rect_tokens = tc.rect_tokens
+        self.node_boxes = config.node_boxes  # read per decoded token: an attribute costs less than the config's
         sizes = tok.input_vocab_sizes
         self.fields = nn.ModuleList(nn.Embedding(n, d) for n in sizes[:5])  # label, x, y, w, h (and node boxes)
         # the peer counts of `facaid.tokenizer.peer_counts`, zero at first: a model widened with them
@@ -134,8 +135,10 @@ class FacaidModel(PreTrainedModel):
                       box_embedding: torch.Tensor | None = None) -> torch.Tensor:
         """The decoder's input embeddings (B, T, d) of output tokens, their local indices and node boxes
         (``box_embedding``: `embed_boxes` of the boxes, when already computed)."""
-        x = self.token_embedding(ids) + self.local_embedding(local)  # (B, T, d)
-        if self.config.node_boxes:
+        # the tables through F.embedding rather than the modules: decoding embeds one token at a time, where a
+        # module call's overhead costs more than the lookup
+        x = F.embedding(ids, self.token_embedding.weight) + F.embedding(local, self.local_embedding.weight)
+        if self.node_boxes:
             if box_embedding is None:
                 if boxes is None:
                     raise ValueError("this model reads node boxes: pass boxes (B, T, 4) to decode")
@@ -146,7 +149,10 @@ class FacaidModel(PreTrainedModel):
     def embed_boxes(self, boxes: torch.Tensor) -> torch.Tensor:
         """The node boxes' part of `embed_outputs`: (..., 4) quantized x, y, w, h -> (..., d), embedded with the
         input rectangles' tables. Decoding reuses it for all the tokens of a node."""
-        return sum(emb(boxes[..., f]) for f, emb in enumerate(self.fields[1:]))
+        f = self.fields  # by index: a slice of a ModuleList builds a new ModuleList
+        x, y, w, h = f[1].weight, f[2].weight, f[3].weight, f[4].weight
+        return (F.embedding(boxes[..., 0], x) + F.embedding(boxes[..., 1], y) + F.embedding(boxes[..., 2], w)
+                + F.embedding(boxes[..., 3], h))
 
     def memory_boxes(self, rects: torch.Tensor) -> torch.Tensor:
         """(B, N, F) encoded rectangles -> (B, M, 5) float (x0, y0, x1, y1, is a rectangle) per memory position, in
