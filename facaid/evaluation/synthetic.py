@@ -273,7 +273,14 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
 
     pts = [p for p in result["noise"] if p["mean_ted"] is not None]
     fig, ax = plt.subplots(figsize=(5, 3.5))
-    ax.plot([100 * p["measured"] for p in pts], [p["mean_ted"] for p in pts], "o-", color="#cc0000")
+    ax.plot([100 * p["measured"] for p in pts], [p["mean_ted"] for p in pts], "o-", color="#cc0000", label="greedy")
+    best = {p["level"]: p["mean_ted"] for p in (result.get("best_of") or {}).get("noise", [])
+            if p["mean_ted"] is not None}
+    if best:  # the same noisy inputs, so at the greedy curve's measured shares
+        both = [p for p in pts if p["level"] in best]
+        ax.plot([100 * p["measured"] for p in both], [best[p["level"]] for p in both], "s-", color="#3465a4",
+                label=f"best of {result['best_of']['k']}")
+        ax.legend()
     ax.set_xlabel("pixels changed (%)")
     ax.set_ylabel("mean TED")
     ax.set_title("noise robustness")
