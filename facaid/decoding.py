@@ -136,9 +136,9 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     logprob = [0.0] * k  # float64 sums, in Python: a tensor element update per token costs more
     gen = torch.Generator().manual_seed(seed)
     ids = torch.tensor(seqs, device=device)
-    prev_local = [tokenizer.local_indices(s, tokenizer.vocab) for s in seqs]
-    local = torch.tensor(prev_local, device=device).clamp(max=MAX_LOCAL - 1)
-    prev_local = [row[-1] for row in prev_local]  # each row's newest local index, not clamped
+    start_local = [tokenizer.local_indices(s, tokenizer.vocab) for s in seqs]
+    local = torch.tensor(start_local, device=device).clamp(max=MAX_LOCAL - 1)
+    prev_local = [row[-1] for row in start_local]  # each row's newest local index, not clamped
     boxes = torch.as_tensor(tokenizer.node_boxes(start, seg.width, seg.height), device=device).expand(k, -1, -1)
     past = None
     fast = None
@@ -164,7 +164,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
             logits, past = model.decode(ids, local, memory, memory_mask, past,
                                         use_cache=True, boxes=boxes, memory_boxes=memory_boxes)
             last = logits[:, -1]
-        scores = last if last.dtype == torch.float32 else last.float()  # (K, V)
+        scores = last.float()  # (K, V)
         if temperature != 1.0:
             scores = scores / temperature
         if constrained:
