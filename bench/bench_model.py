@@ -5,8 +5,9 @@
 Training steps use the shipped config's model size on the same length-sorted batch of generated facades; the
 two input layouts are timed alternately in one run and compared as a ratio (``--steps 0`` skips them).
 Inference: greedy, constrained, batch 1, the shipped checkpoint, median over held-out facades (target: <= 300 ms
-on 2 CPU cores). With ``--repeat R`` each facade is decoded R times in a row; the figures of the first decodes
-are printed, and the median of each facade's fastest decode, which leaves out most of what other work on a shared
+on 2 CPU cores), with the native C step that `decode` uses (`facaid.native`) and with the torch step, the two
+alternating. With ``--repeat R`` each facade is decoded R times in a row; the figures of the first decodes are
+printed, and the median of each facade's fastest decode, which leaves out most of what other work on a shared
 machine adds (the decodes are the same bit for bit).
 """
 
@@ -22,6 +23,7 @@ from facaid.decoding import decode
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model
+from facaid.native import library as native_library
 from facaid.paths import DEFAULT_CHECKPOINT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
@@ -49,25 +51,30 @@ def train_step_times(steps: int, batch_size: int = 32) -> dict[int, float]:
     return {rt: statistics.median(v[1:] or v) for rt, v in times.items()}
 
 
-def inference_latency(checkpoint: str, facades: int, repeat: int = 1) -> list[list[float]]:
-    """Seconds per greedy decode: ``repeat`` decodes of each of ``facades`` held-out facades."""
+def inference_latency(checkpoint: str, facades: int, repeat: int = 1) -> dict[bool, list[list[float]]]:
+    """Seconds per greedy decode: ``repeat`` decodes of each of ``facades`` held-out facades, with the native C
+    step (True) and with the torch step (False), the two alternating so that both see the same machine."""
     model, tok = load_model(checkpoint)
-    decode(model, tok, generate(sample_seed(999, 0)).segmentation)  # warm-up, not timed (another seed)
-    out = []
+    seg = generate(sample_seed(999, 0)).segmentation
+    for native in (True, False):  # warm-up (builds the native step if needed), not timed (another seed)
+        decode(model, tok, seg, native=native)
+    out: dict[bool, list[list[float]]] = {True: [], False: []}
     i = 0
-    while len(out) < facades:
+    while len(out[True]) < facades:
         s = generate(sample_seed(1000, i))
         i += 1
         try:
             tok.encode_segmentation(s.segmentation)
         except ValueError:
             continue
-        runs = []
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            decode(model, tok, s.segmentation)
-            runs.append(time.perf_counter() - t0)
-        out.append(runs)
+        runs: dict[bool, list[float]] = {True: [], False: []}
+        for r in range(repeat):
+            for native in ((True, False) if (i + r) % 2 else (False, True)):
+                t0 = time.perf_counter()
+                decode(model, tok, s.segmentation, native=native)
+                runs[native].append(time.perf_counter() - t0)
+        for native, seconds in runs.items():
+            out[native].append(seconds)
     return out
 
 
@@ -91,10 +98,16 @@ def main() -> None:
         print(f"training step, batch 32: 1 token/rect {t[1]:.2f} s, 5 tokens/rect {t[5]:.2f} s "
               f"(5-token / 1-token = {t[5] / t[1]:.2f})")
     if args.facades:
-        lat = inference_latency(args.checkpoint, args.facades, args.repeat)
-        print(f"inference, greedy, batch 1, {len(lat)} facades: {_figures([runs[0] for runs in lat])}")
-        if args.repeat > 1:
-            print(f"  fastest of {args.repeat} decodes per facade: {_figures([min(runs) for runs in lat])}")
+        both = inference_latency(args.checkpoint, args.facades, args.repeat)
+        if native_library() is None:
+            print("(no native step on this machine: both rows below run the torch step)")
+        for native, name in ((True, "native C step"), (False, "torch step")):
+            lat = both[native]
+            print(f"inference, greedy, batch 1, {name}, {len(lat)} facades: {_figures([runs[0] for runs in lat])}")
+            if args.repeat > 1:
+                print(f"  fastest of {args.repeat} decodes per facade: {_figures([min(runs) for runs in lat])}")
+        ratios = [min(a) / min(b) for a, b in zip(both[True], both[False], strict=True)]
+        print(f"native / torch, median of per-facade ratios: {statistics.median(ratios):.3f}")
 
 
 if __name__ == "__main__":

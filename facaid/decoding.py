@@ -24,6 +24,7 @@ from facaid.grammar.procedure import Procedure
 from facaid.incremental import IncrementalDecoder
 from facaid.metrics import element_counts, pixel_accuracy, scaled_label_map, scaled_procedure_map
 from facaid.model import MAX_LOCAL, FacaidModel, batch_inputs
+from facaid.native import native_decoder
 from facaid.segmentation import Segmentation
 from facaid.tokenizer import BOS, EOS, PAD, TokenError, TokenGrammar, Tokenizer
 
@@ -107,7 +108,7 @@ def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> 
 def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: int = 1, sample: bool = False,
            temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None,
            max_len: int | None = None, constrained: bool = True, greedy: int = 0,
-           incremental: bool = True, merge_floors: bool = True) -> list[Candidate]:
+           incremental: bool = True, merge_floors: bool = True, native: bool = True) -> list[Candidate]:
     """K candidate procedures for a segmentation (greedy when ``sample`` is False; then K copies are equal).
 
     With ``merge_floors`` (and no ``prefix``), neighbouring floors with the same tree and sizes within
@@ -115,7 +116,9 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     ids are then those of the merged tree, its log-probability that of the decoded sequence.
 
     With ``sample``, the first ``greedy`` rows are still decoded greedily, in the same batch as the samples.
-    ``incremental`` (in eval mode) steps with `IncrementalDecoder`; False runs the Hugging Face modules.
+    ``incremental`` (in eval mode) steps with `IncrementalDecoder`; False runs the Hugging Face modules. With
+    ``native`` a single row steps with the C step of `facaid.native` when it is available (the same logits to
+    about 1e-5).
 
     ``constrained=False`` decodes without the grammar mask, to measure what nullification buys: a sequence
     that breaks the grammar stops there and comes back with ``procedure=None`` and the error."""
@@ -143,7 +146,9 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     past = None
     fast = None
     if incremental and not model.training:
-        fast = IncrementalDecoder(model, memory, memory_mask, max_len, rows=k, memory_boxes=memory_boxes)
+        if k == 1 and native:  # one row: the C step, where it builds (`facaid.native`); K rows batch better in torch
+            fast = native_decoder(model, memory, memory_mask, max_len, memory_boxes=memory_boxes)
+        fast = fast or IncrementalDecoder(model, memory, memory_mask, max_len, rows=k, memory_boxes=memory_boxes)
     else:
         memory, memory_mask = memory.expand(k, -1, -1).contiguous(), memory_mask.expand(k, -1).contiguous()
         if memory_boxes is not None:

@@ -1,0 +1,97 @@
+"""The decoder step in C (`facaid.native`): the same logits as the torch paths, and a clean fallback."""
+
+import pytest
+import torch
+
+from facaid import native
+from facaid.decoding import decode
+from facaid.generator import generate
+from facaid.incremental import IncrementalDecoder
+from facaid.model import batch_inputs, batch_outputs, with_box_bias
+
+pytestmark = pytest.mark.skipif(native.library() is None, reason="no C compiler to build the native step")
+
+
+@pytest.fixture(scope="module")
+def models(tiny):
+    model, tok = tiny
+    biased = with_box_bias(model)
+    biased.box_scale.data = torch.tensor([3.0, -2.0])
+    return {"plain": model, "biased": biased}, tok
+
+
+@pytest.mark.parametrize("kind", ["plain", "biased"])
+@pytest.mark.parametrize("k", [1, 3])
+def test_native_step_gives_the_hugging_face_logits(models, kind, k):
+    by_kind, tok = models
+    model = by_kind[kind]
+    sample = generate(4)
+    rects, mask = batch_inputs([tok.encode_segmentation(sample.segmentation)])
+    ids, local, _, boxes = batch_outputs([tok.encode_target(sample.procedure)] * k)
+    ids, local, boxes = ids[:, :50], local[:, :50], boxes[:, :50]
+    with torch.no_grad():
+        memory, memory_mask = model.encode(rects, mask)
+        memory_boxes = model.memory_boxes(rects) if model.box_scale is not None else None
+        full, _ = model.decode(ids, local, memory.repeat(k, 1, 1), memory_mask.repeat(k, 1), boxes=boxes,
+                               memory_boxes=None if memory_boxes is None else memory_boxes.repeat(k, 1, 1))
+        fast = native.NativeDecoder(model, memory, memory_mask, max_len=64, rows=k, memory_boxes=memory_boxes)
+        x = model.embed_outputs(ids, local, boxes)
+        steps = torch.stack([fast.step(x[:, i], boxes[:, i]) for i in range(x.shape[1])], 1)
+    assert torch.allclose(steps, full, atol=1e-5)
+    with pytest.raises(ValueError, match="x must be float32"):
+        fast.step(x[:1, 0, :3], boxes[:, 0])
+
+
+def test_native_step_masks_padded_memory(models):
+    """A padding position of the memory (a bool mask from `encode`) must get no attention, as in torch."""
+    by_kind, tok = models
+    model = by_kind["plain"]
+    rects, mask = batch_inputs([tok.encode_segmentation(generate(5).segmentation)])
+    with torch.no_grad():
+        memory, memory_mask = model.encode(rects, mask)
+        memory_mask = memory_mask.clone()
+        memory_mask[0, -3:] = False
+        memory[0, -3:] = 50.0  # would dominate the attention if it were read
+        a = IncrementalDecoder(model, memory, memory_mask, max_len=16)
+        b = native.NativeDecoder(model, memory, memory_mask, max_len=16)
+        x = torch.randn(12, 1, memory.shape[-1], generator=torch.Generator().manual_seed(0))
+        for step in x:
+            assert torch.allclose(a.step(step), b.step(step), atol=1e-5)
+        with pytest.raises(ValueError, match="at most 16 positions"):
+            for step in torch.zeros(5, 1, memory.shape[-1]):
+                b.step(step)
+
+
+def test_shipped_model_decodes_the_same_with_the_native_step():
+    from facaid.model import load_model
+    from facaid.paths import DEFAULT_CHECKPOINT
+
+    model, tok = load_model(DEFAULT_CHECKPOINT)
+    for seed in (0, 1, 2):
+        seg = generate(seed).segmentation
+        a = decode(model, tok, seg, native=False)[0]
+        b = decode(model, tok, seg)[0]
+        assert a.ids == b.ids and b.logprob == pytest.approx(a.logprob, abs=1e-3)
+
+
+def test_without_the_library_decoding_keeps_torch(models, monkeypatch):
+    by_kind, tok = models
+    seg = generate(4).segmentation
+    expected = decode(by_kind["biased"], tok, seg)[0].ids
+    monkeypatch.setenv("FACAID_NATIVE", "0")
+    assert native.library() is None
+    rects, mask = batch_inputs([tok.encode_segmentation(seg)])
+    memory, memory_mask = by_kind["plain"].encode(rects, mask)
+    assert native.native_decoder(by_kind["plain"], memory, memory_mask, 16) is None
+    assert decode(by_kind["biased"], tok, seg)[0].ids == expected
+
+
+def test_build_is_cached_and_reports_a_failing_compiler(tmp_path, monkeypatch):
+    monkeypatch.setenv("FACAID_CACHE", str(tmp_path))
+    path = native.build()
+    assert path.parent == tmp_path / "native" and path.is_file()
+    assert native.build() == path  # built once per source, flags and machine
+    path.unlink()
+    with pytest.raises(RuntimeError, match="failed"):
+        native.build(compiler="false")  # exits 1, as a broken compiler would
+    assert not list((tmp_path / "native").iterdir())  # nothing half-written is left
