@@ -105,8 +105,8 @@ class NativeDecoder(IncrementalDecoder):
     def __init__(self, model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor, max_len: int,
                  rows: int | None = None, memory_boxes: torch.Tensor | None = None, lib: ctypes.CDLL | None = None):
         super().__init__(model, memory, memory_mask, max_len, rows=rows, memory_boxes=memory_boxes)
-        if memory.shape[0] != 1:
-            raise ValueError("the native step reads one memory row shared by all decoded rows")
+        if memory.shape[0] != 1 or memory.dtype != torch.float32:
+            raise ValueError("the native step reads one float32 memory row shared by all decoded rows")
         self.lib = lib or library()
         if self.lib is None:
             raise RuntimeError("the native step library is unavailable")
@@ -177,8 +177,9 @@ class NativeDecoder(IncrementalDecoder):
 
 def native_decoder(model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor, max_len: int,
                    rows: int | None = None, memory_boxes: torch.Tensor | None = None) -> NativeDecoder | None:
-    """A `NativeDecoder` when the C step is available and applies (one memory row, on the CPU), else None."""
-    if memory.shape[0] != 1 or memory.device.type != "cpu":
+    """A `NativeDecoder` when the C step is available and applies (one float32 memory row on the CPU), else
+    None."""
+    if memory.shape[0] != 1 or memory.device.type != "cpu" or memory.dtype != torch.float32:
         return None
     lib = library()
     if lib is None:

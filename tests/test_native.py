@@ -83,6 +83,10 @@ def test_without_the_library_decoding_keeps_torch(models, monkeypatch):
     rects, mask = batch_inputs([tok.encode_segmentation(seg)])
     memory, memory_mask = by_kind["plain"].encode(rects, mask)
     assert native.native_decoder(by_kind["plain"], memory, memory_mask, 16) is None
+    monkeypatch.delenv("FACAID_NATIVE")
+    assert native.native_decoder(by_kind["plain"], memory.double(), memory_mask, 16) is None  # float32 only
+    assert native.native_decoder(by_kind["plain"], memory.repeat(2, 1, 1), memory_mask.repeat(2, 1), 16) is None
+    assert native.native_decoder(by_kind["plain"], memory, memory_mask, 16) is not None
     assert decode(by_kind["biased"], tok, seg)[0].ids == expected
 
 
