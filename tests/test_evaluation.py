@@ -151,6 +151,8 @@ def test_cli_evaluate_records(tiny, tmp_path, capsys):
             "--unconstrained-count", "0", "--report", str(tmp_path / "rep"), "--records", str(records), "--quiet"]
     assert main(args) == 0
     assert len(records.read_text().splitlines()) == 3
+    # no facade decoded without the mask: its validity is not measured, not 0 %
+    assert "| validity, unconstrained (0 facades) | not measured |" in (tmp_path / "rep" / "report.md").read_text()
     capsys.readouterr()
     assert main([*args, "--seed", "7"]) == 2
     assert "other settings (seed differ)" in capsys.readouterr().err

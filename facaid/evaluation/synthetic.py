@@ -197,7 +197,7 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
         "floor_tolerance": FLOOR_TOLERANCE,  # decoded floors alike within it are merged (`decode`)
         "nll_per_token": {"plain": sum(r["nll"][0] for r in records) / tokens,
                           "nullified": sum(r["nll"][1] for r in records) / tokens},
-        "validity": {"constrained": 1.0, "unconstrained": sum(free) / max(1, len(free)),
+        "validity": {"constrained": 1.0, "unconstrained": sum(free) / len(free) if free else None,
                      "unconstrained_count": len(free)},
         "exact_structure_rate": float((teds == 0).mean()),
         "ted": {"mean": float(teds.mean()), "median": float(np.median(teds)),
@@ -303,7 +303,8 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
         f"| NLL per token, with nullification | {r['nll_per_token']['nullified']:.4f} |",
         f"| validity, constrained | {100 * r['validity']['constrained']:.1f} % |",
         f"| validity, unconstrained ({r['validity']['unconstrained_count']} facades) | "
-        f"{100 * r['validity']['unconstrained']:.1f} % |",
+        + ("not measured |" if r["validity"]["unconstrained"] is None else
+           f"{100 * r['validity']['unconstrained']:.1f} % |"),
         f"| exact structure (TED = 0) | {100 * r['exact_structure_rate']:.1f} % |",
         f"| TED ≤ 5 | {100 * r['ted']['le5']:.1f} % |",
         f"| mean TED | {r['ted']['mean']:.2f} |",
