@@ -7,7 +7,7 @@
    that a head's scores are sums of scaled key rows. At a few hundred steps of one token, torch's fixed cost per
    operation (a few microseconds, about 16 operations a block) outweighs this arithmetic; one call does it all.
 
-   Built and loaded by facaid/native.py; checked against the torch path to 1e-4 by tests/test_native.py. */
+   Built and loaded by facaid/native.py; checked against the torch paths to 1e-5 by tests/test_native.py. */
 
 #include <math.h>
 #include <stddef.h>
