@@ -3,7 +3,7 @@
 Greedy decoding takes a few hundred steps of one token, and a step is some 80 torch operations on vectors of
 128: their fixed cost, not the arithmetic, sets the time. `NativeDecoder` does the whole step in one call of a
 small C function (the same arithmetic as `IncrementalDecoder.step`; the tests check the logits to 1e-5). It takes
-K rows of one input, but `facaid.decoding.decode` uses it for one row (greedy, 0.64x the torch step's time):
+K rows of one input, but `facaid.decoding.decode` uses it for one row (greedy, 0.56x the torch step's time):
 with 16 rows torch's batched matrix products on two threads are faster than this single-threaded loop.
 
 The library is compiled once per source and machine into ``$FACAID_CACHE`` (default ``~/.cache/facaid``) with

@@ -62,11 +62,34 @@ def test_native_step_masks_padded_memory(models):
                 b.step(step)
 
 
-def test_shipped_model_decodes_the_same_with_the_native_step():
+@pytest.fixture(scope="module")
+def shipped():
     from facaid.model import load_model
     from facaid.paths import DEFAULT_CHECKPOINT
 
-    model, tok = load_model(DEFAULT_CHECKPOINT)
+    return load_model(DEFAULT_CHECKPOINT)
+
+
+def test_shipped_model_logits_match_the_torch_step(shipped):
+    """The shipped weights have the activations the C step must get right (softmax and GELU over real ranges):
+    its logits along a real facade's sequence against the torch step's."""
+    model, tok = shipped
+    sample = generate(3)
+    rects, mask = batch_inputs([tok.encode_segmentation(sample.segmentation)])
+    ids, local, _, boxes = batch_outputs([tok.encode_target(sample.procedure)])
+    with torch.no_grad():
+        memory, memory_mask = model.encode(rects, mask)
+        memory_boxes = model.memory_boxes(rects)
+        a = IncrementalDecoder(model, memory, memory_mask, max_len=ids.shape[1], memory_boxes=memory_boxes)
+        b = native.NativeDecoder(model, memory, memory_mask, max_len=ids.shape[1], memory_boxes=memory_boxes)
+        x = model.embed_outputs(ids, local, boxes)
+        worst = max(float((a.step(x[:, i], boxes[:, i]) - b.step(x[:, i], boxes[:, i])).abs().max())
+                    for i in range(x.shape[1]))
+    assert worst < 1e-4
+
+
+def test_shipped_model_decodes_the_same_with_the_native_step(shipped):
+    model, tok = shipped
     for seed in (0, 1, 2):
         seg = generate(seed).segmentation
         a = decode(model, tok, seg, native=False)[0]
