@@ -74,7 +74,10 @@ class IncrementalDecoder:
         self.eps = cfg.layer_norm_epsilon
         self.t = 0
         self.max_len = min(max_len, cfg.n_positions)
-        self.mask = None if bool(memory_mask.all()) else memory_mask[:, None, None, :]
+        self.mask = None  # (B, 1, 1, M) additive: the smallest float where a memory position is padding
+        if not bool(memory_mask.all()):
+            self.mask = memory.new_zeros(memory_mask.shape).masked_fill(
+                ~memory_mask, torch.finfo(memory.dtype).min)[:, None, None, :]
         self.box_scale = model.box_scale
         if self.box_scale is not None:
             if memory_boxes is None:
@@ -82,8 +85,6 @@ class IncrementalDecoder:
             # `FacaidModel.cross_bias` split into what the memory fixes once and what each step's boxes add
             self.box_terms = model.box_terms(memory_boxes)
             self.scale = self.box_scale.detach().view(1, -1, 1, 1)
-            self.pad = None if self.mask is None else self.box_terms[2].new_zeros(memory_mask.shape).masked_fill(
-                ~memory_mask, torch.finfo(torch.float32).min)[:, None, None, :]
             self.last_boxes = self.last_mask = None
         self.wpe = dec.wpe.weight
         self.ln_f = (dec.ln_f.weight, dec.ln_f.bias)
@@ -128,8 +129,8 @@ class IncrementalDecoder:
             mask = self.scale * FacaidModel.box_share(self.box_terms, boxes[None])[:, None]
         else:  # (K, H, 1, M): one position per row
             mask = self.scale * FacaidModel.box_share(self.box_terms, boxes[:, None])[:, None]
-        if self.pad is not None:
-            mask = mask + self.pad
+        if self.mask is not None:
+            mask = mask + self.mask
         self.last_boxes, self.last_mask = boxes, mask
         return mask
 

@@ -105,14 +105,13 @@ class NativeDecoder(IncrementalDecoder):
 
     def __init__(self, model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor, max_len: int,
                  rows: int | None = None, memory_boxes: torch.Tensor | None = None, lib: ctypes.CDLL | None = None):
-        super().__init__(model, memory, memory_mask, max_len, rows=rows, memory_boxes=memory_boxes)
-        if memory.shape[0] != 1 or memory.dtype != torch.float32:
-            raise ValueError("the native step reads one float32 memory row shared by all decoded rows")
+        reason = _unsupported(model, memory)
+        if reason:
+            raise ValueError(reason)
         self.lib = lib or library()
         if self.lib is None:
             raise RuntimeError("the native step library is unavailable")
-        if next(model.parameters()).device.type != "cpu":
-            raise ValueError("the native step runs on the CPU")
+        super().__init__(model, memory, memory_mask, max_len, rows=rows, memory_boxes=memory_boxes)
         self.ffn = self.blocks[0].fc_w.shape[1]
         self.m = memory.shape[1]
         self.keep: list[np.ndarray] = []  # every array the pointers point into
@@ -134,7 +133,7 @@ class NativeDecoder(IncrementalDecoder):
         head_t = _array(self.head[0].t())  # (d, V)
         head_b = None if self.head[1] is None else _array(self.head[1])
         self.vocab = head_t.shape[1]
-        work = np.empty(self.k * (8 * self.d + self.ffn) + max(self.max_len, self.m), dtype=np.float32)
+        work = np.empty(self.k * (6 * self.d + self.ffn) + max(self.max_len, self.m), dtype=np.float32)  # step.c
         self.keep += [wpe, *ln_f, head_t, work] + ([] if head_b is None else [head_b])
         self.wpe_at = wpe.ctypes.data
         self.head_args = (ln_f[0].ctypes.data, ln_f[1].ctypes.data, head_t.ctypes.data,
@@ -149,10 +148,7 @@ class NativeDecoder(IncrementalDecoder):
             return None, 0, 0
         if self.mask_np[0] is mask:
             return self.mask_np[1:]
-        additive = mask
-        if mask.dtype == torch.bool:  # True where attended: 0 there, the smallest float elsewhere
-            additive = torch.zeros(mask.shape).masked_fill(~mask, torch.finfo(torch.float32).min)
-        a = _array(additive[0])  # (H or 1, K or 1, M)
+        a = _array(mask[0])  # (H or 1, K or 1, M), additive (`IncrementalDecoder` builds it so)
         h_stride = 0 if a.shape[0] == 1 else a.shape[1] * self.m
         r_stride = 0 if a.shape[1] == 1 else self.m
         self.mask_np = (mask, a, h_stride, r_stride)
@@ -176,11 +172,20 @@ class NativeDecoder(IncrementalDecoder):
         return out
 
 
+def _unsupported(model: FacaidModel, memory: torch.Tensor) -> str | None:
+    """Why the C step cannot run this model on this memory, or None when it can."""
+    if memory.shape[0] != 1 or memory.dtype != torch.float32:
+        return "the native step reads one float32 memory row shared by all decoded rows"
+    if memory.device.type != "cpu" or next(model.parameters()).device.type != "cpu":
+        return "the native step runs on the CPU"
+    return None
+
+
 def native_decoder(model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor, max_len: int,
                    rows: int | None = None, memory_boxes: torch.Tensor | None = None) -> NativeDecoder | None:
     """A `NativeDecoder` when the C step is available and applies (one float32 memory row on the CPU), else
     None."""
-    if memory.shape[0] != 1 or memory.device.type != "cpu" or memory.dtype != torch.float32:
+    if _unsupported(model, memory):
         return None
     lib = library()
     if lib is None:

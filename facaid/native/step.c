@@ -4,8 +4,9 @@
    key/value cache, cross-attention on the memory with an additive mask, tanh-GELU MLP, final layer norm and
    the output head), written so that the compiler vectorizes every inner loop without reassociating sums:
    matrix-vector products as sums of scaled rows (weights stored (in, out)), keys stored transposed (dh, T) so
-   that a head's scores are sums of scaled key rows, and e^x without library calls (fast_expf). At a few hundred steps of one token, torch's fixed cost per
-   operation (a few microseconds, about 16 operations a block) outweighs this arithmetic; one call does it all.
+   that a head's scores are sums of scaled key rows, and e^x without library calls (fast_expf). At a few hundred
+   steps of one token, torch's fixed cost per operation (a few microseconds, about 16 operations a block)
+   outweighs this arithmetic; one call does it all.
 
    Built and loaded by facaid/native.py; checked against the torch paths to 1e-5 by tests/test_native.py. */
 
@@ -155,8 +156,8 @@ static void attend(const float *restrict q, const float *restrict keys, size_t k
 /* One step for K rows at position t. blocks: BLOCK_PTRS pointers per block (see the enum); the self cache of a
    block holds keys (K, H, dh, L) and values (K, H, L, dh); cross keys (H, dh, M), values (H, M, dh). mask: the
    additive cross-attention mask, element (h, r, m) at h * mask_h + r * mask_r + m, or NULL. x (K, d): the
-   embedded tokens; wpe_t (d): the position embedding of t. work: at least K * (4 d + 3 d + f) + max(L, M)
-   floats. out (K, V): logits. */
+   embedded tokens; wpe_t (d): the position embedding of t. work: at least K * (6 d + f) + max(L, M) floats
+   (x, h, qkv, att, hid, then the scores). out (K, V): logits. */
 int facaid_step(int n_blocks, void **blocks, int k, int d, int heads, int f, int m, int l, int t, int v,
                 const float *x_in, const float *wpe_t, const float *mask, long mask_h, long mask_r,
                 const float *lnf_g, const float *lnf_b, const float *head_wt, const float *head_b, float eps,
