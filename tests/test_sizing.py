@@ -1,3 +1,4 @@
+import numpy as np
 import pytest
 import torch
 
@@ -127,3 +128,27 @@ def test_smoothed_integrals_give_the_sigmoid_rasterizers_overlap_and_gradient():
     reference.backward()
     cos = torch.nn.functional.cosine_similarity(a.grad.flatten(), b.grad.flatten(), dim=0)
     assert cos.item() > 0.95
+
+
+def test_smoothed_integrals_equal_an_explicit_convolution():
+    """Pinned to a plain reference: each class's indicator, edge-padded and convolved with the logistic density
+    (13 taps at tau = 1) along both axes, then summed into a table."""
+    rng = np.random.default_rng(3)
+    label_map = rng.choice(np.array([0, 1, 2, 5], dtype=np.uint8), size=(37, 53), p=[0.1, 0.5, 0.3, 0.1])
+    label_map[10:20, 5:40] = 2  # a block, so the smoothing has edges to blur as well as noise
+    for tau in (1.0, 0.5, 0.0):
+        got = smoothed_integrals(label_map, [1, 2, 5], tau).numpy()
+        assert got.shape == (3, 38, 54)
+        for i, c in enumerate([1, 2, 5]):
+            g = (label_map == c).astype(np.float64)
+            if tau > 0:
+                r = int(np.ceil(6 * tau))
+                t = np.abs(np.arange(-r, r + 1)) / tau
+                kernel = np.exp(-t) / (1 + np.exp(-t)) ** 2
+                kernel /= kernel.sum()
+                p = np.pad(g, r, mode="edge")
+                p = np.stack([np.convolve(col, kernel, mode="valid") for col in p.T], 1)  # along y
+                g = np.stack([np.convolve(row, kernel, mode="valid") for row in p], 0)  # along x
+            want = np.zeros((38, 54))
+            want[1:, 1:] = g.cumsum(0).cumsum(1)
+            np.testing.assert_allclose(got[i], want, rtol=0, atol=1e-9)
