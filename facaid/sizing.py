@@ -87,17 +87,40 @@ def box_integrals(tables: torch.Tensor, index: torch.Tensor, boxes: torch.Tensor
     """For each box (L, 4: x0, y0, x1, y1 in table pixels), the integral of table ``index[l]`` over it.
 
     Bilinear in the summed-area table, which is exact for a piecewise-constant map: differentiable in the
-    box edges at sub-pixel precision, O(L) per call whatever the image size."""
-    _, hp, wp = tables.shape
-    xs = torch.stack([boxes[:, 0], boxes[:, 2]], 1).clamp(0, wp - 1)  # (L, 2)
-    ys = torch.stack([boxes[:, 1], boxes[:, 3]], 1).clamp(0, hp - 1)
-    xi = xs.detach().floor().clamp(max=wp - 2).long()
-    yi = ys.detach().floor().clamp(max=hp - 2).long()
-    fx, fy = (xs - xi)[:, None, :], (ys - yi)[:, :, None]
-    c, x, y = index[:, None, None], xi[:, None, :], yi[:, :, None]
-    v = (tables[c, y, x] * (1 - fx) * (1 - fy) + tables[c, y, x + 1] * fx * (1 - fy)
-         + tables[c, y + 1, x] * (1 - fx) * fy + tables[c, y + 1, x + 1] * fx * fy)  # (L, 2 ys, 2 xs)
-    return v[:, 1, 1] - v[:, 1, 0] - v[:, 0, 1] + v[:, 0, 0]
+    box edges at sub-pixel precision, O(L) per call whatever the image size. Computed in numpy with a
+    hand-written gradient (`_BoxIntegrals`), the same as torch's autograd of the bilinear lookups."""
+    return _BoxIntegrals.apply(boxes, tables, index)
+
+
+class _BoxIntegrals(torch.autograd.Function):
+    @staticmethod
+    def forward(ctx, boxes: torch.Tensor, tables: torch.Tensor, index: torch.Tensor) -> torch.Tensor:
+        t = tables.detach().cpu().numpy()
+        _, hp, wp = t.shape
+        b = boxes.detach().cpu().numpy().astype(np.float64)
+        raw = b[:, [0, 2, 1, 3]].reshape(-1, 2, 2)  # (L, axis x|y, low|high edge)
+        top = np.array([wp - 1, hp - 1])[None, :, None]
+        edges = np.clip(raw, 0, top)
+        cell = np.minimum(np.floor(edges), top - 1).astype(np.int64)
+        f = edges - cell  # (L, 2, 2)
+        c = index.detach().cpu().numpy()[:, None, None]
+        x, y = cell[:, 0][:, None, :], cell[:, 1][:, :, None]  # (L, 1, 2 xs), (L, 2 ys, 1)
+        t00, t01, t10, t11 = t[c, y, x], t[c, y, x + 1], t[c, y + 1, x], t[c, y + 1, x + 1]  # (L, 2 ys, 2 xs)
+        fx, fy = f[:, 0][:, None, :], f[:, 1][:, :, None]
+        v = t00 * (1 - fx) * (1 - fy) + t01 * fx * (1 - fy) + t10 * (1 - fx) * fy + t11 * fx * fy
+        sign = np.array([[1.0, -1.0], [-1.0, 1.0]])  # v[1, 1] - v[1, 0] - v[0, 1] + v[0, 0]
+        # d v / d x edge and d v / d y edge of each corner, signed; zero where the clamp held the edge
+        inside = (raw >= 0) & (raw <= top)
+        dx = (((t01 - t00) * (1 - fy) + (t11 - t10) * fy) * sign).sum(1) * inside[:, 0]  # (L, 2 xs)
+        dy = (((t10 - t00) * (1 - fx) + (t11 - t01) * fx) * sign).sum(2) * inside[:, 1]  # (L, 2 ys)
+        ctx.grad = np.stack([dx[:, 0], dy[:, 0], dx[:, 1], dy[:, 1]], 1)  # as the box's columns
+        out = (v * sign).sum((1, 2))
+        return torch.from_numpy(out).to(device=boxes.device, dtype=boxes.dtype)
+
+    @staticmethod
+    def backward(ctx, grad: torch.Tensor):
+        g = torch.from_numpy(ctx.grad).to(device=grad.device, dtype=grad.dtype) * grad[:, None]
+        return g, None, None
 
 
 def fit_sizes(proc: Procedure, target: Segmentation, *, geometry_rounds: int = 2, geometry_steps: int = 20,

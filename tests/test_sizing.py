@@ -152,3 +152,39 @@ def test_smoothed_integrals_equal_an_explicit_convolution():
             want = np.zeros((38, 54))
             want[1:, 1:] = g.cumsum(0).cumsum(1)
             np.testing.assert_allclose(got[i], want, rtol=0, atol=1e-9)
+
+
+def _reference_box_integrals(tables, index, boxes):
+    """The bilinear lookups as plain torch operations (the implementation before the numpy one)."""
+    _, hp, wp = tables.shape
+    xs = torch.stack([boxes[:, 0], boxes[:, 2]], 1).clamp(0, wp - 1)
+    ys = torch.stack([boxes[:, 1], boxes[:, 3]], 1).clamp(0, hp - 1)
+    xi = xs.detach().floor().clamp(max=wp - 2).long()
+    yi = ys.detach().floor().clamp(max=hp - 2).long()
+    fx, fy = (xs - xi)[:, None, :], (ys - yi)[:, :, None]
+    c, x, y = index[:, None, None], xi[:, None, :], yi[:, :, None]
+    v = (tables[c, y, x] * (1 - fx) * (1 - fy) + tables[c, y, x + 1] * fx * (1 - fy)
+         + tables[c, y + 1, x] * (1 - fx) * fy + tables[c, y + 1, x + 1] * fx * fy)
+    return v[:, 1, 1] - v[:, 1, 0] - v[:, 0, 1] + v[:, 0, 0]
+
+
+def test_box_integrals_equal_torchs_autograd_of_the_lookups():
+    rng = np.random.default_rng(4)
+    label_map = rng.choice(np.array([1, 2, 3], dtype=np.uint8), size=(41, 67))
+    tables = smoothed_integrals(label_map, [1, 2, 3], 1.0)
+    _, hp, wp = tables.shape
+    n = 60
+    boxes = torch.from_numpy(np.stack([rng.uniform(-5, wp + 5, n), rng.uniform(-5, hp + 5, n),
+                                       rng.uniform(-5, wp + 5, n), rng.uniform(-5, hp + 5, n)], 1))
+    boxes[:4] = torch.tensor([[0.0, 0.0, wp - 1, hp - 1], [3.0, 7.0, 20.0, 30.0], [wp - 1, 2.5, wp - 1, hp - 1.0],
+                              [-1.0, hp - 1, 10.5, hp + 2.0]], dtype=torch.float64)  # on the bounds, on whole pixels
+    index = torch.from_numpy(rng.integers(0, 3, n))
+    a = boxes.clone().requires_grad_(True)
+    b = boxes.clone().requires_grad_(True)
+    got = box_integrals(tables, index, a)
+    want = _reference_box_integrals(tables, index, b)
+    torch.testing.assert_close(got, want, rtol=0, atol=1e-9)
+    weights = torch.from_numpy(rng.normal(size=n))
+    (got * weights).sum().backward()
+    (want * weights).sum().backward()
+    torch.testing.assert_close(a.grad, b.grad, rtol=0, atol=1e-9)
