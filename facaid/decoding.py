@@ -11,6 +11,7 @@ keeps the first.
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +25,7 @@ from facaid.grammar.procedure import Procedure
 from facaid.incremental import IncrementalDecoder
 from facaid.metrics import element_counts, pixel_accuracy, scaled_label_map, scaled_procedure_map
 from facaid.model import MAX_LOCAL, FacaidModel, batch_inputs
-from facaid.native import native_decoder
+from facaid.native import native_decoder, torch_threads
 from facaid.segmentation import Segmentation
 from facaid.tokenizer import BOS, EOS, PAD, TokenError, TokenGrammar, Tokenizer
 
@@ -117,8 +118,8 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
 
     With ``sample``, the first ``greedy`` rows are still decoded greedily, in the same batch as the samples.
     ``incremental`` (in eval mode) steps with `IncrementalDecoder`; False runs the Hugging Face modules. With
-    ``native`` a single row steps with the C step of `facaid.native` when it is available (the same logits to
-    about 1e-5).
+    ``native`` the rows step with the C step of `facaid.native` when it is available (the same logits to
+    about 1e-5); K > 1 rows in shards on torch's threads, torch held to one thread meanwhile.
 
     ``constrained=False`` decodes without the grammar mask, to measure what nullification buys: a sequence
     that breaks the grammar stops there and comes back with ``procedure=None`` and the error."""
@@ -146,8 +147,10 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     past = None
     fast = None
     if incremental and not model.training:
-        if k == 1 and native:  # one row: the C step, where it builds (`facaid.native`); K rows batch better in torch
-            fast = native_decoder(model, memory, memory_mask, max_len, memory_boxes=memory_boxes)
+        if native:  # the C step, where it builds (`facaid.native`): K rows in shards on torch's threads
+            threads = torch.get_num_threads() if k > 1 else 1
+            fast = native_decoder(model, memory, memory_mask, max_len, rows=k, memory_boxes=memory_boxes,
+                                  threads=threads)
         fast = fast or IncrementalDecoder(model, memory, memory_mask, max_len, rows=k, memory_boxes=memory_boxes)
     else:
         memory, memory_mask = memory.expand(k, -1, -1).contiguous(), memory_mask.expand(k, -1).contiguous()
@@ -158,59 +161,61 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     last_boxes: list[tuple | None] | None = None  # the rows' node boxes (unquantized) of the newest token
     box_embedding = None  # of ``boxes``, kept while they stay (the tokens of one node)
     row_boxes = boxes[:, -1]
-    while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
-        if fast is not None:  # the same logits without the Hugging Face modules' per-call overhead
-            if box_embedding is None and model.node_boxes:
-                box_embedding = model.embed_boxes(boxes)
-            x = model.embed_outputs(ids, local, boxes, box_embedding)
-            for i in range(x.shape[1]):  # one new token a step after the first (BOS and any prefix)
-                last = fast.step(x[:, i], boxes[:, i] if x.shape[1] > 1 else row_boxes)
-        else:
-            logits, past = model.decode(ids, local, memory, memory_mask, past,
-                                        use_cache=True, boxes=boxes, memory_boxes=memory_boxes)
-            last = logits[:, -1]
-        scores = last.float()  # (K, V)
-        if temperature != 1.0:
-            scores = scores / temperature
-        if constrained:
-            scores = scores.masked_fill(torch.from_numpy(~processor.mask()).to(device), float("-inf"))
-        logp = torch.log_softmax(scores, dim=-1)
-        if sample and greedy < k:  # Gumbel-max: argmax(log p + G) is a draw from p, cheaper than multinomial
-            nxt = logp.argmax(-1).cpu()
-            u = torch.rand(k - greedy, logp.shape[1], generator=gen)
-            nxt[greedy:] = (logp[greedy:].cpu() - torch.log(-torch.log(u))).argmax(-1)
-            picked = logp.gather(1, nxt.view(k, 1).to(logp.device)).view(k).tolist()  # log p of each row's token
-        else:  # the largest log p and where it is (the first of equal ones, as argmax) in one operation
-            top, nxt = logp.max(-1)
-            picked, nxt = top.tolist(), nxt.cpu()
-        new_local, new_boxes = [], []
-        for b, t in enumerate(nxt.tolist()):
-            g = processor.grammars[b]
-            if g.done or errors[b]:
-                t = PAD
+    sharded = getattr(fast, "n_shards", 1) > 1
+    with torch_threads(1) if sharded else contextlib.nullcontext():  # torch's spinning workers off the shards' cores
+        while not all(g.done or e for g, e in zip(processor.grammars, errors, strict=True)) and len(seqs[0]) < max_len:
+            if fast is not None:  # the same logits without the Hugging Face modules' per-call overhead
+                if box_embedding is None and model.node_boxes:
+                    box_embedding = model.embed_boxes(boxes)
+                x = model.embed_outputs(ids, local, boxes, box_embedding)
+                for i in range(x.shape[1]):  # one new token a step after the first (BOS and any prefix)
+                    last = fast.step(x[:, i], boxes[:, i] if x.shape[1] > 1 else row_boxes)
             else:
-                logprob[b] += picked[b]
-                try:
-                    g.step(t, check=not constrained)  # a masked choice is allowed already
-                except TokenError as exc:
-                    errors[b] = str(exc)
-            seqs[b].append(t)
-            new_local.append(vocab.next_local(t, prev_local[b]))
-            box = None if errors[b] else g.next_box()
-            new_boxes.append(None if box is None else tuple(box))
-        processor.seen = [len(s) for s in seqs]
-        ids = nxt.view(k, 1).to(device)
-        prev_local = new_local
-        local = torch.tensor([min(i, MAX_LOCAL - 1) for i in new_local], device=device).view(k, 1)
-        if new_boxes != last_boxes:  # a new node in some row: its box
-            none = [box is None for box in new_boxes]
-            full = (0.0, 0.0, seg.width, seg.height)
-            q = tokenizer.quantize_boxes(np.array([full if box is None else box for box in new_boxes]),
-                                         seg.width, seg.height)
-            q[none] = 0
-            boxes = torch.as_tensor(q, device=device).view(k, 1, 4)
-            row_boxes = boxes[:, 0]  # the same tensor each step while it stays: `fast` keeps its mask
-            last_boxes, box_embedding = new_boxes, None
+                logits, past = model.decode(ids, local, memory, memory_mask, past,
+                                            use_cache=True, boxes=boxes, memory_boxes=memory_boxes)
+                last = logits[:, -1]
+            scores = last.float()  # (K, V)
+            if temperature != 1.0:
+                scores = scores / temperature
+            if constrained:
+                scores = scores.masked_fill(torch.from_numpy(~processor.mask()).to(device), float("-inf"))
+            logp = torch.log_softmax(scores, dim=-1)
+            if sample and greedy < k:  # Gumbel-max: argmax(log p + G) is a draw from p, cheaper than multinomial
+                nxt = logp.argmax(-1).cpu()
+                u = torch.rand(k - greedy, logp.shape[1], generator=gen)
+                nxt[greedy:] = (logp[greedy:].cpu() - torch.log(-torch.log(u))).argmax(-1)
+                picked = logp.gather(1, nxt.view(k, 1).to(logp.device)).view(k).tolist()  # log p of each row's token
+            else:  # the largest log p and where it is (the first of equal ones, as argmax) in one operation
+                top, nxt = logp.max(-1)
+                picked, nxt = top.tolist(), nxt.cpu()
+            new_local, new_boxes = [], []
+            for b, t in enumerate(nxt.tolist()):
+                g = processor.grammars[b]
+                if g.done or errors[b]:
+                    t = PAD
+                else:
+                    logprob[b] += picked[b]
+                    try:
+                        g.step(t, check=not constrained)  # a masked choice is allowed already
+                    except TokenError as exc:
+                        errors[b] = str(exc)
+                seqs[b].append(t)
+                new_local.append(vocab.next_local(t, prev_local[b]))
+                box = None if errors[b] else g.next_box()
+                new_boxes.append(None if box is None else tuple(box))
+            processor.seen = [len(s) for s in seqs]
+            ids = nxt.view(k, 1).to(device)
+            prev_local = new_local
+            local = torch.tensor([min(i, MAX_LOCAL - 1) for i in new_local], device=device).view(k, 1)
+            if new_boxes != last_boxes:  # a new node in some row: its box
+                none = [box is None for box in new_boxes]
+                full = (0.0, 0.0, seg.width, seg.height)
+                q = tokenizer.quantize_boxes(np.array([full if box is None else box for box in new_boxes]),
+                                             seg.width, seg.height)
+                q[none] = 0
+                boxes = torch.as_tensor(q, device=device).view(k, 1, 4)
+                row_boxes = boxes[:, 0]  # the same tensor each step while it stays: `fast` keeps its mask
+                last_boxes, box_embedding = new_boxes, None
     out = []
     for b, g in enumerate(processor.grammars):
         if not g.done:

@@ -3,8 +3,10 @@
 Greedy decoding takes a few hundred steps of one token, and a step is some 80 torch operations on vectors of
 128: their fixed cost, not the arithmetic, sets the time. `NativeDecoder` does the whole step in one call of a
 small C function (the same arithmetic as `IncrementalDecoder.step`; the tests check the logits to 1e-5). It takes
-K rows of one input, but `facaid.decoding.decode` uses it for one row (greedy, 0.56x the torch step's time):
-with 16 rows torch's batched matrix products on two threads are faster than this single-threaded loop.
+K rows of one input: greedy decoding steps one row (0.56x the torch step's time), best of K steps K rows split
+into `threads` shards, each shard one call on its own thread (ctypes lets go of the GIL for the call), while
+torch itself is held to one thread (`torch_threads`), so that its OpenMP workers, which spin for a while after
+each parallel region, do not take the cores the shards run on.
 
 The library is compiled once per source and machine into ``$FACAID_CACHE`` (default ``~/.cache/facaid``) with
 ``-O3 -march=native``; without a C compiler, or with ``FACAID_NATIVE=0``, `native_decoder` returns None and
@@ -13,6 +15,7 @@ decoding keeps the torch path.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import hashlib
 import logging
@@ -20,6 +23,7 @@ import os
 import shutil
 import subprocess
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -34,6 +38,7 @@ SOURCE = Path(__file__).with_name("native") / "step.c"
 FLAGS = ["-O3", "-march=native", "-ffp-contract=fast", "-shared", "-fPIC", "-std=c99"]
 _library: ctypes.CDLL | None = None
 _tried = False
+_pool: ThreadPoolExecutor | None = None
 
 
 def cache_dir() -> Path:
@@ -99,12 +104,35 @@ def _array(t: torch.Tensor) -> np.ndarray:
     return np.ascontiguousarray(t.detach().to(torch.float32).cpu().numpy())
 
 
+def _shared_pool(workers: int) -> ThreadPoolExecutor:
+    global _pool
+    if _pool is None or _pool._max_workers < workers:
+        _pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="facaid-native")
+    return _pool
+
+
+@contextlib.contextmanager
+def torch_threads(n: int):
+    """Run the block with torch on ``n`` threads, then restore the setting."""
+    before = torch.get_num_threads()
+    if n == before:
+        yield
+        return
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
+
+
 class NativeDecoder(IncrementalDecoder):
-    """`IncrementalDecoder` whose `step` is one call of the C step. Only for rows that read one memory row (what
-    `decode` builds); the cross-attention keys and values, caches and masks are the parent's, read in place."""
+    """`IncrementalDecoder` whose `step` is one call of the C step per shard of rows (``threads`` shards of at
+    least four rows, run at once). Only for rows that read one memory row (what `decode` builds); the
+    cross-attention keys and values, caches and masks are the parent's, read in place."""
 
     def __init__(self, model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor, max_len: int,
-                 rows: int | None = None, memory_boxes: torch.Tensor | None = None, lib: ctypes.CDLL | None = None):
+                 rows: int | None = None, memory_boxes: torch.Tensor | None = None, lib: ctypes.CDLL | None = None,
+                 threads: int = 1):
         reason = _unsupported(model, memory)
         if reason:
             raise ValueError(reason)
@@ -127,18 +155,29 @@ class NativeDecoder(IncrementalDecoder):
             arrays += [cache[0], cache[1]]
             self.keep += arrays
             pointers += [a.ctypes.data for a in arrays]
-        self.pointers = (ctypes.c_void_p * len(pointers))(*pointers)
+        self.n_shards = max(1, min(threads, self.k // 4))
+        bounds = [self.k * i // self.n_shards for i in range(self.n_shards + 1)]
+        per_block = len(pointers) // len(self.blocks)
+        self.shards = []  # (first row, rows, block pointers with the caches at that row, work buffer)
+        for first, end in zip(bounds[:-1], bounds[1:], strict=True):
+            moved = list(pointers)
+            for b in range(len(self.blocks)):  # the self caches: (K, H, dh, L) and (K, H, L, dh) floats
+                for j in (per_block - 2, per_block - 1):
+                    moved[b * per_block + j] += 4 * first * self.d * self.max_len
+            self.shards.append((first, end - first, (ctypes.c_void_p * len(moved))(*moved)))
         wpe = _array(self.wpe)
         ln_f = [_array(a) for a in self.ln_f]
         head_t = _array(self.head[0].t())  # (d, V)
         head_b = None if self.head[1] is None else _array(self.head[1])
         self.vocab = head_t.shape[1]
-        work = np.empty(self.k * (6 * self.d + self.ffn) + max(self.max_len, self.m), dtype=np.float32)  # step.c
-        self.keep += [wpe, *ln_f, head_t, work] + ([] if head_b is None else [head_b])
+        self.work = []
+        for _, n, _ in self.shards:  # what step.c uses: n * (6 d + f) + max(L, M) floats
+            self.work.append(np.empty(n * (6 * self.d + self.ffn) + max(self.max_len, self.m), dtype=np.float32))
+        self.keep += [wpe, *ln_f, head_t, *self.work] + ([] if head_b is None else [head_b])
         self.wpe_at = wpe.ctypes.data
         self.head_args = (ln_f[0].ctypes.data, ln_f[1].ctypes.data, head_t.ctypes.data,
-                          None if head_b is None else head_b.ctypes.data, self.eps, work.ctypes.data)
-        self.sizes = (len(self.blocks), self.pointers, self.k, self.d, self.heads, self.ffn, self.m, self.max_len)
+                          None if head_b is None else head_b.ctypes.data, self.eps)
+        self.pool = _shared_pool(self.n_shards - 1) if self.n_shards > 1 else None
         self.mask_np: tuple[torch.Tensor | None, np.ndarray | None, int, int] = (None, None, 0, 0)
 
     def _mask_array(self, mask: torch.Tensor | None) -> tuple[np.ndarray | None, int, int]:
@@ -163,11 +202,17 @@ class NativeDecoder(IncrementalDecoder):
         mask, mask_h, mask_r = self._mask_array(self._cross_mask(boxes))
         x = x.contiguous()
         out = torch.empty((self.k, self.vocab))
-        rc = self.lib.facaid_step(*self.sizes, self.t, self.vocab, x.data_ptr(), self.wpe_at + 4 * self.d * self.t,
-                                  None if mask is None else mask.ctypes.data, mask_h, mask_r, *self.head_args,
-                                  out.data_ptr())
-        if rc != 0:
-            raise RuntimeError(f"native step failed with code {rc}")
+        wpe_t = self.wpe_at + 4 * self.d * self.t
+        calls = []
+        for (first, n, pointers), work in zip(self.shards, self.work, strict=True):
+            at_mask = None if mask is None else mask.ctypes.data + 4 * first * mask_r
+            calls.append((len(self.blocks), pointers, n, self.d, self.heads, self.ffn, self.m, self.max_len, self.t,
+                          self.vocab, x.data_ptr() + 4 * first * self.d, wpe_t, at_mask, mask_h, mask_r,
+                          *self.head_args, work.ctypes.data, out.data_ptr() + 4 * first * self.vocab))
+        others = [self.pool.submit(self.lib.facaid_step, *args) for args in calls[1:]] if self.pool else []
+        codes = [self.lib.facaid_step(*calls[0])] + [f.result() for f in others]
+        if any(codes):
+            raise RuntimeError(f"native step failed with codes {codes}")
         self.t += 1
         return out
 
@@ -182,7 +227,8 @@ def _unsupported(model: FacaidModel, memory: torch.Tensor) -> str | None:
 
 
 def native_decoder(model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor, max_len: int,
-                   rows: int | None = None, memory_boxes: torch.Tensor | None = None) -> NativeDecoder | None:
+                   rows: int | None = None, memory_boxes: torch.Tensor | None = None,
+                   threads: int = 1) -> NativeDecoder | None:
     """A `NativeDecoder` when the C step is available and applies (one float32 memory row on the CPU), else
     None."""
     if _unsupported(model, memory):
@@ -190,4 +236,5 @@ def native_decoder(model: FacaidModel, memory: torch.Tensor, memory_mask: torch.
     lib = library()
     if lib is None:
         return None
-    return NativeDecoder(model, memory, memory_mask, max_len, rows=rows, memory_boxes=memory_boxes, lib=lib)
+    return NativeDecoder(model, memory, memory_mask, max_len, rows=rows, memory_boxes=memory_boxes, lib=lib,
+                         threads=threads)

@@ -21,20 +21,24 @@ def models(tiny):
 
 
 @pytest.mark.parametrize("kind", ["plain", "biased"])
-@pytest.mark.parametrize("k", [1, 3])
-def test_native_step_gives_the_hugging_face_logits(models, kind, k):
+@pytest.mark.parametrize(("k", "threads"), [(1, 1), (3, 1), (9, 2), (16, 3)])
+def test_native_step_gives_the_hugging_face_logits(models, kind, k, threads):
+    """Each row its own sequence (other facades' trees), so that rows read from another row's cache or mask
+    (the shards' offsets) would show; 9 rows on two threads are shards of 4 and 5, 16 on three 5, 5 and 6."""
     by_kind, tok = models
     model = by_kind[kind]
     sample = generate(4)
     rects, mask = batch_inputs([tok.encode_segmentation(sample.segmentation)])
-    ids, local, _, boxes = batch_outputs([tok.encode_target(sample.procedure)] * k)
+    ids, local, _, boxes = batch_outputs([tok.encode_target(generate(4 + r).procedure) for r in range(k)])
     ids, local, boxes = ids[:, :50], local[:, :50], boxes[:, :50]
     with torch.no_grad():
         memory, memory_mask = model.encode(rects, mask)
         memory_boxes = model.memory_boxes(rects) if model.box_scale is not None else None
         full, _ = model.decode(ids, local, memory.repeat(k, 1, 1), memory_mask.repeat(k, 1), boxes=boxes,
                                memory_boxes=None if memory_boxes is None else memory_boxes.repeat(k, 1, 1))
-        fast = native.NativeDecoder(model, memory, memory_mask, max_len=64, rows=k, memory_boxes=memory_boxes)
+        fast = native.NativeDecoder(model, memory, memory_mask, max_len=64, rows=k, memory_boxes=memory_boxes,
+                                    threads=threads)
+        assert fast.n_shards == {1: 1, 3: 1, 9: 2, 16: 3}[k]
         x = model.embed_outputs(ids, local, boxes)
         steps = torch.stack([fast.step(x[:, i], boxes[:, i]) for i in range(x.shape[1])], 1)
     assert torch.allclose(steps, full, atol=1e-5)
@@ -95,6 +99,34 @@ def test_shipped_model_decodes_the_same_with_the_native_step(shipped):
         a = decode(model, tok, seg, native=False)[0]
         b = decode(model, tok, seg)[0]
         assert a.ids == b.ids and b.logprob == pytest.approx(a.logprob, abs=1e-3)
+
+
+def test_best_of_k_samples_the_same_on_sharded_native_steps(shipped):
+    """Best of K steps its rows in shards on torch's threads, with torch held to one thread meanwhile: the same
+    samples as the torch step, and torch's setting back afterwards."""
+    model, tok = shipped
+    seg = generate(1).segmentation
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        a = decode(model, tok, seg, k=8, sample=True, greedy=1, temperature=0.7, seed=3, native=False)
+        b = decode(model, tok, seg, k=8, sample=True, greedy=1, temperature=0.7, seed=3)
+        assert torch.get_num_threads() == 2
+    finally:
+        torch.set_num_threads(before)
+    assert len({tuple(c.ids) for c in a}) > 2  # the rows differ, so a row read from another would show
+    assert [c.ids for c in a] == [c.ids for c in b]
+    assert [c.logprob for c in b] == pytest.approx([c.logprob for c in a], abs=1e-3)
+
+
+def test_torch_threads_restores_the_setting():
+    before = torch.get_num_threads()
+    with native.torch_threads(1):
+        assert torch.get_num_threads() == 1
+    assert torch.get_num_threads() == before
+    with pytest.raises(KeyError), native.torch_threads(1):
+        raise KeyError("inside")
+    assert torch.get_num_threads() == before
 
 
 def test_without_the_library_decoding_keeps_torch(models, monkeypatch):
