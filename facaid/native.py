@@ -39,6 +39,7 @@ FLAGS = ["-O3", "-march=native", "-ffp-contract=fast", "-shared", "-fPIC", "-std
 _library: ctypes.CDLL | None = None
 _tried = False
 _pool: ThreadPoolExecutor | None = None
+_pool_size = 0
 
 
 def cache_dir() -> Path:
@@ -105,10 +106,19 @@ def _array(t: torch.Tensor) -> np.ndarray:
 
 
 def _shared_pool(workers: int) -> ThreadPoolExecutor:
-    global _pool
-    if _pool is None or _pool._max_workers < workers:
-        _pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="facaid-native")
+    """The threads the shards beyond the first run on, made once per process (and again for more shards)."""
+    global _pool, _pool_size
+    if _pool is None or _pool_size < workers:
+        _pool, _pool_size = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="facaid-native"), workers
     return _pool
+
+
+def _forget_pool() -> None:
+    global _pool, _pool_size
+    _pool, _pool_size = None, 0  # a forked child has none of its parent's threads
+
+
+os.register_at_fork(after_in_child=_forget_pool)
 
 
 @contextlib.contextmanager

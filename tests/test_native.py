@@ -154,3 +154,22 @@ def test_build_is_cached_and_reports_a_failing_compiler(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError, match="failed"):
         native.build(compiler="false")  # exits 1, as a broken compiler would
     assert not list((tmp_path / "native").iterdir())  # nothing half-written is left
+
+
+def test_a_forked_child_makes_its_own_shard_threads():
+    """A pool's threads do not survive a fork (a prefork worker, a forking server): the child starts a new one."""
+    import os
+
+    pool = native._shared_pool(1)
+    assert pool.submit(lambda: 41 + 1).result() == 42
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: report whether it inherited the pool and whether a new one runs, then leave
+        ok = native._pool is None and native._shared_pool(1).submit(lambda: 7).result(timeout=10) == 7
+        os.write(write, b"1" if ok else b"0")
+        os._exit(0)
+    os.close(write)
+    got = os.read(read, 1)
+    os.waitpid(pid, 0)
+    assert got == b"1"
+    assert native._pool is pool

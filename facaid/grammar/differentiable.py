@@ -7,6 +7,7 @@ rectangles, and gradients reach every parameter, shared ones (repeated patterns,
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +48,11 @@ class Plan:
 
         return Plan(self.width, self.height, [mv(lv) for lv in self.levels], self.leaf_level.to(device),
                     self.leaf_index.to(device), self.labels.to(device), self.values.to(device))
+
+    @functools.cached_property
+    def arrays(self) -> list[_LevelArrays]:
+        """The levels' index arrays in numpy, for `execute_plan`; made on first use."""
+        return [_LevelArrays(lv) for lv in self.levels]
 
 
 def compile_plan(proc: Procedure) -> Plan:
@@ -108,14 +114,6 @@ class _LevelArrays:
         self.hi_col = self.lo_col + 2
         self.across = np.stack([1 - self.lo_col, 3 - self.lo_col], 1)  # (N, 2): the other axis' columns
         self.rows = np.arange(len(self.group))
-
-
-def _arrays(plan: Plan) -> list[_LevelArrays]:
-    cached = getattr(plan, "_arrays", None)
-    if cached is None:
-        cached = [_LevelArrays(lv) for lv in plan.levels]
-        plan._arrays = cached
-    return cached
 
 
 def _level_forward(a: _LevelArrays, parent_boxes: np.ndarray, params: np.ndarray):
@@ -208,7 +206,7 @@ class _Execute(torch.autograd.Function):
     @staticmethod
     def forward(ctx, params: torch.Tensor, plan: Plan):
         p = params.detach().cpu().numpy().astype(np.float64)
-        levels = _arrays(plan)
+        levels = plan.arrays
         boxes = [np.array([[0.0, 0.0, plan.width, plan.height]])]
         saved, overflow = [], 0.0
         for a in levels:
@@ -226,13 +224,13 @@ class _Execute(torch.autograd.Function):
     @staticmethod
     def backward(ctx, grad_leaves: torch.Tensor, grad_overflow: torch.Tensor):
         flat = np.zeros((sum(ctx.sizes), 4))
-        np.add.at(flat, ctx.rows, grad_leaves.detach().cpu().numpy().astype(np.float64))
+        flat[ctx.rows] = grad_leaves.detach().cpu().numpy()  # each leaf is a node of its own
         ends = np.cumsum(ctx.sizes)
         grads = [flat[e - n:e] for n, e in zip(ctx.sizes, ends, strict=True)]  # views, per level
         g_params = np.zeros(ctx.n_params)
         g_over = float(grad_overflow)
         for i in range(len(ctx.saved) - 1, -1, -1):
-            _level_backward(_arrays(ctx.plan)[i], ctx.saved[i], grads[i + 1], g_over, g_params, grads[i])
+            _level_backward(ctx.plan.arrays[i], ctx.saved[i], grads[i + 1], g_over, g_params, grads[i])
         out = torch.from_numpy(g_params).to(device=grad_leaves.device, dtype=grad_leaves.dtype)
         return out, None
 
