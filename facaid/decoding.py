@@ -148,9 +148,8 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     fast = None
     if incremental and not model.training:
         if native:  # the C step, where it builds (`facaid.native`): K rows in shards on torch's threads
-            threads = torch.get_num_threads() if k > 1 else 1
             fast = native_decoder(model, memory, memory_mask, max_len, rows=k, memory_boxes=memory_boxes,
-                                  threads=threads)
+                                  threads=torch.get_num_threads())
         fast = fast or IncrementalDecoder(model, memory, memory_mask, max_len, rows=k, memory_boxes=memory_boxes)
     else:
         memory, memory_mask = memory.expand(k, -1, -1).contiguous(), memory_mask.expand(k, -1).contiguous()

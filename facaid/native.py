@@ -153,7 +153,10 @@ class NativeDecoder(IncrementalDecoder):
         self.ffn = self.blocks[0].fc_w.shape[1]
         self.m = memory.shape[1]
         self.keep: list[np.ndarray] = []  # every array the pointers point into
-        pointers = []
+        self.n_shards = max(1, min(threads, self.k // 4))
+        bounds = [self.k * i // self.n_shards for i in range(self.n_shards + 1)]
+        ranges = list(zip(bounds[:-1], bounds[1:], strict=True))  # each shard's rows [first, end)
+        pointers: list[list[int]] = [[] for _ in ranges]  # per shard: every block's pointers
         for w, (ck, cv), (kv, _, _) in zip(self.blocks, self.cross, self.cache, strict=True):
             arrays = [w.ln_1[0], w.ln_1[1], w.attn_w, w.attn_b, w.attn_proj_w, w.attn_proj_b,
                       w.ln_cross[0], w.ln_cross[1], w.cross_q_w, w.cross_q_b, w.cross_proj_w, w.cross_proj_b,
@@ -162,28 +165,19 @@ class NativeDecoder(IncrementalDecoder):
             arrays.append(_array(ck[0].transpose(1, 2)))  # (H, dh, M)
             arrays.append(_array(cv[0]))  # (H, M, dh)
             cache = kv.numpy()  # the parent's buffer, read as keys (K, H, dh, L) and values (K, H, L, dh)
-            arrays += [cache[0], cache[1]]
-            self.keep += arrays
-            pointers += [a.ctypes.data for a in arrays]
-        self.n_shards = max(1, min(threads, self.k // 4))
-        bounds = [self.k * i // self.n_shards for i in range(self.n_shards + 1)]
-        per_block = len(pointers) // len(self.blocks)
-        self.shards = []  # (first row, rows, block pointers with the caches at that row, work buffer)
-        for first, end in zip(bounds[:-1], bounds[1:], strict=True):
-            moved = list(pointers)
-            for b in range(len(self.blocks)):  # the self caches: (K, H, dh, L) and (K, H, L, dh) floats
-                for j in (per_block - 2, per_block - 1):
-                    moved[b * per_block + j] += 4 * first * self.d * self.max_len
-            self.shards.append((first, end - first, (ctypes.c_void_p * len(moved))(*moved)))
+            self.keep += arrays + [cache]
+            for shard, (first, _) in zip(pointers, ranges, strict=True):  # the self caches from its first row
+                shard += [a.ctypes.data for a in arrays] + [cache[0, first:].ctypes.data, cache[1, first:].ctypes.data]
         wpe = _array(self.wpe)
         ln_f = [_array(a) for a in self.ln_f]
         head_t = _array(self.head[0].t())  # (d, V)
         head_b = None if self.head[1] is None else _array(self.head[1])
         self.vocab = head_t.shape[1]
-        self.work = []
-        for _, n, _ in self.shards:  # what step.c uses: n * (6 d + f) + max(L, M) floats
-            self.work.append(np.empty(n * (6 * self.d + self.ffn) + max(self.max_len, self.m), dtype=np.float32))
-        self.keep += [wpe, *ln_f, head_t, *self.work] + ([] if head_b is None else [head_b])
+        # per shard: (first row, rows, block pointers, work buffer of what step.c uses: rows * (6 d + f) + max(L, M))
+        self.shards = [(first, end - first, (ctypes.c_void_p * len(ptrs))(*ptrs),
+                        np.empty((end - first) * (6 * self.d + self.ffn) + max(self.max_len, self.m), dtype=np.float32))
+                       for (first, end), ptrs in zip(ranges, pointers, strict=True)]
+        self.keep += [wpe, *ln_f, head_t] + ([] if head_b is None else [head_b])
         self.wpe_at = wpe.ctypes.data
         self.head_args = (ln_f[0].ctypes.data, ln_f[1].ctypes.data, head_t.ctypes.data,
                           None if head_b is None else head_b.ctypes.data, self.eps)
@@ -214,7 +208,7 @@ class NativeDecoder(IncrementalDecoder):
         out = torch.empty((self.k, self.vocab))
         wpe_t = self.wpe_at + 4 * self.d * self.t
         calls = []
-        for (first, n, pointers), work in zip(self.shards, self.work, strict=True):
+        for first, n, pointers, work in self.shards:
             at_mask = None if mask is None else mask.ctypes.data + 4 * first * mask_r
             calls.append((len(self.blocks), pointers, n, self.d, self.heads, self.ffn, self.m, self.max_len, self.t,
                           self.vocab, x.data_ptr() + 4 * first * self.d, wpe_t, at_mask, mask_h, mask_r,

@@ -54,6 +54,12 @@ class Plan:
         """The levels' index arrays in numpy, for `execute_plan`; made on first use."""
         return [_LevelArrays(lv) for lv in self.levels]
 
+    @functools.cached_property
+    def leaf_rows(self) -> np.ndarray:
+        """Each leaf's row among all levels' boxes stacked (the root's first), for `execute_plan`."""
+        starts = np.cumsum([0, 1] + [len(lv.parent) for lv in self.levels[:-1]])
+        return starts[self.leaf_level.cpu().numpy()] + self.leaf_index.cpu().numpy()
+
 
 def compile_plan(proc: Procedure) -> Plan:
     """Resolve the structure of a procedure for differentiable execution."""
@@ -193,11 +199,6 @@ def _level_backward(a: _LevelArrays, saved, grad_boxes: np.ndarray, grad_overflo
         grad_parent[:, col] += np.bincount(a.parent, g_pb[:, col], minlength=len(grad_parent))
 
 
-def _leaf_rows(plan: Plan, sizes: list[int]) -> np.ndarray:
-    starts = np.cumsum([0] + sizes[:-1])
-    return starts[plan.leaf_level.cpu().numpy()] + plan.leaf_index.cpu().numpy()
-
-
 class _Execute(torch.autograd.Function):
     """The executor on numpy arrays with a hand-written backward pass: a level is some 40 numpy operations
     of a microsecond or two, where torch's autograd spent 5-15 microseconds on each of as many operations
@@ -206,25 +207,22 @@ class _Execute(torch.autograd.Function):
     @staticmethod
     def forward(ctx, params: torch.Tensor, plan: Plan):
         p = params.detach().cpu().numpy().astype(np.float64)
-        levels = plan.arrays
         boxes = [np.array([[0.0, 0.0, plan.width, plan.height]])]
         saved, overflow = [], 0.0
-        for a in levels:
+        for a in plan.arrays:
             level_boxes, level_overflow, keep = _level_forward(a, boxes[-1], p)
             boxes.append(level_boxes)
             saved.append(keep)
             overflow += level_overflow
-        sizes = [len(b) for b in boxes]
-        rows = _leaf_rows(plan, sizes)
-        leaves = np.concatenate(boxes, 0)[rows]
-        ctx.plan, ctx.saved, ctx.sizes, ctx.rows, ctx.n_params = plan, saved, sizes, rows, len(p)
+        leaves = np.concatenate(boxes, 0)[plan.leaf_rows]
+        ctx.plan, ctx.saved, ctx.sizes, ctx.n_params = plan, saved, [len(b) for b in boxes], len(p)
         out = torch.from_numpy(leaves).to(device=params.device, dtype=params.dtype)
         return out, torch.tensor(overflow, dtype=params.dtype, device=params.device)
 
     @staticmethod
     def backward(ctx, grad_leaves: torch.Tensor, grad_overflow: torch.Tensor):
         flat = np.zeros((sum(ctx.sizes), 4))
-        flat[ctx.rows] = grad_leaves.detach().cpu().numpy()  # each leaf is a node of its own
+        flat[ctx.plan.leaf_rows] = grad_leaves.detach().cpu().numpy()  # each leaf is a node of its own
         ends = np.cumsum(ctx.sizes)
         grads = [flat[e - n:e] for n, e in zip(ctx.sizes, ends, strict=True)]  # views, per level
         g_params = np.zeros(ctx.n_params)
