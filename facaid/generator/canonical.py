@@ -10,6 +10,8 @@ and any leaf under one pixel (rounding drops it from the segmentation). A split 
 child gives way to that child, which takes over its role if it has none, and always takes over a `SLOT_ROLES`
 role: the builder gives a floor or a ground floor without margins that role itself, so a floor whose margins
 are too thin to see must get it too (it kept its row's ``bay`` before, and the same picture had two trees).
+Likewise a row of bays mirrored around a centre bay that rounds to the same tree as the other bays becomes the
+repeat that draws the same row (`_plain_row`).
 """
 
 from __future__ import annotations
@@ -45,6 +47,8 @@ def canonical(proc: Procedure) -> Procedure:
             node.children = [node.children[i] for i in keep]
         if node.rule == "split" and node.role == "floors":
             merge_floor_runs(node)
+        if node.rule == "mirror" and node.role == "bay":
+            node = _plain_row(node) or node
         if len(node.children) == 1 and (node.rule == "split" or node.center):
             return _lone_child(node)
         return node
@@ -101,6 +105,24 @@ def merge_repeated_floors(root: Node, tolerance: float | None = None) -> Node:
         return node
 
     return visit(root)
+
+
+def _plain_row(mirror: Node) -> Node | None:
+    """A row of bays mirrored around a centre bay that is, in pixels, the same as its other bays (a wider window
+    capped at the same width) as the repeat that draws it; None for a row whose centre differs. The builder
+    compares the centre bay with the others in metres; rounding to pixels can make them one."""
+    if not mirror.center or not mirror.children or mirror.children[0].rule != "repeat":
+        return None
+    side = mirror.children[0]
+    middle = list(zip(mirror.sizes[1:], mirror.children[1:], strict=True))  # the centre bay and a pillar before it
+    pattern = list(zip(side.sizes, side.children, strict=True))
+    if (not isinstance(side.count, int) or side.tail or len(middle) != len(pattern)
+            or any(s != t or m.to_dict() != n.to_dict() for (s, m), (t, n) in zip(middle, pattern, strict=True))):
+        return None
+    tail = len(pattern) - 1  # a pillar before the centre also ends the row: (pillar bay) x n, pillar
+    if tail and not (tail == 1 and pattern[0][1].is_leaf):
+        return None
+    return Node.repeat(mirror.axis, 2 * side.count + 1, pattern, tail=tail, role=mirror.role)
 
 
 def _lone_child(node: Node) -> Node:
