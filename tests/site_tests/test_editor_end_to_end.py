@@ -106,6 +106,10 @@ def test_editor_from_upload_to_downloads(live_server, alice, worker, page, tmp_p
     assert page.text_content("#job-status").startswith("done")
     page.click("#result-link")
     page.wait_for_url(f"{base}/procedures/*")
+    # the procedure and its overlay on the photo at the same scale, side by side
+    page.wait_for_function("['render', 'overlay'].every(id => document.getElementById(id).complete)")
+    render, overlay = (page.locator(f"#{i}").bounding_box() for i in ("render", "overlay"))
+    assert abs(render["width"] - overlay["width"]) <= 1 and abs(render["height"] - overlay["height"]) <= 1
     # downloads
     with page.expect_download() as d:
         page.click("text=labels.png")
