@@ -108,9 +108,9 @@ def merge_repeated_floors(root: Node, tolerance: float | None = None) -> Node:
 
 
 def _plain_row(mirror: Node) -> Node | None:
-    """A row of bays mirrored around a centre bay that is, in pixels, the same as its other bays (a wider window
-    capped at the same width) as the repeat that draws it; None for a row whose centre differs. The builder
-    compares the centre bay with the others in metres; rounding to pixels can make them one."""
+    """The repeat that draws ``mirror``, a row of bays mirrored around a centre bay that is, in pixels, the same
+    as its other bays (a wider window capped at the same width); None when the centre differs. The builder
+    compares the centre bay with the others in metres, and rounding to pixels can make them one."""
     if not mirror.center or not mirror.children or mirror.children[0].rule != "repeat":
         return None
     side = mirror.children[0]

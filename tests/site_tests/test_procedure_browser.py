@@ -1,6 +1,7 @@
 """The procedure page in Debian's Chromium through Playwright: the parameter tree shows rounded values without
-changing the stored ones, an edit re-renders at once and saves, variations come back as eight cards, and the
-procedure and its overlay are drawn at the same scale."""
+changing the stored ones, an edit re-renders at once and saves, variations come back as eight cards. (The
+procedure beside its overlay on a photo is checked in `test_editor_end_to_end.py`, which makes a photo's
+procedure through the worker.)"""
 
 from __future__ import annotations
 
@@ -21,6 +22,10 @@ def _repeats(node: dict) -> list[dict]:
     for child in node.get("children", []):
         out += _repeats(child)
     return out
+
+
+def _sizes(node: dict) -> list[float]:
+    return [s[1] for s in node.get("sizes", [])] + [v for c in node.get("children", []) for v in _sizes(c)]
 
 
 def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
@@ -47,10 +52,7 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     page.wait_for_function("document.getElementById('saved').textContent === 'saved'")
     stored = Procedure.objects.get(pk=proc.pk).data
     assert _repeats(stored["root"])[0]["count"] == first["count"] + 1
-    # every size went back as it was: the rounded display did not round the values
-    def sizes(node):
-        return [s[1] for s in node.get("sizes", [])] + [v for c in node.get("children", []) for v in sizes(c)]
-    assert sizes(stored["root"]) == sizes(data["root"])
+    assert _sizes(stored["root"]) == _sizes(data["root"])  # the rounded display did not round the values
 
     page.click("#vary")
     page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
