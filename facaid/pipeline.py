@@ -18,6 +18,7 @@ sized (``result.shortcut``): sizing the decoded structure could not close that g
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -85,13 +86,18 @@ def default_model(path: str = str(DEFAULT_CHECKPOINT)) -> tuple[FacaidModel, Tok
 def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None = None,
                 tokenizer: Tokenizer | None = None, k: int = DEFAULT_K, sizing: bool = True, seed: int = 0,
                 prefix: list[int] | None = None, retry_below: float = 0.97, retry_k: int = 8,
-                induce: bool = True) -> Reconstruction:
-    """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object)."""
+                induce: bool = True, progress: Callable[[float, str], None] | None = None) -> Reconstruction:
+    """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object).
+
+    ``progress(fraction, stage)``, when given, is told each stage as it starts (fractions from 0 to 1, roughly
+    of the time taken): decoding, sizing, and the second chance's sampling when it runs."""
     seg = segmentation if isinstance(segmentation, Segmentation) else Segmentation.from_dict(segmentation)
     if model is None or tokenizer is None:
         model, tokenizer = default_model()
+    tell = progress or (lambda fraction, stage: None)
     timings = {}
     t0 = time.perf_counter()
+    tell(0.0, f"decoding {k} candidate{'s' if k > 1 else ''}")
     flat = flatten(seg)
     readable = fit_to_model(flat, tokenizer)
     t1 = time.perf_counter()
@@ -102,6 +108,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     retried = shortcut = False
     source = "model"
     if sizing:
+        tell(0.5, "sizing")
         structure, read = None, False  # the induced structure, read at most once
         if induce and prefix is None and before < FAR_OFF:
             structure, read = induce_procedure(flat), True
@@ -119,6 +126,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
                 if other.accuracy > fitted.accuracy:
                     fitted, before, source = other, other.accuracy_before, "induced"
         if fitted.accuracy < retry_below and retry_k and source == "model":
+            tell(0.75, f"sampling {retry_k} more candidates")
             retried = True
             more = decode(model, tokenizer, readable, k=retry_k, sample=True, greedy=0, seed=seed + 1, prefix=prefix)
             other = _second_chance(ranked[1:] + more, ranked[0], flat)

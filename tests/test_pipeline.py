@@ -77,3 +77,31 @@ def test_second_chance_sizes_more_candidates_when_the_first_fits_badly(tiny):
     assert again.accuracy == procedure_accuracy(again.procedure, flatten(seg))
     never = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_below=0.0, induce=False)
     assert not never.retried and never.accuracy == first.accuracy
+
+
+def test_progress_hears_each_stage_in_order(tiny):
+    model, tok = tiny  # untrained: its structures fit badly, so the second chance samples
+    seg = generate(6).segmentation
+    heard = []
+    reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False,
+                progress=lambda f, stage: heard.append((f, stage)))
+    assert [s for _, s in heard] == ["decoding 2 candidates", "sizing", "sampling 2 more candidates"]
+    assert [f for f, _ in heard] == sorted(f for f, _ in heard) and heard[0][0] >= 0 and heard[-1][0] < 1
+    heard.clear()
+    reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0, induce=False,
+                progress=lambda f, stage: heard.append((f, stage)))
+    assert [s for _, s in heard] == ["decoding 1 candidate", "sizing"]
+
+
+def test_worker_reports_loading_then_the_pipeline_s_stages(tiny, tmp_path):
+    from worker.compute import reconstruct as job
+
+    model, tok = tiny
+    save_model(model, tok, tmp_path / "ckpt")
+    heard = []
+    out = job(generate(6).segmentation.to_dict(), str(tmp_path / "ckpt"), k=2,
+              progress=lambda f, stage: heard.append((round(f, 6), stage)))
+    assert heard[0] == (0.05, "loading the model") and heard[1] == (0.2, "decoding 2 candidates")
+    assert heard[2] == (0.6, "sizing") and heard[-1] == (1.0, "done")
+    assert [f for f, _ in heard] == sorted(f for f, _ in heard)
+    Procedure.from_dict(out["procedure"])

@@ -19,21 +19,22 @@ def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed
     """Segmentation JSON -> {"procedure": JSON, "accuracy", "accuracy_decoded", "iou", "timings"}.
 
     ``prefix`` (a procedure JSON) with ``prefix_nodes`` > 0 keeps that procedure's first nodes (BFS) and lets
-    the model continue from them."""
+    the model continue from them. ``progress(fraction, stage)`` hears of each stage: loading the model (the
+    first job of a process imports torch and reads the weights, seconds), then `facaid.reconstruct`'s own stages
+    in the fractions 0.2 to 1."""
+    seg = Segmentation.from_dict(segmentation)
+    if progress:
+        progress(0.05, "loading the model")
     from facaid.decoding import prefix_from_procedure
     from facaid.pipeline import default_model
     from facaid.pipeline import reconstruct as run
 
-    seg = Segmentation.from_dict(segmentation)
-    if progress:
-        progress(0.05, "loading the model")
     model, tokenizer = default_model(checkpoint)
     prefix_ids = None
     if prefix is not None and prefix_nodes > 0:
         prefix_ids = prefix_from_procedure(tokenizer, Procedure.from_dict(prefix), prefix_nodes)
-    if progress:
-        progress(0.2, "decoding and sizing")
-    result = run(seg, model=model, tokenizer=tokenizer, k=k, seed=seed, prefix=prefix_ids)
+    stages = (lambda fraction, stage: progress(0.2 + 0.8 * fraction, stage)) if progress else None
+    result = run(seg, model=model, tokenizer=tokenizer, k=k, seed=seed, prefix=prefix_ids, progress=stages)
     out = result.to_dict()
     out["procedure"] = result.procedure.to_dict()
     if progress:
