@@ -493,7 +493,8 @@ async function submit() {
 
 async function poll(code) {
   const job = await api(`/api/v1/jobs/${code}/`);
-  $("#job-status").textContent = `${job.status}${job.stage ? ` (${job.stage})` : ""}`;
+  const stage = job.status === "running" && job.stage ? ` (${job.stage})` : "";  // not "done (done)"
+  $("#job-status").textContent = `${job.status}${stage}`;
   $("#job-progress").value = job.progress;
   if (job.status === "queued" || job.status === "running") return setTimeout(() => poll(code), 1000);
   if (job.status === "failed") return status(`The reconstruction failed: ${job.message}`, "error");
