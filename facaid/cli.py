@@ -95,6 +95,14 @@ def cmd_render(args: argparse.Namespace) -> None:
     from facaid.segmentation import rasterize
 
     seg = load_segmentation_or_procedure(_read_json(args.input))
+    if args.out.lower().endswith(".svg"):
+        if args.photo or args.legend or args.outline:
+            raise CliError("--photo, --legend and --outline draw PNGs; an .svg output is the labels alone")
+        from facaid.render import segmentation_svg
+
+        Path(args.out).write_text(segmentation_svg(seg), encoding="utf-8")
+        print(f"wrote {args.out} ({seg.width}x{seg.height}, {len(seg.rects)} rectangles)")
+        return
     if args.photo:
         try:
             photo = Image.open(args.photo)
@@ -245,11 +253,12 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--quiet", action="store_true", help="no progress bar")
     g.set_defaults(func=cmd_generate)
 
-    r = sub.add_parser("render", help="render a segmentation or procedure JSON to PNG",
+    r = sub.add_parser("render", help="render a segmentation or procedure JSON to PNG or SVG",
                        description="Render a segmentation, a procedure or a dataset sample to a PNG in the "
-                                   "documented palette, or as an overlay on a photo.")
+                                   "documented palette, or as an overlay on a photo; to an SVG of one group of "
+                                   "rectangles per class when the output ends in .svg.")
     r.add_argument("input", help="segmentation or procedure JSON file")
-    r.add_argument("--out", required=True, help="output PNG")
+    r.add_argument("--out", required=True, help="output PNG, or SVG when it ends in .svg")
     r.add_argument("--photo", help="draw the labels over this photo")
     r.add_argument("--alpha", type=float, default=0.5, help="overlay opacity (default 0.5)")
     r.add_argument("--outline", action="store_true", help="outline element rectangles")

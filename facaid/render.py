@@ -1,4 +1,4 @@
-"""Rendering label maps to pictures: the documented palette, overlays on photos, side-by-side strips."""
+"""Rendering label maps to pictures: the documented palette, overlays on photos, side-by-side strips, and SVG."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from facaid.labels import LABELS, PALETTE, PALETTE_ARRAY
-from facaid.segmentation import Segmentation, rasterize
+from facaid.segmentation import Segmentation, paint_order, rasterize
 
 _LUT = np.array(PALETTE_ARRAY, dtype=np.uint8)
 
@@ -61,3 +61,30 @@ def side_by_side(images: list[Image.Image], height: int = 256, gap: int = 8,
         out.paste(im, (x, gap))
         x += im.width + gap
     return out
+
+
+def segmentation_svg(seg: Segmentation) -> str:
+    """The segmentation as an SVG document of the same size: the background, then one group per class (``id`` the
+    class name, its palette colour as ``fill``) holding its rectangles, in the paint order, so that the SVG draws
+    exactly what `render_segmentation` paints: vector rectangles a drawing program can select class by class."""
+    w, h = seg.width, seg.height
+    lines = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" '
+             'shape-rendering="crispEdges">',
+             f'<rect id="background" width="{w}" height="{h}" fill="{_hex(PALETTE["background"])}"/>']
+    group = None
+    for r in paint_order(seg.rects):
+        name = LABELS[r.label]
+        if name != group:
+            if group is not None:
+                lines.append("</g>")
+            lines.append(f'<g id="{name}" fill="{_hex(PALETTE[name])}">')
+            group = name
+        lines.append(f'<rect x="{r.x0}" y="{r.y0}" width="{r.x1 - r.x0}" height="{r.y1 - r.y0}"/>')
+    if group is not None:
+        lines.append("</g>")
+    lines.append("</svg>")
+    return "\n".join(lines) + "\n"
+
+
+def _hex(rgb: tuple[int, int, int]) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*rgb)

@@ -2,6 +2,7 @@ import gzip
 import json
 import subprocess
 import sys
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
@@ -10,7 +11,7 @@ from PIL import Image
 from facaid.cli import main
 from facaid.generator import generate
 from facaid.labels import LABELS, PALETTE
-from facaid.render import colorize, legend, overlay, render_segmentation
+from facaid.render import colorize, legend, overlay, render_segmentation, segmentation_svg
 from facaid.segmentation import Segmentation, rasterize
 
 
@@ -31,6 +32,52 @@ def test_render_and_overlay_sizes():
     with pytest.raises(ValueError, match="alpha"):
         overlay(photo, rasterize(seg), alpha=2)
     assert legend().width == 96 * 12
+
+
+def _paint_svg(text: str) -> np.ndarray:
+    """Paint an SVG of `segmentation_svg` rectangle by rectangle in document order, as a browser does."""
+    ns = "{http://www.w3.org/2000/svg}"
+    root = ET.fromstring(text)
+    out = np.full((int(root.get("height")), int(root.get("width"))), -1, dtype=np.int64)
+    colour = {_hex: i for i, _hex in enumerate("#{:02x}{:02x}{:02x}".format(*PALETTE[n]) for n in LABELS)}
+    parent_fill = None
+    for el in root.iter():
+        if el.tag == f"{ns}rect":
+            fill = el.get("fill") or parent_fill
+            x, y = int(el.get("x", 0)), int(el.get("y", 0))
+            out[y : y + int(el.get("height")), x : x + int(el.get("width"))] = colour[fill]
+        elif el.tag == f"{ns}g":
+            parent_fill = el.get("fill")
+            assert el.get("id") == LABELS[colour[parent_fill]]  # a group is its class, by name and colour
+    return out
+
+
+OVERLAPPING = Segmentation.from_dict({"width": 40, "height": 30, "rects": [  # drawn in the paint order, not this
+    {"label": "window", "x0": 5, "y0": 5, "x1": 20, "y1": 20},
+    {"label": "facade", "x0": 0, "y0": 2, "x1": 40, "y1": 30},
+    {"label": "door", "x0": 15, "y0": 10, "x1": 25, "y1": 30},
+    {"label": "sill", "x0": 4, "y0": 19, "x1": 21, "y1": 22}]})
+
+
+@pytest.mark.parametrize("seg", [generate(11, "tenement").segmentation, generate(4, "wings").segmentation,
+                                 generate(7, "haussmann").segmentation, OVERLAPPING])
+def test_svg_draws_what_the_png_paints(seg):
+    text = segmentation_svg(seg)
+    assert np.array_equal(_paint_svg(text), rasterize(seg))
+    groups = [g.get("id") for g in ET.fromstring(text) if g.tag.endswith("g")]
+    assert len(groups) == len(set(groups)) and "window" in groups and "facade" in groups  # one group per class
+    assert text.count("<rect") == len(seg.rects) + 1  # and the background
+
+
+def test_cli_renders_svg_and_refuses_png_options_for_it(tmp_path, capsys):
+    sample = generate(11, "tenement")
+    proc_path = tmp_path / "p.json"
+    proc_path.write_text(sample.procedure.to_json())
+    assert main(["render", str(proc_path), "--out", str(tmp_path / "p.svg")]) == 0
+    assert np.array_equal(_paint_svg((tmp_path / "p.svg").read_text()), rasterize(sample.segmentation))
+    assert main(["render", str(proc_path), "--out", str(tmp_path / "q.svg"), "--legend"]) == 2
+    assert "an .svg output is the labels alone" in capsys.readouterr().err
+    assert not (tmp_path / "q.svg").exists()
 
 
 def test_cli_render_procedure_segmentation_and_overlay(tmp_path, capsys):

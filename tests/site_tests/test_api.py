@@ -2,6 +2,7 @@
 
 import io
 import json
+import xml.etree.ElementTree as ET
 
 import pytest
 from PIL import Image
@@ -95,6 +96,11 @@ def test_downloads_render_and_variations(facade_photo, as_alice, alice):
     for name in ("labels.png", "overlay.png"):
         img = Image.open(io.BytesIO(as_alice.get(base + name).content))
         assert img.size == (photo["width"], photo["height"])
+    r = as_alice.get(base + "labels.svg")
+    assert r["Content-Type"] == "image/svg+xml" and r["Content-Disposition"].endswith('-labels.svg"')
+    svg = ET.fromstring(r.content)
+    assert (svg.get("width"), svg.get("height")) == (str(photo["width"]), str(photo["height"]))
+    assert r.content.count(b"<rect") == len(seg["rects"]) + 1  # every rectangle and the background
     assert as_alice.get(base + "overlay.png?alpha=7").status_code == 400
     assert as_alice.get(base + "nothing.txt").status_code == 404
     r = as_alice.post(f"/api/v1/procedures/{proc.code}/variations", {"n": 3, "seed": 5}, format="json")

@@ -22,6 +22,7 @@ from rest_framework.response import Response
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import to_segmentation
 from facaid.rectify import rectify
+from facaid.render import segmentation_svg
 from facaid.variation import vary
 from webapp.facades import access, jobs, rendering
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
@@ -328,12 +329,14 @@ def render_preview(request):
     return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
 
 
-DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "overlay.png")
+DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "labels.svg", "overlay.png")
+PHOTO_DOWNLOADS = ("overlay.png",)  # only where the photo is visible to the user
 
 
 @extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1")],
                responses={(200, "application/octet-stream"): bytes},
-               summary="Downloads: procedure.json, segmentation.json (executed), labels.png, overlay.png")
+               summary="Downloads: procedure.json, segmentation.json (executed), labels.png, labels.svg (one group "
+                       "of rectangles per class), overlay.png")
 @api_view(["GET"])
 @permission_classes([AllowAny])
 def procedure_download(request, code, name):
@@ -350,6 +353,8 @@ def procedure_download(request, code, name):
             resp = HttpResponse(seg.to_json(), content_type="application/json")
         elif name == "labels.png":
             resp = HttpResponse(rendering.label_map_png(seg), content_type="image/png")
+        elif name == "labels.svg":
+            resp = HttpResponse(segmentation_svg(seg), content_type="image/svg+xml")
         else:
             if not access.photo_visible_to(request.user, proc.photo):
                 raise ValidationError({"name": "this procedure has no photo you may see to overlay"})

@@ -131,7 +131,7 @@ def procedure(request, code):
         "proc": proc, "owner": owner, "photo_visible": photo_visible, "lineage": proc.lineage(),
         "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
-        "downloads": api.DOWNLOADS if photo_visible else api.DOWNLOADS[:3]})
+        "downloads": [d for d in api.DOWNLOADS if photo_visible or d not in api.PHOTO_DOWNLOADS]})
 
 
 @login_required
