@@ -11,7 +11,8 @@ import pytest
 from site_helpers import login
 
 from facaid.generator import generate
-from webapp.facades.models import Procedure
+from facaid.grammar import Procedure as Tree
+from webapp.facades.models import Procedure, Segmentation
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
@@ -57,3 +58,25 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     page.click("#vary")
     page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
     assert errors == []
+
+
+def test_nodes_are_numbered_breadth_first_and_a_click_picks_the_re_run_prefix(live_server, alice, facade_photo,
+                                                                               browser):
+    _, seg = facade_photo
+    data = generate(3).procedure.to_dict()
+    proc = Procedure.objects.create(owner=alice, data=data, segmentation=Segmentation.objects.get(
+        photo__code=seg["photo"], version=seg["version"]))
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/procedures/{proc.code}")
+    page.wait_for_selector("#tree .bfs")
+    shown = page.eval_on_selector_all("#tree li", "els => els.map(li => li.firstChild.textContent + "
+                                                  "li.childNodes[1].textContent)")
+    bfs = list(Tree.from_dict(data).root.bfs())
+    assert len(shown) == len(bfs)
+    by_index = {int(t.split(" ", 1)[0][1:]): t.split(" ", 2)[1] for t in shown}
+    assert sorted(by_index) == list(range(len(bfs)))
+    for k, node in enumerate(bfs):  # "#k rule_axis" or "#k label": the k-th node breadth first
+        assert by_index[k] == (node.label if node.is_leaf else f"{node.rule}_{node.axis}")
+    page.click('#tree .bfs >> text="#5"')
+    assert page.input_value("#id_nodes") == "6"

@@ -26,4 +26,5 @@ class ReconstructForm(forms.Form):
 
 
 class RerunForm(forms.Form):
-    nodes = forms.IntegerField(min_value=1, max_value=8192, initial=1, help_text="nodes kept (breadth first)")
+    nodes = forms.IntegerField(min_value=1, max_value=8192, initial=1,
+                               help_text="nodes kept, breadth first: #0 to #N-1 in the tree above (click a # to pick)")

@@ -24,9 +24,20 @@ function numberInput(value, step, onChange, decimals = 2) {
   return input;
 }
 
-function buildTree(node) {
+// Each node shows its breadth-first index (#k), the order in which a re-run from a prefix keeps nodes: clicking
+// it sets the re-run form to keep the nodes up to and including it.
+function buildTree(node, order, sizeInput = null) {
   const li = document.createElement("li");
-  li.append(label(node));
+  const k = order.get(node);
+  const badge = document.createElement("span");
+  badge.className = "bfs"; badge.textContent = `#${k}`;
+  badge.title = `node ${k} breadth first: a re-run keeping ${k + 1} node${k ? "s" : ""} keeps #0 to #${k}`;
+  badge.addEventListener("click", () => {
+    const field = document.getElementById("id_nodes");
+    if (field) { field.value = k + 1; field.focus(); }
+  });
+  li.append(badge, ` ${label(node)}`);
+  if (sizeInput) li.append(sizeInput);
   if (node.rule === "repeat" && node.count !== "fill") {
     li.append(" × ", numberInput(node.count, 1, (v) => { node.count = Math.max(1, Math.round(v)); }, 0));
   }
@@ -34,21 +45,29 @@ function buildTree(node) {
     const ul = document.createElement("ul");
     node.children.forEach((child, i) => {
       const size = node.sizes[i];  // [mode, value]
-      const item = buildTree(child);
       const span = document.createElement("span");
       const rel = size[0] === "rel";
       span.append(` ${size[0]} `, numberInput(size[1], rel ? 0.01 : 1, (v) => { size[1] = v; }, rel ? 4 : 2));
-      item.insertBefore(span, item.firstChild.nextSibling);
-      ul.append(item);
+      ul.append(buildTree(child, order, span));
     });
     li.append(ul);
   }
   return li;
 }
 
+function breadthFirst(root) {
+  const order = new Map();
+  const queue = [root];
+  for (let i = 0; i < queue.length; i++) {
+    order.set(queue[i], i);
+    queue.push(...(queue[i].children || []));
+  }
+  return order;
+}
+
 function drawTree() {
   const root = document.createElement("ul");
-  root.append(buildTree(proc.root));
+  root.append(buildTree(proc.root, breadthFirst(proc.root)));
   document.getElementById("tree").replaceChildren(root);
 }
 
