@@ -110,6 +110,11 @@ def test_editor_from_upload_to_downloads(live_server, alice, worker, page, tmp_p
     page.wait_for_function("['render', 'overlay'].every(id => document.getElementById(id).complete)")
     render, overlay = (page.locator(f"#{i}").bounding_box() for i in ("render", "overlay"))
     assert abs(render["width"] - overlay["width"]) <= 1 and abs(render["height"] - overlay["height"]) <= 1
+    assert abs(render["y"] - overlay["y"]) <= 1  # side by side
+    page.set_viewport_size({"width": 600, "height": 900})  # a phone: stacked, each as wide as the page allows
+    render, overlay = (page.locator(f"#{i}").bounding_box() for i in ("render", "overlay"))
+    assert overlay["y"] >= render["y"] + render["height"] and render["width"] > 450
+    page.set_viewport_size({"width": 1400, "height": 1000})
     # downloads
     with page.expect_download() as d:
         page.click("text=labels.png")
