@@ -348,6 +348,51 @@ def deepened(model: FacaidModel, decoder_layers: int) -> FacaidModel:
     return deep
 
 
+# a BERT layer's projections into its residual sums and its two post-layer norms
+_BERT_OUTPUTS = ("attention.output.dense.", "output.dense.")
+_BERT_NORMS = ("attention.output.LayerNorm.", "output.LayerNorm.")
+
+
+def encoder_deepened(model: FacaidModel, encoder_layers: int) -> FacaidModel:
+    """The same model with ``encoder_layers`` encoder layers, the new ones appended after the last and computing
+    nothing new until training moves them: the encoder's capacity grown at no cost to decoding (the encoder runs
+    once per facade, the decoder once per token).
+
+    Each new layer is a copy of the last whose output projections are zero. A causal (GPT-2) encoder is
+    pre-layer-norm, so that is all (as in `deepened`). A bidirectional (BERT) encoder is post-layer-norm: a layer
+    ends in ``LayerNorm(x + f(x))``, and with f zero it would normalize its input again. So the last trained layer's
+    closing norm loses its gain and bias (it outputs the normalized vector), every new layer's norms are plain
+    (normalizing a normalized vector changes it by the norm's epsilon only) and the last new layer's closing norm
+    takes the gain and bias: the encoder's output is the same to float precision."""
+    have = model.config.encoder_layers
+    if encoder_layers <= have:
+        raise ValueError(f"a deepened encoder needs more than the {have} layers it has, got {encoder_layers}")
+    config = copy.deepcopy(model.config)
+    config.encoder_layers = encoder_layers
+    deep = FacaidModel(config).to(next(model.parameters()).device)
+    state = model.state_dict()
+    bert = config.encoder == "bidirectional"
+    stem, outputs = ("encoder.encoder.layer.", _BERT_OUTPUTS) if bert else ("encoder.h.", _BLOCK_OUTPUTS)
+    last = f"{stem}{have - 1}."
+    block = {name[len(last):]: value for name, value in state.items() if name.startswith(last)}
+    for i in range(have, encoder_layers):
+        for name, value in block.items():
+            new = value.clone()
+            if name.startswith(outputs):
+                new.zero_()
+            elif bert and name.startswith(_BERT_NORMS):
+                new.fill_(1.0 if name.endswith("weight") else 0.0)
+            state[f"{stem}{i}.{name}"] = new
+    if bert:
+        for part in ("weight", "bias"):
+            closing = f"output.LayerNorm.{part}"
+            state[f"{stem}{encoder_layers - 1}.{closing}"] = block[closing].clone()
+            state[f"{last}{closing}"] = torch.full_like(block[closing], 1.0 if part == "weight" else 0.0)
+    deep.load_state_dict(state, strict=True)
+    deep.train(model.training)
+    return deep
+
+
 def save_model(model: FacaidModel, tokenizer: Tokenizer, path: str | Path) -> None:
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)

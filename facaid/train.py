@@ -34,6 +34,7 @@ from facaid.model import (
     batch_inputs,
     batch_outputs,
     deepened,
+    encoder_deepened,
     load_model,
     save_model,
     with_box_bias,
@@ -71,8 +72,8 @@ class TrainConfig:
     count_lr_scale: float = 1.0  # the peer counts' embeddings learn at this multiple of the learning rate (a
     # model widened for them starts them at zero while the rest is trained already)
     box_lr_scale: float = 1.0  # the same for the box bias's per-head scales (`FacaidConfig.box_bias`)
-    grown_lr_scale: float = 1.0  # the same for the decoder blocks appended to the ``init`` checkpoint's
-    # (`facaid.model.deepened`), with weight decay as the rest
+    grown_lr_scale: float = 1.0  # the same for the decoder blocks and encoder layers appended to the ``init``
+    # checkpoint's (`facaid.model.deepened`, `encoder_deepened`), with weight decay as the rest
     # A scale of 0 freezes those parameters: no gradient is computed for them. With the box scales frozen the
     # cross-attention's bias needs none, so it runs in the fused attention kernel (bench/bench_train.py: a CPU
     # step 1.2x as fast at the median, a run of long batches 1.4x).
@@ -337,8 +338,8 @@ _ARCHITECTURE = ("d_model", "encoder_layers", "decoder_layers", "heads", "ffn", 
 def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig, device) -> FacaidModel:
     """The weights of checkpoint ``path`` for a fine-tuning run; its architecture and tokenizer must be the
     config's, except that the config may add what starts out computing what the checkpoint computed: peer
-    counts, finer coordinates (`adapt_to_tokenizer`), the box bias (`with_box_bias`) and decoder blocks
-    (`deepened`)."""
+    counts, finer coordinates (`adapt_to_tokenizer`), the box bias (`with_box_bias`), decoder blocks
+    (`deepened`) and encoder layers (`encoder_deepened`)."""
     model, tokenizer = load_model(path, device)
     try:
         model, tokenizer = adapt_to_tokenizer(model, tokenizer, tok_cfg)
@@ -348,6 +349,8 @@ def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig,
         model = with_box_bias(model)
     if model_cfg.decoder_layers > model.config.decoder_layers:
         model = deepened(model, model_cfg.decoder_layers)
+    if model_cfg.encoder_layers > model.config.encoder_layers:
+        model = encoder_deepened(model, model_cfg.encoder_layers)
     differ = [k for k in _ARCHITECTURE if getattr(model.config, k) != getattr(model_cfg, k)]
     if differ:
         raise ValueError(f"train.init {path} has another architecture ({', '.join(differ)} differ from [model])")
@@ -374,9 +377,10 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         torch.set_num_threads(cfg.threads)
     torch.manual_seed(cfg.seed)
     tokenizer = Tokenizer(tok_cfg)
-    # grown_from: the decoder blocks of the init checkpoint, when the config appends more (they learn at
-    # grown_lr_scale); kept in the state so that a resumed run has the same optimizer groups
-    state = {"step": 0, "sample_index": 0, "skipped": 0, "elapsed": 0.0, "batches": None, "grown_from": None}
+    # grown_from / encoder_grown_from: the decoder blocks / encoder layers of the init checkpoint, when the config
+    # appends more (they learn at grown_lr_scale); kept in the state so that a resumed run has the same groups
+    state = {"step": 0, "sample_index": 0, "skipped": 0, "elapsed": 0.0, "batches": None, "grown_from": None,
+             "encoder_grown_from": None}
     if resume and (last / "state.pt").is_file():
         model, tokenizer = load_model(last, device)
         if tokenizer.config != tok_cfg:
@@ -385,8 +389,11 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         state.update(saved["state"])
     elif cfg.init:
         model = _initial_model(cfg.init, model_cfg, tok_cfg, device)
-        have = FacaidConfig.from_pretrained(cfg.init).decoder_layers
+        init_cfg = FacaidConfig.from_pretrained(cfg.init)
+        have = init_cfg.decoder_layers
         state["grown_from"] = have if have < model.config.decoder_layers else None
+        have = init_cfg.encoder_layers
+        state["encoder_grown_from"] = have if have < model.config.encoder_layers else None
         saved = None
     else:
         model = FacaidModel(model_cfg).to(device)
@@ -394,9 +401,13 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     model.train()
     # parameters added to a trained model (at zero) learn at their own multiple of the rate, without decay
     added = (("count_fields.", cfg.count_lr_scale), ("box_scale", cfg.box_lr_scale))
-    # decoder blocks appended to a trained model learn at their own multiple of the rate, with decay
+    # decoder blocks and encoder layers appended to a trained model learn at their own multiple of the rate, with
+    # decay
     grown = tuple(f"decoder.h.{i}." for i in range(state["grown_from"] or model.config.decoder_layers,
                                                     model.config.decoder_layers))
+    encoder_stem = "encoder.encoder.layer." if model.config.encoder == "bidirectional" else "encoder.h."
+    grown += tuple(f"{encoder_stem}{i}." for i in range(state["encoder_grown_from"] or model.config.encoder_layers,
+                                                        model.config.encoder_layers))
 
     def decayed(params: list, scale: float) -> list[dict]:  # weight decay on matrices only
         return [{"params": [p for p in params if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": scale},

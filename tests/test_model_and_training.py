@@ -16,6 +16,7 @@ from facaid.model import (
     batch_inputs,
     batch_outputs,
     deepened,
+    encoder_deepened,
     load_model,
     save_model,
     widen_for_counts,
@@ -27,7 +28,7 @@ from facaid.train import _ARCHITECTURE, load_config, lr_at, structure_weighted_l
 
 # what `train.init` may add to a checkpoint's model (`deepened`, `with_box_bias`), and what it must keep (dropout is a
 # training setting, not compared)
-GROWN = ("decoder_layers", "box_bias")
+GROWN = ("decoder_layers", "encoder_layers", "box_bias")
 FIXED = tuple(k for k in _ARCHITECTURE if k not in (*GROWN, "dropout"))
 TINY = {"d_model": 16, "encoder_layers": 1, "decoder_layers": 1, "heads": 2, "ffn": 32, "node_boxes": True}
 
@@ -183,6 +184,45 @@ def test_a_deepened_decoder_keeps_the_logits_until_trained(tmp_path):
     assert again.config.decoder_layers == 3
     with pytest.raises(ValueError, match="more than the 3 decoder layers it has, got 3"):
         deepened(again, 3)
+
+
+@pytest.mark.parametrize("encoder", ["bidirectional", "causal"])
+def test_a_deepened_encoder_keeps_the_memory_until_trained(tmp_path, encoder):
+    model, tok = tiny(encoder=encoder)
+    with torch.no_grad():  # a trained layer's closing norm has a gain and a bias, which the new layers must keep
+        for p in model.encoder.parameters():
+            p.add_(0.3 * torch.randn_like(p))
+    model.eval()
+    deep = encoder_deepened(model, 3)
+    deep.eval()
+    assert deep.config.encoder_layers == 3 and deep.config.decoder_layers == model.config.decoder_layers
+    rects, mask, ids, local, targets, boxes = batch(tok, [4, 5])
+    with torch.no_grad():
+        a, _ = model(rects, mask, ids, local, boxes=boxes)
+        b, _ = deep(rects, mask, ids, local, boxes=boxes)
+        assert torch.allclose(model.encode(rects, mask)[0], deep.encode(rects, mask)[0], atol=1e-5)
+    assert torch.allclose(a, b, atol=1e-5)
+    layers = deep.encoder.encoder.layer if encoder == "bidirectional" else deep.encoder.h
+    assert len(layers) == 3
+    # the new layers write nothing at first, and learn: one step on their zero projections changes the memory
+    outputs = ("attention.output.dense.", "output.dense.") if encoder == "bidirectional" else ("attn.c_proj.",
+                                                                                                "mlp.c_proj.")
+    for name, p in layers[2].named_parameters():
+        if name.startswith(outputs):
+            assert not p.any(), name
+    deep.train()
+    _, loss = deep(rects, mask, ids, local, targets, boxes)
+    loss.backward()
+    out = layers[2].output.dense if encoder == "bidirectional" else layers[2].mlp.c_proj
+    assert out.weight.grad.abs().sum() > 0
+    with torch.no_grad():
+        out.weight -= 0.5 * out.weight.grad.sign()
+        assert not torch.allclose(deep.encode(rects, mask)[0], model.encode(rects, mask)[0], atol=1e-3)
+    save_model(deep, tok, tmp_path / "deep")
+    again, _ = load_model(tmp_path / "deep")
+    assert again.config.encoder_layers == 3
+    with pytest.raises(ValueError, match="more than the 3 layers it has, got 2"):
+        encoder_deepened(again, 2)
 
 
 def test_finer_coordinates_read_positions_as_before_and_sizes_between_two_steps_as_their_mean():
@@ -371,6 +411,7 @@ def test_committed_configs_build_the_shipped_architecture(name):
     for key in FIXED:
         assert getattr(model_config, key) == shipped[key], key
     assert model_config.decoder_layers <= shipped["decoder_layers"]
+    assert model_config.encoder_layers <= shipped["encoder_layers"]
     shipped_tok = TokenizerConfig(**shipped["tokenizer"])
     # the configs before configs/finetune-counts.toml read no peer counts, those before configs/finetune-fine.toml
     # coarser coordinates and one peer rule (`adapt_to_tokenizer` took each to the next); the rest is the same
@@ -588,6 +629,14 @@ def test_fine_tuning_starts_from_a_checkpoint(tmp_path):
     train(cfg, until=1, progress=False)
     resumed, _ = load_model(train(cfg, resume=True, progress=False))
     assert torch.allclose(resumed.decoder.h[1].mlp.c_proj.weight, deep.decoder.h[1].mlp.c_proj.weight, atol=1e-6)
+    # the same for encoder layers
+    grown = {}
+    for scale in (1.0, 10.0):
+        write_config(cfg, tmp_path / f"enc-{scale}", steps=2, extra=f'init = "{base}"\ngrown_lr_scale = {scale}')
+        cfg.write_text(cfg.read_text().replace("encoder_layers = 1", "encoder_layers = 2"))
+        wide, _ = load_model(train(cfg, progress=False))
+        grown[scale] = wide.encoder.encoder.layer[1].output.dense.weight.abs().max().item()
+    assert 5 < grown[10.0] / grown[1.0] < 15
     write_config(cfg, tmp_path / "tuned", steps=0, extra=f'noise = 0.5\ninit = "{base}"')
     text = cfg.read_text()
     cfg.write_text(text.replace("d_model = 16", "d_model = 8"))
