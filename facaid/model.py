@@ -325,24 +325,38 @@ def with_box_bias(model: FacaidModel) -> FacaidModel:
 _BLOCK_OUTPUTS = ("attn.c_proj.", "crossattention.c_proj.", "mlp.c_proj.")
 
 
+def _grown(model: FacaidModel, key: str, layers: int, stem: str, outputs: tuple[str, ...],
+           norms: tuple[str, ...] = ()) -> tuple[FacaidModel, dict, dict]:
+    """A model with ``layers`` blocks where ``model`` has ``config.<key>``, and the state that fills it: the
+    blocks under ``stem`` appended after the last, each a copy of it whose ``outputs`` are zero and whose ``norms``
+    are plain (gain 1, bias 0). Also the last block's own state, by name within the block."""
+    have = getattr(model.config, key)
+    if layers <= have:
+        raise ValueError(f"a deepened model needs more than the {have} {key.replace('_', ' ')} it has, got {layers}")
+    config = copy.deepcopy(model.config)
+    setattr(config, key, layers)
+    deep = FacaidModel(config).to(next(model.parameters()).device)
+    state = model.state_dict()
+    last = f"{stem}{have - 1}."
+    block = {name[len(last):]: value for name, value in state.items() if name.startswith(last)}
+    for i in range(have, layers):
+        for name, value in block.items():
+            new = value.clone()
+            if name.startswith(outputs):
+                new.zero_()
+            elif name.startswith(norms):
+                new.fill_(1.0 if name.endswith("weight") else 0.0)
+            state[f"{stem}{i}.{name}"] = new
+    return deep, state, block
+
+
 def deepened(model: FacaidModel, decoder_layers: int) -> FacaidModel:
     """The same model with ``decoder_layers`` decoder blocks: the new ones are appended after the last, each a
     copy of it whose output projections are zero. The decoder's blocks are pre-layer-norm (GPT-2), so a block
     that writes nothing into the residual stream passes it on unchanged, and the logits are the same until
     training moves them; its attention and MLP inputs start as the last block's, not at random. The start of a
     fine-tune that gives a trained model more capacity."""
-    have = model.config.decoder_layers
-    if decoder_layers <= have:
-        raise ValueError(f"a deepened model needs more than the {have} decoder layers it has, got {decoder_layers}")
-    config = copy.deepcopy(model.config)
-    config.decoder_layers = decoder_layers
-    deep = FacaidModel(config).to(next(model.parameters()).device)
-    state = model.state_dict()
-    last = f"decoder.h.{have - 1}."
-    block = {name[len(last):]: value for name, value in state.items() if name.startswith(last)}
-    for i in range(have, decoder_layers):
-        for name, value in block.items():
-            state[f"decoder.h.{i}.{name}"] = value.clone().zero_() if name.startswith(_BLOCK_OUTPUTS) else value.clone()
+    deep, state, _ = _grown(model, "decoder_layers", decoder_layers, "decoder.h.", _BLOCK_OUTPUTS)
     deep.load_state_dict(state, strict=True)
     deep.train(model.training)
     return deep
@@ -364,30 +378,16 @@ def encoder_deepened(model: FacaidModel, encoder_layers: int) -> FacaidModel:
     closing norm loses its gain and bias (it outputs the normalized vector), every new layer's norms are plain
     (normalizing a normalized vector changes it by the norm's epsilon only) and the last new layer's closing norm
     takes the gain and bias: the encoder's output is the same to float precision."""
-    have = model.config.encoder_layers
-    if encoder_layers <= have:
-        raise ValueError(f"a deepened encoder needs more than the {have} layers it has, got {encoder_layers}")
-    config = copy.deepcopy(model.config)
-    config.encoder_layers = encoder_layers
-    deep = FacaidModel(config).to(next(model.parameters()).device)
-    state = model.state_dict()
-    bert = config.encoder == "bidirectional"
-    stem, outputs = ("encoder.encoder.layer.", _BERT_OUTPUTS) if bert else ("encoder.h.", _BLOCK_OUTPUTS)
-    last = f"{stem}{have - 1}."
-    block = {name[len(last):]: value for name, value in state.items() if name.startswith(last)}
-    for i in range(have, encoder_layers):
-        for name, value in block.items():
-            new = value.clone()
-            if name.startswith(outputs):
-                new.zero_()
-            elif bert and name.startswith(_BERT_NORMS):
-                new.fill_(1.0 if name.endswith("weight") else 0.0)
-            state[f"{stem}{i}.{name}"] = new
-    if bert:
-        for part in ("weight", "bias"):
+    if model.config.encoder == "bidirectional":
+        stem = "encoder.encoder.layer."
+        deep, state, block = _grown(model, "encoder_layers", encoder_layers, stem, _BERT_OUTPUTS, _BERT_NORMS)
+        have = model.config.encoder_layers
+        for part, plain in (("weight", 1.0), ("bias", 0.0)):
             closing = f"output.LayerNorm.{part}"
             state[f"{stem}{encoder_layers - 1}.{closing}"] = block[closing].clone()
-            state[f"{last}{closing}"] = torch.full_like(block[closing], 1.0 if part == "weight" else 0.0)
+            state[f"{stem}{have - 1}.{closing}"] = torch.full_like(block[closing], plain)
+    else:
+        deep, state, _ = _grown(model, "encoder_layers", encoder_layers, "encoder.h.", _BLOCK_OUTPUTS)
     deep.load_state_dict(state, strict=True)
     deep.train(model.training)
     return deep

@@ -221,7 +221,7 @@ def test_a_deepened_encoder_keeps_the_memory_until_trained(tmp_path, encoder):
     save_model(deep, tok, tmp_path / "deep")
     again, _ = load_model(tmp_path / "deep")
     assert again.config.encoder_layers == 3
-    with pytest.raises(ValueError, match="more than the 3 layers it has, got 2"):
+    with pytest.raises(ValueError, match="more than the 3 encoder layers it has, got 2"):
         encoder_deepened(again, 2)
 
 
