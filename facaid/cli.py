@@ -196,6 +196,18 @@ def cmd_vary(args: argparse.Namespace) -> None:
     print(f"wrote {len(variants)} variants and variants.png (the original first) to {out}/")
 
 
+def cmd_cga(args: argparse.Namespace) -> None:
+    from facaid.cga import default_scale, procedure_cga
+    from facaid.grammar.procedure import Procedure
+
+    proc = Procedure.from_dict(_read_json(args.input))
+    scale = args.metres_per_pixel if args.metres_per_pixel is not None else default_scale(proc)
+    text = procedure_cga(proc, scale, name=Path(args.input).name)
+    Path(args.out).write_text(text, encoding="utf-8")
+    print(f"wrote {args.out} ({text.count(' -->')} rules, {proc.width * scale:.2f} m x {proc.height * scale:.2f} m "
+          f"at {scale:.4g} m per pixel)")
+
+
 def cmd_evaluate_real(args: argparse.Namespace) -> None:
     from facaid.evaluation.real import evaluate_real, format_summary
     from facaid.model import load_model
@@ -334,6 +346,17 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--seed", type=int, default=0)
     v.add_argument("--out", default="out/variants", help="output directory (default out/variants)")
     v.set_defaults(func=cmd_vary)
+
+    e = sub.add_parser("cga", help="a procedure as CityEngine CGA rules",
+                       description="Write a procedure as a CGA rule file: apply its start rule Facade to a facade "
+                                   "shape in CityEngine. Fixed sizes keep their metres, floating ones share the rest "
+                                   "and repeats lay out as many copies as fit (docs/pipeline.md).")
+    e.add_argument("input", help="procedure JSON")
+    e.add_argument("--out", required=True, help="output .cga file")
+    e.add_argument("--metres-per-pixel", type=float, default=None,
+                   help="the scale (default: a storey of the procedure is 3 m tall; 12 m for the whole facade "
+                        "when it has no floors)")
+    e.set_defaults(func=cmd_cga)
 
     r2 = sub.add_parser("evaluate-real", help="reconstruct the CMP facades and compare (evaluation only)",
                         description="Reconstruct every facade of an annotations.jsonl (CMP format) and report mean "

@@ -8,6 +8,7 @@ import pytest
 from PIL import Image
 from site_helpers import image_bytes, upload
 
+from facaid.cga import procedure_cga
 from facaid.generator import generate
 from webapp.facades.models import Job
 
@@ -101,6 +102,14 @@ def test_downloads_render_and_variations(facade_photo, as_alice, alice):
     svg = ET.fromstring(r.content)
     assert (svg.get("width"), svg.get("height")) == (str(photo["width"]), str(photo["height"]))
     assert r.content.count(b"<rect") == len(seg["rects"]) + 1  # every rectangle and the background
+    r = as_alice.get(base + "procedure.cga")
+    assert r["Content-Type"].startswith("text/plain") and r["Content-Disposition"].endswith('-procedure.cga"')
+    assert r.content.decode() == procedure_cga(sample.procedure, name=f"facaid-{str(proc.code)[:8]}")
+    scaled = as_alice.get(base + "procedure.cga?metres_per_pixel=0.05").content.decode()
+    assert "0.05 m per pixel" in scaled
+    for bad in ("0", "-1", "nan", "abc", "1e9"):
+        r = as_alice.get(base + f"procedure.cga?metres_per_pixel={bad}")
+        assert r.status_code == 400 and "metres_per_pixel" in r.json(), bad
     assert as_alice.get(base + "overlay.png?alpha=7").status_code == 400
     assert as_alice.get(base + "nothing.txt").status_code == 404
     r = as_alice.post(f"/api/v1/procedures/{proc.code}/variations", {"n": 3, "seed": 5}, format="json")

@@ -19,6 +19,7 @@ from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
+from facaid.cga import procedure_cga
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import to_segmentation
 from facaid.rectify import rectify
@@ -329,14 +330,16 @@ def render_preview(request):
     return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
 
 
-DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "labels.svg", "overlay.png")
+DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "labels.svg", "procedure.cga", "overlay.png")
 PHOTO_DOWNLOADS = ("overlay.png",)  # only where the photo is visible to the user
 
 
-@extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1")],
+@extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),
+                           OpenApiParameter("metres_per_pixel", float,
+                                            description="procedure.cga's scale (default: a storey is 3 m)")],
                responses={(200, "application/octet-stream"): bytes},
                summary="Downloads: procedure.json, segmentation.json (executed), labels.png, labels.svg (one group "
-                       "of rectangles per class), overlay.png")
+                       "of rectangles per class), procedure.cga (CityEngine CGA rules), overlay.png")
 @api_view(["GET"])
 @permission_classes([AllowAny])
 def procedure_download(request, code, name):
@@ -347,6 +350,13 @@ def procedure_download(request, code, name):
     tree = parse_procedure(proc.data)
     if name == "procedure.json":
         resp = HttpResponse(tree.to_json(indent=2), content_type="application/json")
+    elif name == "procedure.cga":
+        scale = request.query_params.get("metres_per_pixel")
+        try:
+            text = procedure_cga(tree, None if scale is None else float(scale), name=proc.title or stem)
+        except ValueError:
+            raise ValidationError({"metres_per_pixel": "metres_per_pixel must be a number > 0"}) from None
+        resp = HttpResponse(text, content_type="text/plain; charset=utf-8")
     else:
         seg = to_segmentation(tree)
         if name == "segmentation.json":

@@ -1,0 +1,176 @@
+"""A procedure as CityEngine CGA rules: the facade's split grammar in the language it comes from.
+
+`procedure_cga(proc)` writes one rule per inner node (and per mirrored variant of one), one per label and a start
+rule ``Facade`` to apply to a facade shape (scope x along the facade, y up, sizes in metres). At the procedure's own
+size the rules draw exactly its rectangles; on a shape of another size they resize as the procedure does: fixed
+sizes keep their metres, floating ones (``~``) share what is left, relative ones (``'``) keep their fraction, and
+each repeat becomes a CGA repeat split (``{ ... }*``), which lays out as many copies as fit.
+
+How the grammar maps:
+- ``split`` → ``split(axis) { size : Child | ... }``. Each size is the length the child has at the procedure's own
+  size, in the child's mode: ``abs`` metres, ``rel`` a fraction, ``flt`` floating metres, so that CGA's rules for
+  floating parts give back every length whatever they are in detail.
+- ``repeat`` → ``split(axis) { { pattern }* | tail }``: the pattern's floating items float and its fixed ones stay
+  fixed (a pattern with nothing floating floats whole, so that the copies fill the region), the tail items are fixed.
+- ``mirror`` → the split it stands for; the reflected half gets variants of its rules laid out from the other end
+  (named ``…_mx`` / ``…_my``).
+- CGA's y axis goes up where the procedure's goes down: every split along y lists its children bottom to top.
+- A leaf paints its label's palette colour (``Background`` is ``NIL``): the rules to replace with real geometry.
+"""
+
+from __future__ import annotations
+
+import math
+
+from facaid.grammar.execute import execute_with_boxes, expand, layout, repeat_count
+from facaid.grammar.procedure import Node, Procedure
+from facaid.labels import PALETTE
+
+LEAF_RULES: dict[str, str] = {
+    "background": "Background", "facade": "Wall", "window": "Window", "door": "Door", "cornice": "Cornice",
+    "sill": "Sill", "balcony": "Balcony", "blind": "Blind", "deco": "Deco", "molding": "Molding",
+    "pillar": "Pillar", "shop": "Shop",
+}
+STOREY_M = 3.0  # the height of a storey in metres, which sets the default scale
+UNKNOWN_HEIGHT_M = 12.0  # the height a facade without floors is taken to have
+MAX_SCALE = 100.0  # metres per pixel
+CGA_VERSION = "2019.0"  # the rules use split, color and NIL only, which every CityEngine since reads
+
+
+def default_scale(proc: Procedure) -> float:
+    """Metres per pixel: a storey (the median height of the nodes whose role is ``floor``) is `STOREY_M` tall; a
+    procedure without floors is taken to be `UNKNOWN_HEIGHT_M` tall."""
+    _, boxes = execute_with_boxes(proc)
+    heights = sorted(boxes[id(node)][3] - boxes[id(node)][1] for _, node in proc.nodes()
+                     if node.role == "floor" and id(node) in boxes)
+    heights = [h for h in heights if h > 0]
+    if heights:
+        return STOREY_M / heights[len(heights) // 2]
+    return UNKNOWN_HEIGHT_M / proc.height
+
+
+def _number(value: float, digits: int) -> str:
+    text = f"{value:.{digits}f}".rstrip("0").rstrip(".")
+    return "0" if text in ("", "-0") else text
+
+
+# inner rules are named for their node's role (else its rule); "Facade" is the start rule, so a building is that
+ROLE_NAMES = {"facade": "building"}
+
+
+def _camel(word: str) -> str:
+    word = ROLE_NAMES.get(word, word)
+    return word[:1].upper() + word[1:]
+
+
+class _Writer:
+    def __init__(self, proc: Procedure, scale: float):
+        self.scale = scale
+        _, self.boxes = execute_with_boxes(proc)
+        self.index = {id(node): k for k, (_, node) in enumerate(proc.nodes())}
+        self.rules: dict[tuple[int, bool, bool], str] = {}  # (node, flipped x, flipped y) -> its rule's name
+        self.lines: list[str] = []
+
+    def metres(self, pixels: float) -> str:
+        return _number(pixels * self.scale, 4)
+
+    def rule(self, node: Node, flips: tuple[bool, bool]) -> str:
+        """The name of the rule that draws ``node`` laid out with these flips (the executor's: from the far end of
+        x, of y), writing it and the rules it calls first."""
+        if node.is_leaf:
+            return LEAF_RULES[node.label]
+        key = (id(node), *flips)
+        if key in self.rules:
+            return self.rules[key]
+        name = f"{_camel(node.role or node.rule)}{self.index[id(node)]}"
+        name += ("_mx" if flips[0] else "") + ("_my" if flips[1] else "")
+        self.rules[key] = name
+        slot = len(self.lines)  # a parent's rule comes before its children's
+        self.lines.append("")
+        box = self.boxes[id(node)]
+        along_x = node.axis == "x"
+        length = box[2] - box[0] if along_x else box[3] - box[1]
+        # CGA lays children out from the scope's origin: the left, and the bottom, where the procedure starts at the
+        # top; a flip lays them out from the other end
+        backwards = (flips[0] if along_x else not flips[1])
+        if node.rule == "repeat":
+            body = self.repeat(node, length, flips, backwards)
+        else:
+            body = self.split(node, length, flips, backwards)
+        self.lines[slot] = f"{name} -->\n\tsplit({node.axis}) {body}\n"
+        return name
+
+    def split(self, node: Node, length: float, flips: tuple[bool, bool], backwards: bool) -> str:
+        sizes, children, reflected = expand(node, length)
+        lengths = layout(sizes, length)
+        items = []
+        for size, child, mirrored, part in zip(sizes, children, reflected, lengths, strict=True):
+            child_flips = flips
+            if mirrored:
+                child_flips = (not flips[0], flips[1]) if node.axis == "x" else (flips[0], not flips[1])
+            if size.mode == "abs":
+                text = self.metres(part)
+            elif size.mode == "rel":
+                text = "'" + _number(part / length if length > 0 else 0.0, 6)
+            else:
+                text = "~" + self.metres(part)
+            items.append(f"{text} : {self.rule(child, child_flips)}")
+        if backwards:
+            items.reverse()
+        return "{ " + " | ".join(items) + " }"
+
+    def repeat(self, node: Node, length: float, flips: tuple[bool, bool], backwards: bool) -> str:
+        n = repeat_count(node, length)
+        k = len(node.children)
+        sizes, children, _ = expand(node, length)
+        lengths = layout(sizes, length)
+        floats = any(s.mode == "flt" for s in node.sizes)
+        pattern = []
+        for size, child, part in zip(node.sizes, node.children, lengths[:k], strict=True):
+            fixed = floats and size.mode != "flt"
+            pattern.append(f"{'' if fixed else '~'}{self.metres(part)} : {self.rule(child, flips)}")
+        tail = [f"{self.metres(part)} : {self.rule(child, flips)}"
+                for child, part in zip(children[k * n:], lengths[k * n:], strict=True)]
+        if backwards:
+            pattern.reverse()
+            tail.reverse()
+        group = "{ " + " | ".join(pattern) + " }*"
+        if not tail:
+            return group
+        items = [*tail, group] if backwards else [group, *tail]
+        return "{ " + " | ".join(items) + " }"
+
+
+def procedure_cga(proc: Procedure, scale: float | None = None, name: str = "") -> str:
+    """The procedure as a CGA rule file (see the module's docstring); ``scale`` in metres per pixel (default
+    `default_scale`), ``name`` goes into the header comment."""
+    if scale is None:
+        scale = default_scale(proc)
+    if not (isinstance(scale, (int, float)) and math.isfinite(scale) and 0 < scale <= MAX_SCALE):
+        raise ValueError(f"scale must be a number of metres per pixel > 0 and at most {MAX_SCALE:g}, got {scale!r}")
+    writer = _Writer(proc, float(scale))
+    root = writer.rule(proc.root, (False, False))
+    width, height = writer.metres(proc.width), writer.metres(proc.height)
+    name = " ".join(name.replace("*/", "* /").split())[:200]  # one line that cannot close the comment
+    title = f" {name}" if name else ""
+    head = [
+        "/**",
+        f" * Facade rules written by FaçAID from the procedure{title}.",
+        f" * Drawn at {round(proc.width)} x {round(proc.height)} px, {width} m x {height} m at "
+        f"{_number(scale, 6)} m per pixel.",
+        " * Apply Facade to a facade shape (scope x along the facade, y up): fixed sizes keep their metres,",
+        " * floating ones (~) share the rest, and repeats lay out as many copies as fit.",
+        " * Replace the label rules at the end (Window, Door, ...) with your own geometry.",
+        " */",
+        "",
+        f'version "{CGA_VERSION}"',
+        "",
+        "@StartRule",
+        f"Facade -->\n\t{root}\n",
+    ]
+    labels = sorted({node.label for _, node in proc.nodes() if node.is_leaf}, key=list(LEAF_RULES).index)
+    leaves = []
+    for label in labels:
+        body = "NIL" if label == "background" else 'color("#{:02x}{:02x}{:02x}")'.format(*PALETTE[label])
+        leaves.append(f"{LEAF_RULES[label]} -->\n\t{body}\n")
+    return "\n".join(head) + "\n" + "\n".join(writer.lines) + "\n" + "\n".join(leaves)
