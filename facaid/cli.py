@@ -208,6 +208,21 @@ def cmd_cga(args: argparse.Namespace) -> None:
           f"at {scale:.4g} m per pixel)")
 
 
+def cmd_mesh(args: argparse.Namespace) -> None:
+    from facaid.grammar.procedure import Procedure
+    from facaid.mesh import procedure_mesh
+
+    out = Path(args.out)
+    if out.suffix.lower() != ".obj":
+        raise CliError(f"--out must be a file name that ends in .obj (its materials go beside it), got {args.out}")
+    proc = Procedure.from_dict(_read_json(args.input))
+    mtl_path = out.with_suffix(".mtl")
+    obj, mtl = procedure_mesh(proc, args.metres_per_pixel, mtl_name=mtl_path.name)
+    out.write_text(obj, encoding="utf-8")
+    mtl_path.write_text(mtl, encoding="utf-8")
+    print(f"wrote {out} ({obj.count(chr(10) + 'f ')} faces) and {mtl_path}")
+
+
 def cmd_evaluate_real(args: argparse.Namespace) -> None:
     from facaid.evaluation.real import evaluate_real, format_summary
     from facaid.model import load_model
@@ -357,6 +372,17 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the scale (default: a storey of the procedure is 3 m tall; 12 m for the whole facade "
                         "when it has no floors)")
     e.set_defaults(func=cmd_cga)
+
+    m = sub.add_parser("mesh", help="a procedure as a relief mesh (OBJ and MTL)",
+                       description="Write a procedure as a Wavefront OBJ relief mesh with its MTL beside it: windows, "
+                                   "doors and shops set back, cornices, sills, pillars and balconies standing out, "
+                                   "one material per label (docs/pipeline.md).")
+    m.add_argument("input", help="procedure JSON")
+    m.add_argument("--out", required=True, help="output .obj file; the .mtl of the same name is written beside it")
+    m.add_argument("--metres-per-pixel", type=float, default=None,
+                   help="the scale (default: a storey of the procedure is 3 m tall; 12 m for the whole facade "
+                        "when it has no floors)")
+    m.set_defaults(func=cmd_mesh)
 
     r2 = sub.add_parser("evaluate-real", help="reconstruct the CMP facades and compare (evaluation only)",
                         description="Reconstruct every facade of an annotations.jsonl (CMP format) and report mean "

@@ -3,6 +3,7 @@
 import io
 import json
 import xml.etree.ElementTree as ET
+import zipfile
 
 import pytest
 from PIL import Image
@@ -10,6 +11,7 @@ from site_helpers import image_bytes, upload
 
 from facaid.cga import procedure_cga
 from facaid.generator import generate
+from facaid.mesh import procedure_mesh
 from webapp.facades.models import Job
 
 pytestmark = pytest.mark.django_db
@@ -107,9 +109,15 @@ def test_downloads_render_and_variations(facade_photo, as_alice, alice):
     assert r.content.decode() == procedure_cga(sample.procedure, name=f"facaid-{str(proc.code)[:8]}")
     scaled = as_alice.get(base + "procedure.cga?metres_per_pixel=0.05").content.decode()
     assert "0.05 m per pixel" in scaled
+    r = as_alice.get(base + "mesh.zip?metres_per_pixel=0.02")
+    assert r["Content-Type"] == "application/zip" and r["Content-Disposition"].endswith('-mesh.zip"')
+    with zipfile.ZipFile(io.BytesIO(r.content)) as z:
+        assert sorted(z.namelist()) == ["facade.mtl", "facade.obj"]
+        assert (z.read("facade.obj").decode(), z.read("facade.mtl").decode()) == procedure_mesh(sample.procedure, 0.02)
     for bad in ("0", "-1", "nan", "abc", "1e9"):
-        r = as_alice.get(base + f"procedure.cga?metres_per_pixel={bad}")
-        assert r.status_code == 400 and "metres_per_pixel" in r.json(), bad
+        for name in ("procedure.cga", "mesh.zip"):
+            r = as_alice.get(base + f"{name}?metres_per_pixel={bad}")
+            assert r.status_code == 400 and "metres_per_pixel" in r.json(), (name, bad)
     assert as_alice.get(base + "overlay.png?alpha=7").status_code == 400
     assert as_alice.get(base + "nothing.txt").status_code == 404
     r = as_alice.post(f"/api/v1/procedures/{proc.code}/variations", {"n": 3, "seed": 5}, format="json")

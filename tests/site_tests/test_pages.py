@@ -69,4 +69,4 @@ def test_procedure_page_for_owner_and_visitor(alice):
     assert "Save changes" not in visitor and "to fork this procedure" in visitor
     # no photo: every download but the overlay, the SVG among them
     assert "download/labels.svg" in visitor and "download/labels.png" in visitor and "overlay.png" not in visitor
-    assert "download/procedure.cga" in visitor
+    assert "download/procedure.cga" in visitor and "download/mesh.zip" in visitor

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import io
+import zipfile
 
 from django.core.files.base import ContentFile
 from django.db import transaction
@@ -19,9 +20,10 @@ from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
-from facaid.cga import procedure_cga
+from facaid.cga import MAX_SCALE, procedure_cga
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import to_segmentation
+from facaid.mesh import procedure_mesh
 from facaid.rectify import rectify
 from facaid.render import segmentation_svg
 from facaid.variation import vary
@@ -330,16 +332,19 @@ def render_preview(request):
     return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
 
 
-DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "labels.svg", "procedure.cga", "overlay.png")
+DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "labels.svg", "procedure.cga", "mesh.zip",
+             "overlay.png")
 PHOTO_DOWNLOADS = ("overlay.png",)  # only where the photo is visible to the user
 
 
 @extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),
                            OpenApiParameter("metres_per_pixel", float,
-                                            description="procedure.cga's scale (default: a storey is 3 m)")],
+                                            description="procedure.cga's and mesh.zip's scale (default: a storey "
+                                                        "is 3 m)")],
                responses={(200, "application/octet-stream"): bytes},
                summary="Downloads: procedure.json, segmentation.json (executed), labels.png, labels.svg (one group "
-                       "of rectangles per class), procedure.cga (CityEngine CGA rules), overlay.png")
+                       "of rectangles per class), procedure.cga (CityEngine CGA rules), mesh.zip (a relief mesh: "
+                       "facade.obj and facade.mtl), overlay.png")
 @api_view(["GET"])
 @permission_classes([AllowAny])
 def procedure_download(request, code, name):
@@ -350,13 +355,18 @@ def procedure_download(request, code, name):
     tree = parse_procedure(proc.data)
     if name == "procedure.json":
         resp = HttpResponse(tree.to_json(indent=2), content_type="application/json")
-    elif name == "procedure.cga":
+    elif name in ("procedure.cga", "mesh.zip"):
         scale = request.query_params.get("metres_per_pixel")
         try:
-            text = procedure_cga(tree, None if scale is None else float(scale), name=proc.title or stem)
+            scale = None if scale is None else float(scale)
+            if name == "procedure.cga":
+                resp = HttpResponse(procedure_cga(tree, scale, name=proc.title or stem),
+                                    content_type="text/plain; charset=utf-8")
+            else:
+                resp = HttpResponse(_mesh_zip(tree, scale), content_type="application/zip")
         except ValueError:
-            raise ValidationError({"metres_per_pixel": "metres_per_pixel must be a number > 0"}) from None
-        resp = HttpResponse(text, content_type="text/plain; charset=utf-8")
+            raise ValidationError({"metres_per_pixel": "metres_per_pixel must be a number > 0 and at most "
+                                                       f"{MAX_SCALE:g}"}) from None
     else:
         seg = to_segmentation(tree)
         if name == "segmentation.json":
@@ -378,6 +388,15 @@ def procedure_download(request, code, name):
                 resp = HttpResponse(rendering.overlay_png(seg, Image.open(f), alpha), content_type="image/png")
     resp["Content-Disposition"] = f'attachment; filename="{stem}-{name}"'
     return resp
+
+
+def _mesh_zip(tree, scale: float | None) -> bytes:
+    obj, mtl = procedure_mesh(tree, scale, mtl_name="facade.mtl")
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("facade.obj", obj)
+        z.writestr("facade.mtl", mtl)
+    return out.getvalue()
 
 
 @extend_schema(request={"application/json": dict}, responses={202: JobSerializer},
