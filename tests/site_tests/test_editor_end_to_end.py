@@ -1,12 +1,13 @@
 """The whole path in Debian's Chromium, with a real Redis and a real worker: log in, upload a facade photo,
 rectify it, draw rectangles with mouse and keys, use the repeat tool, undo and redo, submit, wait for the
-result, download the PNG and the JSON and check them."""
+result, download the PNG, the JSON, the CGA rules and the mesh and check them."""
 
 from __future__ import annotations
 
 import io
 import json
 import shutil
+import zipfile
 
 import pytest
 from PIL import Image, ImageOps
@@ -125,5 +126,13 @@ def test_editor_from_upload_to_downloads(live_server, alice, worker, page, tmp_p
     proc = json.loads(d.value.path().read_text())
     assert proc["grammar"] == "facaid-split-1" and (round(proc["width"]), round(proc["height"])) == (sw, sh)
     assert (214, 200, 178) in {c for _, c in png.getcolors(1 << 16)}  # the wall came back
+    with page.expect_download() as d:
+        page.click("a[href$='/procedure.cga']")
+    rules = d.value.path().read_text()
+    assert "@StartRule\nFacade -->" in rules and "Wall -->" in rules
+    with page.expect_download() as d:
+        page.click("a[href$='/mesh.zip']")
+    with zipfile.ZipFile(d.value.path()) as z:
+        assert sorted(z.namelist()) == ["facade.mtl", "facade.obj"] and "usemtl facade" in z.read("facade.obj").decode()
     page.screenshot(path=str(tmp_path / "procedure.png"))
     assert page.errors == []

@@ -70,3 +70,4 @@ def test_procedure_page_for_owner_and_visitor(alice):
     # no photo: every download but the overlay, the SVG among them
     assert "download/labels.svg" in visitor and "download/labels.png" in visitor and "overlay.png" not in visitor
     assert "download/procedure.cga" in visitor and "download/mesh.zip" in visitor
+    assert "CityEngine CGA rules" in visitor and "for Blender and other 3D tools" in visitor  # each says what it is

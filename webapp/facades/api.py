@@ -335,6 +335,15 @@ def render_preview(request):
 DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "labels.svg", "procedure.cga", "mesh.zip",
              "overlay.png")
 PHOTO_DOWNLOADS = ("overlay.png",)  # only where the photo is visible to the user
+DOWNLOAD_HELP = {  # what each download is, for the procedure page's buttons
+    "procedure.json": "the procedure: the tree with its sizes, to edit or reconstruct from",
+    "segmentation.json": "the labelled rectangles it draws",
+    "labels.png": "the label map as a picture",
+    "labels.svg": "the label map as vector rectangles, one group per class",
+    "procedure.cga": "CityEngine CGA rules: apply Facade to a facade shape",
+    "mesh.zip": "a 3D relief mesh (OBJ and MTL) for Blender and other 3D tools",
+    "overlay.png": "the label map over the photo",
+}
 
 
 @extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),

@@ -131,7 +131,8 @@ def procedure(request, code):
         "proc": proc, "owner": owner, "photo_visible": photo_visible, "lineage": proc.lineage(),
         "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
-        "downloads": [d for d in api.DOWNLOADS if photo_visible or d not in api.PHOTO_DOWNLOADS]})
+        "downloads": [(d, api.DOWNLOAD_HELP[d]) for d in api.DOWNLOADS
+                      if photo_visible or d not in api.PHOTO_DOWNLOADS]})
 
 
 @login_required
