@@ -49,6 +49,15 @@ def default_scale(proc: Procedure) -> float:
     return UNKNOWN_HEIGHT_M / proc.height
 
 
+def checked_scale(proc: Procedure, scale: float | None) -> float:
+    """``scale`` (metres per pixel) if it is one, `default_scale` if None; ValueError otherwise."""
+    if scale is None:
+        return default_scale(proc)
+    if not (isinstance(scale, (int, float)) and math.isfinite(scale) and 0 < scale <= MAX_SCALE):
+        raise ValueError(f"scale must be a number of metres per pixel > 0 and at most {MAX_SCALE:g}, got {scale!r}")
+    return float(scale)
+
+
 def _number(value: float, digits: int) -> str:
     text = f"{value:.{digits}f}".rstrip("0").rstrip(".")
     return "0" if text in ("", "-0") else text
@@ -144,11 +153,8 @@ class _Writer:
 def procedure_cga(proc: Procedure, scale: float | None = None, name: str = "") -> str:
     """The procedure as a CGA rule file (see the module's docstring); ``scale`` in metres per pixel (default
     `default_scale`), ``name`` goes into the header comment."""
-    if scale is None:
-        scale = default_scale(proc)
-    if not (isinstance(scale, (int, float)) and math.isfinite(scale) and 0 < scale <= MAX_SCALE):
-        raise ValueError(f"scale must be a number of metres per pixel > 0 and at most {MAX_SCALE:g}, got {scale!r}")
-    writer = _Writer(proc, float(scale))
+    scale = checked_scale(proc, scale)
+    writer = _Writer(proc, scale)
     root = writer.rule(proc.root, (False, False))
     width, height = writer.metres(proc.width), writer.metres(proc.height)
     name = " ".join(name.replace("*/", "* /").split())[:200]  # one line that cannot close the comment

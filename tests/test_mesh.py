@@ -113,3 +113,13 @@ def test_cli_writes_the_obj_and_its_materials(tmp_path, capsys):
     assert (tmp_path / "house.obj").read_text() == obj and (tmp_path / "house.mtl").read_text() == mtl
     assert main(["mesh", str(path), "--out", str(tmp_path / "house.png")]) == 2
     assert "ends in .obj" in capsys.readouterr().err
+
+
+def test_a_procedure_of_too_many_rectangles_is_refused_with_its_count():
+    from facaid.grammar.procedure import Node, Procedure, Size
+    from facaid.mesh import MAX_MESH_RECTS, MeshTooLarge
+
+    row = Node.repeat("x", 200, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
+    proc = Procedure(width=2000, height=2000, root=Node.repeat("y", 60, [(Size("flt", 1), row)]))
+    with pytest.raises(MeshTooLarge, match=f"draws 24000 rectangles; a mesh is made of at most {MAX_MESH_RECTS}"):
+        procedure_mesh(proc, 0.01)

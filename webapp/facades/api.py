@@ -20,10 +20,10 @@ from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
-from facaid.cga import MAX_SCALE, procedure_cga
+from facaid.cga import MAX_SCALE, checked_scale, procedure_cga
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import to_segmentation
-from facaid.mesh import procedure_mesh
+from facaid.mesh import MeshTooLarge, procedure_mesh
 from facaid.rectify import rectify
 from facaid.render import segmentation_svg
 from facaid.variation import vary
@@ -367,15 +367,18 @@ def procedure_download(request, code, name):
     elif name in ("procedure.cga", "mesh.zip"):
         scale = request.query_params.get("metres_per_pixel")
         try:
-            scale = None if scale is None else float(scale)
-            if name == "procedure.cga":
-                resp = HttpResponse(procedure_cga(tree, scale, name=proc.title or stem),
-                                    content_type="text/plain; charset=utf-8")
-            else:
-                resp = HttpResponse(_mesh_zip(tree, scale), content_type="application/zip")
+            scale = checked_scale(tree, None if scale is None else float(scale))
         except ValueError:
             raise ValidationError({"metres_per_pixel": "metres_per_pixel must be a number > 0 and at most "
                                                        f"{MAX_SCALE:g}"}) from None
+        if name == "procedure.cga":
+            resp = HttpResponse(procedure_cga(tree, scale, name=proc.title or stem),
+                                content_type="text/plain; charset=utf-8")
+        else:
+            try:
+                resp = HttpResponse(_mesh_zip(tree, scale), content_type="application/zip")
+            except MeshTooLarge as exc:
+                raise ValidationError({"name": str(exc)}) from None
     else:
         seg = to_segmentation(tree)
         if name == "segmentation.json":
