@@ -362,27 +362,24 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--out", default="out/variants", help="output directory (default out/variants)")
     v.set_defaults(func=cmd_vary)
 
-    e = sub.add_parser("cga", help="a procedure as CityEngine CGA rules",
-                       description="Write a procedure as a CGA rule file: apply its start rule Facade to a facade "
-                                   "shape in CityEngine. Fixed sizes keep their metres, floating ones share the rest "
-                                   "and repeats lay out as many copies as fit (docs/pipeline.md).")
-    e.add_argument("input", help="procedure JSON")
-    e.add_argument("--out", required=True, help="output .cga file")
-    e.add_argument("--metres-per-pixel", type=float, default=None,
-                   help="the scale (default: a storey of the procedure is 3 m tall; 12 m for the whole facade "
-                        "when it has no floors)")
-    e.set_defaults(func=cmd_cga)
-
-    m = sub.add_parser("mesh", help="a procedure as a relief mesh (OBJ and MTL)",
-                       description="Write a procedure as a Wavefront OBJ relief mesh with its MTL beside it: windows, "
-                                   "doors and shops set back, cornices, sills, pillars and balconies standing out, "
-                                   "one material per label (docs/pipeline.md).")
-    m.add_argument("input", help="procedure JSON")
-    m.add_argument("--out", required=True, help="output .obj file; the .mtl of the same name is written beside it")
-    m.add_argument("--metres-per-pixel", type=float, default=None,
-                   help="the scale (default: a storey of the procedure is 3 m tall; 12 m for the whole facade "
-                        "when it has no floors)")
-    m.set_defaults(func=cmd_mesh)
+    exports = (
+        ("cga", cmd_cga, "a procedure as CityEngine CGA rules", "output .cga file",
+         "Write a procedure as a CGA rule file: apply its start rule Facade to a facade shape in CityEngine. Fixed "
+         "sizes keep their metres, floating ones share the rest and repeats lay out as many copies as fit "
+         "(docs/pipeline.md)."),
+        ("mesh", cmd_mesh, "a procedure as a relief mesh (OBJ and MTL)",
+         "output .obj file; the .mtl of the same name is written beside it",
+         "Write a procedure as a Wavefront OBJ relief mesh with its MTL beside it: windows, doors and shops set back, "
+         "cornices, sills, pillars and balconies standing out, one material per label (docs/pipeline.md)."),
+    )
+    for name, func, summary, out_help, description in exports:
+        e = sub.add_parser(name, help=summary, description=description)
+        e.add_argument("input", help="procedure JSON")
+        e.add_argument("--out", required=True, help=out_help)
+        e.add_argument("--metres-per-pixel", type=float, default=None,
+                       help="the scale (default: a storey of the procedure is 3 m tall; 12 m for the whole facade "
+                            "when it has no floors)")
+        e.set_defaults(func=func)
 
     r2 = sub.add_parser("evaluate-real", help="reconstruct the CMP facades and compare (evaluation only)",
                         description="Reconstruct every facade of an annotations.jsonl (CMP format) and report mean "
