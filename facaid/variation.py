@@ -9,7 +9,7 @@ from __future__ import annotations
 import random
 
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.grammar.execute import first_boxes
+from facaid.grammar.execute import expand, first_boxes, layout
 from facaid.grammar.procedure import MAX_COUNT, Node, Procedure, ProcedureError, Size, validate
 
 
@@ -54,14 +54,17 @@ def _regions(proc: Procedure) -> dict[int, float]:
 
 def resize(proc: Procedure, width: float, height: float) -> Procedure:
     """The facade at a new size: fixed sizes keep their pixels, floating ones stretch, and every repeat
-    lays out as many copies as now fit their nominal size (rounded, at least one)."""
+    lays out as many copies of its pattern as now fit beside its tail (rounded, at least one), as a ``"fill"``
+    repeat counts them."""
     if not (1 <= width <= 100_000 and 1 <= height <= 100_000):
         raise ValueError(f"size must be between 1 and 100000 pixels, got {width}x{height}")
     old = _regions(proc)
-    units = {}
+    units = {}  # a repeat's pattern length and its tail's, at the old size
     for _, node in proc.nodes():
         if node.rule == "repeat" and node.count != "fill" and id(node) in old:
-            units[id(node)] = old[id(node)] / node.count
+            length = old[id(node)]
+            tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
+            units[id(node)] = ((length - tail) / node.count, tail)
     out = _copy(proc)
     out.width, out.height = width, height
     # match nodes of the copy with the original by position in the walk
@@ -71,7 +74,8 @@ def resize(proc: Procedure, width: float, height: float) -> Procedure:
             continue
         lengths = _regions(out)
         if id(new) in lengths:
-            new.count = max(1, min(MAX_COUNT, round(lengths[id(new)] / units[id(orig)])))
+            unit, tail = units[id(orig)]
+            new.count = max(1, min(MAX_COUNT, round((lengths[id(new)] - tail) / unit)))
     validate(out)
     return out
 

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from facaid.cli import main
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar import Procedure, ProcedureError, execute, validate
-from facaid.labels import LABELS
+from facaid.labels import LABEL_ID, LABELS
 from facaid.variation import change_count, resize, swap, vary, with_count, with_size
 
 
@@ -34,6 +34,23 @@ def test_resize_adapts_repeats():
     assert windows(wider) > 1.6 * windows(proc)
     with pytest.raises(ValueError, match="between 1 and 100000"):
         resize(proc, 0, 10)
+
+
+def test_resize_counts_the_copies_that_fit_beside_the_tail():
+    """Bays of a 40 px pillar and a 40 px tile, twice, and a closing pillar (200 px). At 340 px, four bays and the
+    pillar need 360 px (tiles 35 px) and three 280 px (tiles 60 px): four fit best. Counting the old region over the
+    old count (100 px a bay, the tail shared out) gave three."""
+    from facaid.grammar.execute import execute
+    from facaid.grammar.procedure import Node, Procedure, Size
+
+    bays = Node.repeat("x", 2, [(Size("abs", 40), Node.leaf("pillar")), (Size("flt", 1), Node.leaf("window"))],
+                       tail=1)
+    proc = Procedure(width=200, height=50, root=bays)
+    wider = resize(proc, 340, 50)
+    assert wider.root.count == 4
+    tiles = [x1 - x0 for label, x0, _, x1, _ in execute(wider) if label == LABEL_ID["window"]]
+    assert tiles == pytest.approx([35.0] * 4)
+    assert resize(proc, 200, 50).root.count == 2
 
 
 def test_change_count_grows_the_image():
