@@ -240,7 +240,9 @@ def cmd_evaluate_real(args: argparse.Namespace) -> None:
 
 
 def cmd_demo(args: argparse.Namespace) -> None:
+    from facaid.cga import procedure_cga
     from facaid.generator import generate
+    from facaid.mesh import procedure_mesh
     from facaid.render import render_segmentation, side_by_side
 
     out = Path(args.out)
@@ -250,13 +252,17 @@ def cmd_demo(args: argparse.Namespace) -> None:
         sample = generate(args.seed + k, style)
         (out / f"{style}.procedure.json").write_text(sample.procedure.to_json(indent=1) + "\n")
         (out / f"{style}.segmentation.json").write_text(json.dumps(sample.segmentation.to_dict()) + "\n")
+        (out / f"{style}.cga").write_text(procedure_cga(sample.procedure, name=style))
+        obj, mtl = procedure_mesh(sample.procedure, mtl_name=f"{style}.mtl")
+        (out / f"{style}.obj").write_text(obj)
+        (out / f"{style}.mtl").write_text(mtl)
         image = render_segmentation(sample.segmentation, outline=True)
         image.save(out / f"{style}.png")
         images.append(image)
         print(f"{style:<11} {sample.procedure.width}x{sample.procedure.height} px, "
               f"{sum(1 for _ in sample.procedure.nodes())} nodes, {len(sample.segmentation.rects)} rectangles")
     side_by_side(images, height=320).save(out / "gallery.png")
-    print(f"wrote procedures, segmentations and pictures to {out}/ (gallery.png shows them all)")
+    print(f"wrote procedures, segmentations, pictures, CGA rules and meshes to {out}/ (gallery.png shows them all)")
 
 
 # --- parser ---------------------------------------------------------------------------------------------------

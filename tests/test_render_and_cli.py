@@ -156,5 +156,8 @@ def test_demo_and_console_script(tmp_path):
     assert main(["demo", "--out", str(tmp_path)]) == 0
     assert (tmp_path / "gallery.png").is_file()
     assert (tmp_path / "haussmann.procedure.json").is_file()
+    assert "@StartRule" in (tmp_path / "haussmann.cga").read_text()
+    assert "mtllib haussmann.mtl" in (tmp_path / "haussmann.obj").read_text()
+    assert "newmtl window" in (tmp_path / "haussmann.mtl").read_text()
     done = subprocess.run([sys.executable, "-m", "facaid.cli", "--help"], capture_output=True, text=True)
     assert done.returncode == 0 and "generate" in done.stdout
