@@ -27,7 +27,7 @@ DEPTHS: dict[str, float] = {
 }
 
 
-MAX_MESH_RECTS = 20_000  # real facades draw a few hundred; 20,000 make a 9 MB OBJ in about half a second
+MAX_MESH_RECTS = 20_000  # real facades draw a few hundred; 20,000 make an 8 MB OBJ in about half a second
 
 
 class MeshTooLarge(ValueError):
