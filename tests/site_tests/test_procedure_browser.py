@@ -1,5 +1,6 @@
 """The procedure page in Debian's Chromium through Playwright: the parameter tree shows rounded values without
-changing the stored ones, an edit re-renders at once and saves, variations come back as eight cards. (The
+changing the stored ones, an edit re-renders at once and saves, variations come back as eight cards, a facade width
+in metres scales the CGA rules and the mesh. (The
 procedure beside its overlay on a photo is checked in `test_editor_end_to_end.py`, which makes a photo's
 procedure through the worker.)"""
 
@@ -57,6 +58,19 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
 
     page.click("#vary")
     page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
+
+    # a facade width in metres sets the scale of the CGA rules and the mesh; cleared, the default again
+    cga = page.locator("a[href*='/procedure.cga']")
+    page.fill("#width-m", "20")
+    assert cga.get_attribute("href").endswith(f"/procedure.cga?metres_per_pixel={20 / data['width']}")
+    with page.expect_download() as d:
+        cga.click()
+    assert "20 m x" in d.value.path().read_text()
+    with page.expect_download() as d:
+        page.click("a[href*='/mesh.zip']")
+    assert d.value.suggested_filename.endswith("-mesh.zip")
+    page.fill("#width-m", "")
+    assert cga.get_attribute("href").endswith("/procedure.cga")
     assert errors == []
 
 

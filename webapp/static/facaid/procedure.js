@@ -107,6 +107,18 @@ document.getElementById("save")?.addEventListener("click", async () => {
   }
 });
 
+// The CGA rules and the mesh are in metres: a facade width the user knows sets their scale (metres per pixel of
+// the saved procedure); left empty, the server's default makes a storey 3 m tall.
+const widthField = document.getElementById("width-m");
+widthField?.addEventListener("input", () => {
+  const metres = Number(widthField.value);
+  const scaled = widthField.value !== "" && Number.isFinite(metres) && metres > 0;
+  for (const link of document.querySelectorAll("a[href$='/procedure.cga'], a[href$='/mesh.zip'], a[href*='/procedure.cga?'], a[href*='/mesh.zip?']")) {
+    const base = link.getAttribute("href").split("?")[0];
+    link.setAttribute("href", scaled ? `${base}?metres_per_pixel=${metres / Number(widthField.dataset.px)}` : base);
+  }
+});
+
 document.getElementById("opacity")?.addEventListener("input", (e) => {
   document.getElementById("overlay").style.opacity = e.target.value;
 });
