@@ -383,8 +383,8 @@ def build_parser() -> argparse.ArgumentParser:
         e.add_argument("input", help="procedure JSON")
         e.add_argument("--out", required=True, help=out_help)
         e.add_argument("--metres-per-pixel", type=float, default=None,
-                       help="the scale (default: a storey of the procedure is 3 m tall; 12 m for the whole facade "
-                            "when it has no floors)")
+                       help="the scale (default: a storey, from the floors or the rows of windows, is 3 m tall; "
+                            "12 m for the whole facade when it has neither)")
         e.set_defaults(func=func)
 
     r2 = sub.add_parser("evaluate-real", help="reconstruct the CMP facades and compare (evaluation only)",

@@ -197,6 +197,20 @@ def test_the_default_scale_makes_a_storey_three_metres():
     assert "Facade -->\n\tWall" in procedure_cga(flat)
 
 
+def test_without_believable_floors_the_rows_of_windows_set_the_scale():
+    """Four storeys of 100 px, each a window (split by a transom) over a 20 px band that an induced procedure might
+    call ``floor``: the window rows' period, 100 px, is the storey."""
+    window = Node.split("y", [(Size("abs", 30), Node.leaf("window")), (Size("abs", 4), Node.leaf("molding")),
+                              (Size("abs", 26), Node.leaf("window"))])
+    tile = Node.split("x", [(Size("flt", 1), Node.leaf("facade")), (Size("abs", 40), window),
+                            (Size("flt", 1), Node.leaf("facade"))])
+    storey = Node.split("y", [(Size("abs", 20), Node.leaf("facade")), (Size("abs", 60), tile),
+                              (Size("abs", 20), Node.leaf("cornice", role="floor"))])
+    proc = Procedure(width=200, height=400, root=Node.repeat("y", 4, [(Size("flt", 1), storey)]))
+    assert default_scale(proc) == pytest.approx(3.0 / 100)
+    assert_same_leaves(proc, procedure_cga(proc), 3.0 / 100)
+
+
 @pytest.mark.parametrize("bad", [0, -1, float("nan"), float("inf"), 1e6, "1"])
 def test_a_bad_scale_is_refused(bad):
     with pytest.raises(ValueError, match="scale must be a number of metres per pixel > 0 and at most 100"):
