@@ -80,8 +80,10 @@ def default_scale(proc: Procedure) -> float:
 
     The storey is the median height of the nodes whose role is ``floor`` when the rows of windows agree with it
     within a quarter (the generator's and the model's trees), else the period of the rows of windows: an induced
-    procedure's ``floor`` repeats can be bands of a storey. On 195 generated facades the period of the window rows
-    is the floors' height within 10 % for 77 % (median 5 % more, the ground floor's row being further)."""
+    procedure's ``floor`` repeats can be bands of a storey (induced from 60 generated facades, half have none and
+    the rest are within a quarter of the true storey for 48 %, the window rows for 86 %). On 195 generated facades
+    the period of the window rows is the floors' height within 10 % for 77 % (median 5 % more, the ground floor's
+    row being further)."""
     floor, period = _floor_height(proc), _window_row_period(proc)
     if floor and (period is None or abs(period / floor - 1) <= 0.25):
         return STOREY_M / floor
