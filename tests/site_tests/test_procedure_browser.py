@@ -71,6 +71,9 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     assert d.value.suggested_filename.endswith("-mesh.zip")
     page.fill("#width-m", "")
     assert cga.get_attribute("href").endswith("/procedure.cga")
+    page.fill("#width-m", str(1000 * data["width"]))  # past the server's 100 m per pixel: the default, and a message
+    assert cga.get_attribute("href").endswith("/procedure.cga")
+    assert page.eval_on_selector("#width-m", "e => e.validationMessage").startswith("a width from 0.1 to")
     assert errors == []
 
 

@@ -110,9 +110,12 @@ document.getElementById("save")?.addEventListener("click", async () => {
 // The CGA rules and the mesh are in metres: a facade width the user knows sets their scale (metres per pixel of
 // the saved procedure); left empty, the server's default makes a storey 3 m tall.
 const widthField = document.getElementById("width-m");
+if (widthField) widthField.max = 100 * Number(widthField.dataset.px);  // the server takes up to 100 m per pixel
 widthField?.addEventListener("input", () => {
   const metres = Number(widthField.value);
-  const scaled = widthField.value !== "" && Number.isFinite(metres) && metres > 0;
+  const scaled = widthField.value !== "" && Number.isFinite(metres) && metres > 0 && metres <= Number(widthField.max);
+  widthField.setCustomValidity(widthField.value === "" || scaled ? "" : `a width from 0.1 to ${widthField.max} m`);
+  widthField.reportValidity();
   for (const link of document.querySelectorAll("a[href$='/procedure.cga'], a[href$='/mesh.zip'], a[href*='/procedure.cga?'], a[href*='/mesh.zip?']")) {
     const base = link.getAttribute("href").split("?")[0];
     link.setAttribute("href", scaled ? `${base}?metres_per_pixel=${metres / Number(widthField.dataset.px)}` : base);
