@@ -24,7 +24,7 @@ import math
 
 from facaid.grammar.execute import execute_with_boxes, expand, layout, leaf_array, repeat_count
 from facaid.grammar.procedure import Node, Procedure
-from facaid.labels import LABEL_ID, PALETTE
+from facaid.labels import LABEL_ID, hex_colour
 
 LEAF_RULES: dict[str, str] = {
     "background": "Background", "facade": "Wall", "window": "Window", "door": "Door", "cornice": "Cornice",
@@ -220,6 +220,6 @@ def procedure_cga(proc: Procedure, scale: float | None = None, name: str = "") -
     labels = sorted({node.label for _, node in proc.nodes() if node.is_leaf}, key=list(LEAF_RULES).index)
     leaves = []
     for label in labels:
-        body = "NIL" if label == "background" else 'color("#{:02x}{:02x}{:02x}")'.format(*PALETTE[label])
+        body = "NIL" if label == "background" else f'color("{hex_colour(label)}")'
         leaves.append(f"{LEAF_RULES[label]} -->\n\t{body}\n")
     return "\n".join(head) + "\n" + "\n".join(writer.lines) + "\n" + "\n".join(leaves)

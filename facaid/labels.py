@@ -59,6 +59,11 @@ PALETTE: dict[str, tuple[int, int, int]] = {
 PALETTE_ARRAY: tuple[tuple[int, int, int], ...] = tuple(PALETTE[name] for name in LABELS)
 
 
+def hex_colour(label: str) -> str:
+    """A label's palette colour as ``#rrggbb`` (SVG fills, CGA colours)."""
+    return "#{:02x}{:02x}{:02x}".format(*PALETTE[label])
+
+
 def label_id(name: str) -> int:
     """Return the id of a label name; raise ValueError naming the valid labels otherwise."""
     try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image, ImageDraw
 
-from facaid.labels import LABELS, PALETTE, PALETTE_ARRAY
+from facaid.labels import LABELS, PALETTE, PALETTE_ARRAY, hex_colour
 from facaid.segmentation import Segmentation, paint_order, rasterize
 
 _LUT = np.array(PALETTE_ARRAY, dtype=np.uint8)
@@ -70,21 +70,17 @@ def segmentation_svg(seg: Segmentation) -> str:
     w, h = seg.width, seg.height
     lines = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" '
              'shape-rendering="crispEdges">',
-             f'<rect id="background" width="{w}" height="{h}" fill="{_hex(PALETTE["background"])}"/>']
+             f'<rect id="background" width="{w}" height="{h}" fill="{hex_colour("background")}"/>']
     group = None
     for r in paint_order(seg.rects):
         name = LABELS[r.label]
         if name != group:
             if group is not None:
                 lines.append("</g>")
-            lines.append(f'<g id="{name}" fill="{_hex(PALETTE[name])}">')
+            lines.append(f'<g id="{name}" fill="{hex_colour(name)}">')
             group = name
         lines.append(f'<rect x="{r.x0}" y="{r.y0}" width="{r.x1 - r.x0}" height="{r.y1 - r.y0}"/>')
     if group is not None:
         lines.append("</g>")
     lines.append("</svg>")
     return "\n".join(lines) + "\n"
-
-
-def _hex(rgb: tuple[int, int, int]) -> str:
-    return "#{:02x}{:02x}{:02x}".format(*rgb)
