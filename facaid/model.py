@@ -362,6 +362,8 @@ def deepened(model: FacaidModel, decoder_layers: int) -> FacaidModel:
     return deep
 
 
+# where each kind of encoder keeps its layers in the state dict
+ENCODER_STEMS = {"bidirectional": "encoder.encoder.layer.", "causal": "encoder.h."}
 # a BERT layer's projections into its residual sums and its two post-layer norms
 _BERT_OUTPUTS = ("attention.output.dense.", "output.dense.")
 _BERT_NORMS = ("attention.output.LayerNorm.", "output.LayerNorm.")
@@ -378,8 +380,8 @@ def encoder_deepened(model: FacaidModel, encoder_layers: int) -> FacaidModel:
     closing norm loses its gain and bias (it outputs the normalized vector), every new layer's norms are plain
     (normalizing a normalized vector changes it by the norm's epsilon only) and the last new layer's closing norm
     takes the gain and bias: the encoder's output is the same to float precision."""
+    stem = ENCODER_STEMS[model.config.encoder]
     if model.config.encoder == "bidirectional":
-        stem = "encoder.encoder.layer."
         deep, state, block = _grown(model, "encoder_layers", encoder_layers, stem, _BERT_OUTPUTS, _BERT_NORMS)
         have = model.config.encoder_layers
         for part, plain in (("weight", 1.0), ("bias", 0.0)):
@@ -387,7 +389,7 @@ def encoder_deepened(model: FacaidModel, encoder_layers: int) -> FacaidModel:
             state[f"{stem}{encoder_layers - 1}.{closing}"] = block[closing].clone()
             state[f"{stem}{have - 1}.{closing}"] = torch.full_like(block[closing], plain)
     else:
-        deep, state, _ = _grown(model, "encoder_layers", encoder_layers, "encoder.h.", _BLOCK_OUTPUTS)
+        deep, state, _ = _grown(model, "encoder_layers", encoder_layers, stem, _BLOCK_OUTPUTS)
     deep.load_state_dict(state, strict=True)
     deep.train(model.training)
     return deep

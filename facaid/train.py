@@ -28,6 +28,7 @@ from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
 from facaid.grammar.procedure import MODES
 from facaid.model import (
+    ENCODER_STEMS,
     FacaidConfig,
     FacaidModel,
     adapt_to_tokenizer,
@@ -405,9 +406,9 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     # decay
     grown = tuple(f"decoder.h.{i}." for i in range(state["grown_from"] or model.config.decoder_layers,
                                                     model.config.decoder_layers))
-    encoder_stem = "encoder.encoder.layer." if model.config.encoder == "bidirectional" else "encoder.h."
-    grown += tuple(f"{encoder_stem}{i}." for i in range(state["encoder_grown_from"] or model.config.encoder_layers,
-                                                        model.config.encoder_layers))
+    encoder = ENCODER_STEMS[model.config.encoder]
+    grown += tuple(f"{encoder}{i}." for i in range(state["encoder_grown_from"] or model.config.encoder_layers,
+                                                   model.config.encoder_layers))
 
     def decayed(params: list, scale: float) -> list[dict]:  # weight decay on matrices only
         return [{"params": [p for p in params if p.dim() >= 2], "weight_decay": cfg.weight_decay, "scale": scale},
