@@ -99,7 +99,5 @@ def procedure_mesh(proc: Procedure, scale: float | None = None, mtl_name: str = 
 def _area_normal(corners: np.ndarray, normal: tuple[int, int, int]) -> float:
     """The component along ``normal`` of the quad's (a, b, c) winding normal: > 0 when counter-clockwise seen
     from that side."""
-    (ax, ay, az), (bx, by, bz), (cx, cy, cz) = corners[:3]
-    ux, uy, uz, vx, vy, vz = bx - ax, by - ay, bz - az, cx - ax, cy - ay, cz - az
-    cross = (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
-    return sum(c * n for c, n in zip(cross, normal, strict=True))
+    a, b, c = corners[:3]
+    return float(np.dot(np.cross(b - a, c - a), normal))

@@ -116,7 +116,7 @@ widthField?.addEventListener("input", () => {
   const scaled = widthField.value !== "" && Number.isFinite(metres) && metres > 0 && metres <= Number(widthField.max);
   widthField.setCustomValidity(widthField.value === "" || scaled ? "" : `a width from 0.1 to ${widthField.max} m`);
   widthField.reportValidity();
-  for (const link of document.querySelectorAll("a[href$='/procedure.cga'], a[href$='/mesh.zip'], a[href*='/procedure.cga?'], a[href*='/mesh.zip?']")) {
+  for (const link of document.querySelectorAll("a[href*='/procedure.cga'], a[href*='/mesh.zip']")) {
     const base = link.getAttribute("href").split("?")[0];
     link.setAttribute("href", scaled ? `${base}?metres_per_pixel=${metres / Number(widthField.dataset.px)}` : base);
   }
