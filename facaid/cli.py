@@ -136,12 +136,14 @@ def cmd_evaluate(args: argparse.Namespace) -> None:
     from facaid.evaluation.synthetic import evaluate_synthetic, write_report
     from facaid.model import load_model
 
+    if args.ceiling and args.best_of < 2:
+        raise CliError("--ceiling measures the candidates of best of K: give --best-of K (K >= 2) too")
     if args.threads:
         torch.set_num_threads(args.threads)
     model, tokenizer = load_model(args.checkpoint)
     result = evaluate_synthetic(model, tokenizer, args.count, args.seed, noise_count=args.noise_count,
                                 unconstrained_count=args.unconstrained_count, best_of=args.best_of,
-                                progress=not args.quiet, records=args.records)
+                                ceiling=args.ceiling, progress=not args.quiet, records=args.records)
     result["checkpoint"] = str(args.checkpoint)
     report = write_report(result, args.report)
     print(report.read_text().split("## Noise")[0].strip())
@@ -324,6 +326,9 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--best-of", type=int, default=0, metavar="K",
                    help=f"also decode best of K (greedy + K-1 samples ranked by reproduction), as reconstruct does "
                         f"(which decodes {DEFAULT_K})")
+    e.add_argument("--ceiling", action="store_true",
+                   help="with --best-of: also the figures of the truth's pick among the trees best of K chose from "
+                        "(how far a better ranking of the same candidates could go)")
     e.add_argument("--report", default="out/evaluate", help="report directory (default out/evaluate)")
     e.add_argument("--json", help="write the figures to this JSON file")
     e.add_argument("--records", metavar="FILE",

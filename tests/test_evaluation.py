@@ -66,6 +66,37 @@ def test_evaluate_and_report(tiny, tmp_path):
     assert "## By style" in text and "best of 3: exact" in text
 
 
+def test_ceiling_is_the_truths_pick_among_the_trees_best_of_k_chose_from(tiny, tmp_path):
+    from facaid.decoding import ranked_candidates
+    from facaid.evaluation.synthetic import held_out
+    from facaid.evaluation.ted import tree_edit_distance
+
+    model, tok = tiny
+    kw = dict(seed=1000, noise_count=1, unconstrained_count=0, best_of=4, progress=False)
+    path = tmp_path / "records.jsonl"
+    result = evaluate_synthetic(model, tok, count=3, ceiling=True, records=path, **kw)
+    records = [json.loads(line) for line in path.read_text().splitlines()]
+    assert records[0]["settings"]["ceiling"] is True
+    for i, (rec, ex) in enumerate(zip(records[1:], held_out(tok, 1000), strict=False)):
+        truth = ex["sample"].procedure.root
+        teds = [tree_edit_distance(truth, c.procedure.root)
+                for c in ranked_candidates(model, tok, ex["sample"].segmentation, 4, seed=i)]
+        assert rec["best"]["ted"] == teds[0] and rec["best"]["ceiling"] == min(teds)
+    assert len(records[1]["noise"][0]) == 4 and records[1]["noise"][1][3] <= records[1]["noise"][1][2]
+    ceiling, best = result["best_of"]["ceiling"], result["best_of"]
+    assert ceiling["ted_mean"] == pytest.approx(sum(r["best"]["ceiling"] for r in records[1:]) / 3)
+    assert ceiling["ted_mean"] <= best["ted_mean"] and [p["count"] for p in ceiling["noise"]] == [1] * 5
+    assert all("ceiling" in st for st in result["by_style"].values())
+    text = write_report(result, tmp_path / "report").read_text()
+    assert "the truth's pick among the trees best of 4 chose from" in text
+    assert "Mean TED under noise, the truth's pick" in text and "truth's pick: exact" in text
+    # without it, the settings and records are as before, so that earlier records files still resume
+    plain = evaluate_synthetic(model, tok, count=1, records=tmp_path / "plain.jsonl", **kw)
+    head, rec = (json.loads(line) for line in (tmp_path / "plain.jsonl").read_text().splitlines())
+    assert "ceiling" not in head["settings"] and "ceiling" not in rec["best"] and len(rec["noise"][0]) == 3
+    assert "ceiling" not in plain["best_of"] and "truth's pick" not in write_report(plain, tmp_path / "r2").read_text()
+
+
 def test_figures_by_style():
     figures = by_style(["wings", "house", "wings", "house"], [0, 3, 12, 0], [0, 0, 6, 0])
     assert list(figures) == ["house", "wings"]
@@ -88,6 +119,8 @@ def test_cli_evaluate(tiny, tmp_path, capsys):
     assert "Not measured (`--noise-count 0`)." in text and "Mean TED under noise" not in text
     assert main(["evaluate", "--checkpoint", str(tmp_path / "missing"), "--count", "2"]) == 2
     assert "no checkpoint" in capsys.readouterr().err
+    assert main(["evaluate", "--checkpoint", str(tmp_path / "ckpt"), "--count", "2", "--ceiling"]) == 2
+    assert "give --best-of K" in capsys.readouterr().err
 
 
 def _without_latency(result):

@@ -18,7 +18,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from facaid.decoding import best_of_k, decode
+from facaid.decoding import decode, ranked_candidates
 from facaid.defaults import FLOOR_TOLERANCE, TEMPERATURE
 from facaid.evaluation.noise import perturb
 from facaid.evaluation.records import RecordLog, model_digest
@@ -28,6 +28,7 @@ from facaid.generator.dataset import sample_seed
 from facaid.grammar.procedure import Node
 from facaid.model import FacaidModel, batch_inputs, batch_outputs
 from facaid.pipeline import fit_to_model
+from facaid.segmentation import Segmentation
 from facaid.tokenizer import TokenGrammar, Tokenizer
 
 NOISE_LEVELS = (0.0, 0.05, 0.10, 0.15, 0.20)
@@ -92,11 +93,25 @@ def held_out(tokenizer: Tokenizer, seed: int, start: int = 0) -> Iterator[dict]:
                "height": s.procedure.height}
 
 
+def best_of_teds(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, truth: Node, k: int, seed: int,
+                 ceiling: bool) -> tuple[int, int | None, float]:
+    """The tree edit distance of best-of-K's choice; with ``ceiling`` the least one among the trees it chose
+    from (the K candidates and their composition: what a ranking that knew the truth would reach), else None;
+    and the seconds best of K took (decoding and ranking, not the distances)."""
+    t0 = time.perf_counter()
+    ranked = ranked_candidates(model, tokenizer, seg, k, seed=seed)
+    seconds = time.perf_counter() - t0
+    chosen = tree_edit_distance(truth, ranked[0].procedure.root)
+    if not ceiling:
+        return chosen, None, seconds
+    return chosen, min([chosen] + [tree_edit_distance(truth, c.procedure.root) for c in ranked[1:]]), seconds
+
+
 def measure(model: FacaidModel, tokenizer: Tokenizer, ex: dict, i: int, sums: tuple[float, float, int], *,
-            noise_count: int, unconstrained_count: int, best_of: int) -> dict:
+            noise_count: int, unconstrained_count: int, best_of: int, ceiling: bool = False) -> dict:
     """The figures of the ``i``-th held-out example as one JSON-ready record (`summarize` adds them up).
     Sampling and noise are seeded by ``i``, so a record does not depend on the run that made it, but for its
-    latencies."""
+    latencies. With ``ceiling``, best of K's records also hold the ceiling of its ranking (`best_of_teds`)."""
     s = ex["sample"]
     truth = s.procedure.root
     t0 = time.perf_counter()
@@ -107,29 +122,30 @@ def measure(model: FacaidModel, tokenizer: Tokenizer, ex: dict, i: int, sums: tu
                  "truth": dict(Counter(production(n) for _, n in s.procedure.nodes())),
                  "predicted": dict(Counter(production(n) for _, n in pred.procedure.nodes()))}
     if best_of > 1:
-        t0 = time.perf_counter()
-        best = best_of_k(model, tokenizer, s.segmentation, best_of, seed=i)
-        rec["best"] = {"latency": time.perf_counter() - t0, "ted": tree_edit_distance(truth, best.procedure.root)}
+        ted, least, seconds = best_of_teds(model, tokenizer, s.segmentation, truth, best_of, i, ceiling)
+        rec["best"] = {"latency": seconds, "ted": ted, **({"ceiling": least} if ceiling else {})}
     if i < unconstrained_count:
         free = decode(model, tokenizer, s.segmentation, constrained=False)[0]
         rec["unconstrained_valid"] = free.procedure is not None
     if i < noise_count:
-        rec["noise"] = []  # per level of NOISE_LEVELS[1:]: [TED, pixels changed, TED best of K or None]
+        # per level of NOISE_LEVELS[1:]: [TED, pixels changed, TED best of K or None(, its ceiling)]
+        rec["noise"] = []
         for level in NOISE_LEVELS[1:]:
             noisy, measured = perturb(s.segmentation, level, seed=i)
             noisy = fit_to_model(noisy, tokenizer)  # noise can add pieces
             d = tree_edit_distance(truth, decode(model, tokenizer, noisy)[0].procedure.root)
-            b = (tree_edit_distance(truth, best_of_k(model, tokenizer, noisy, best_of, seed=i).procedure.root)
-                 if best_of > 1 else None)
-            rec["noise"].append([d, measured, b])
+            b, c = best_of_teds(model, tokenizer, noisy, truth, best_of, i, ceiling)[:2] if best_of > 1 else (None,) * 2
+            rec["noise"].append([d, measured, b, c] if ceiling else [d, measured, b])
     return rec
 
 
 def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, seed: int, *,
                        noise_count: int = 100, unconstrained_count: int = 200, best_of: int = 0,
-                       progress: bool = True, records: str | Path | None = None) -> dict:
+                       ceiling: bool = False, progress: bool = True, records: str | Path | None = None) -> dict:
     """Figures of the greedy decoder; with ``best_of`` = K > 1 also of best-of-K decoding (the greedy candidate
-    and K-1 samples, the one whose execution reproduces the input best), as `facaid.reconstruct` decodes.
+    and K-1 samples, the one whose execution reproduces the input best), as `facaid.reconstruct` decodes. With
+    ``ceiling`` (and best of K), also the figures of the best tree among those best of K chose from, known from
+    the truth: how far a better ranking of the same candidates could take it (`best_of_teds`).
 
     With ``records`` (a JSON-lines file), each facade's figures are appended to it as they are measured, and a
     run started again on the same file with the same settings and weights goes on where the last one stopped
@@ -138,6 +154,9 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
     settings = {"seed": seed, "noise_count": noise_count, "unconstrained_count": unconstrained_count,
                 "best_of": best_of, "temperature": TEMPERATURE, "floor_tolerance": FLOOR_TOLERANCE,
                 "model": model_digest(model, tokenizer)}
+    ceiling = ceiling and best_of > 1
+    if ceiling:  # only then, so that the records files of runs without it still resume
+        settings["ceiling"] = True
     log = RecordLog(records, settings) if records is not None else None
     done = log.records[:count] if log else []
     examples = held_out(tokenizer, seed, start=done[-1]["index"] + 1 if done else 0)
@@ -146,7 +165,7 @@ def evaluate_synthetic(model: FacaidModel, tokenizer: Tokenizer, count: int, see
         chunk = [next(examples) for _ in range(min(NLL_BATCH, count - len(done)))]
         for ex, sums in zip(chunk, nll_sums(model, tokenizer, chunk), strict=True):
             rec = measure(model, tokenizer, ex, len(done), sums, noise_count=noise_count,
-                          unconstrained_count=unconstrained_count, best_of=best_of)
+                          unconstrained_count=unconstrained_count, best_of=best_of, ceiling=ceiling)
             if log:
                 log.append(rec)
             done.append(rec)
@@ -189,6 +208,12 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
                                "p90": 1000 * float(np.percentile(blat, 90))},
                 "noise": [{"level": lv, "mean_ted": float(np.mean(t)) if t else None, "count": len(t)}
                           for lv, t in zip(NOISE_LEVELS, curve, strict=True)]}
+        if all("ceiling" in r["best"] for r in records):
+            least = [[r["best"]["ceiling"] for r in noisy]] + [[r["noise"][j][3] for r in noisy]
+                                                               for j in range(len(NOISE_LEVELS) - 1)]
+            best["ceiling"] = {**ted_figures([r["best"]["ceiling"] for r in records]),
+                               "noise": [{"level": lv, "mean_ted": float(np.mean(t)) if t else None,
+                                          "count": len(t)} for lv, t in zip(NOISE_LEVELS, least, strict=True)]}
     curve = noise_curve(0)
     return {
         "count": len(records),
@@ -212,7 +237,8 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
                        "p90": 1000 * float(np.percentile(latency, 90))},
         "productions": {"truth": dict(truth_counts.most_common()), "predicted": dict(pred_counts.most_common())},
         "best_of": best,
-        "by_style": by_style([r["style"] for r in records], teds.tolist(), best_teds),
+        "by_style": by_style([r["style"] for r in records], teds.tolist(), best_teds,
+                             [r["best"]["ceiling"] for r in records] if best and "ceiling" in best else None),
     }
 
 
@@ -223,14 +249,17 @@ def ted_figures(teds: list[int]) -> dict:
             "ted_mean": float(t.mean())}
 
 
-def by_style(styles: list[str], teds: list[int], best_teds: list[int] | None = None) -> dict:
-    """Exact structure rate, TED <= 5 and mean TED per generator style (greedy, and best of K when given)."""
+def by_style(styles: list[str], teds: list[int], best_teds: list[int] | None = None,
+             ceiling_teds: list[int] | None = None) -> dict:
+    """Exact structure rate, TED <= 5 and mean TED per generator style (greedy, and best of K and its ceiling
+    when given)."""
     out = {}
     for name in sorted(set(styles)):
         pick = [i for i, st in enumerate(styles) if st == name]
         out[name] = {"count": len(pick), "greedy": ted_figures([teds[i] for i in pick])}
-        if best_teds:
-            out[name]["best_of"] = ted_figures([best_teds[i] for i in pick])
+        for key, values in (("best_of", best_teds), ("ceiling", ceiling_teds)):
+            if values:
+                out[name][key] = ted_figures([values[i] for i in pick])
     return out
 
 
@@ -339,25 +368,29 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
             f"| inference latency, best of {k}, batch 1 (median / p90) | {b['latency_ms']['median']:.0f} / "
             f"{b['latency_ms']['p90']:.0f} ms |",
         ]
-        noisy = [p for p in b["noise"] if p["mean_ted"] is not None]
-        if noisy:
-            lines += ["", f"Mean TED under noise, best of {k}: " + ", ".join(
-                f"{100 * p['level']:.0f} %: {p['mean_ted']:.2f}" for p in noisy) + "."]
+        c = b.get("ceiling")
+        if c:
+            lines += [f"| the truth's pick among the trees best of {k} chose from (the ceiling of its ranking): "
+                      f"exact / TED ≤ 5 / mean TED | {100 * c['exact_structure_rate']:.1f} % / "
+                      f"{100 * c['ted_le5']:.1f} % / {c['ted_mean']:.2f} |"]
+        for name, curve in ((f"best of {k}", b["noise"]), ("the truth's pick", c["noise"] if c else [])):
+            noisy = [p for p in curve if p["mean_ted"] is not None]
+            if noisy:
+                lines += ["", f"Mean TED under noise, {name}: " + ", ".join(
+                    f"{100 * p['level']:.0f} %: {p['mean_ted']:.2f}" for p in noisy) + "."]
     lines += ["", "![noise](noise.png)", "", "## Tree edit distance", "", "![ted](ted.png)", ""]
     if r.get("by_style"):
         best_k = r["best_of"]["k"] if r.get("best_of") else None
         head = "| style | facades | exact | TED ≤ 5 | mean TED |"
-        if best_k:
-            head += f" best of {best_k}: exact | TED ≤ 5 | mean TED |"
+        columns = [("best_of", f"best of {best_k}"), ("ceiling", "truth's pick")] if best_k else []
+        columns = [(key, name) for key, name in columns if all(key in st for st in r["by_style"].values())]
+        for _, name in columns:
+            head += f" {name}: exact | TED ≤ 5 | mean TED |"
         lines += ["## By style", "", head, "|" + " --- |" * (head.count("|") - 1)]
         for name, st in r["by_style"].items():
-            g = st["greedy"]
-            row = (f"| {name} | {st['count']} | {100 * g['exact_structure_rate']:.1f} % | "
-                   f"{100 * g['ted_le5']:.1f} % | {g['ted_mean']:.2f} |")
-            if best_k and "best_of" in st:
-                b = st["best_of"]
-                row += (f" {100 * b['exact_structure_rate']:.1f} % | {100 * b['ted_le5']:.1f} % | "
-                        f"{b['ted_mean']:.2f} |")
+            row = f"| {name} | {st['count']} |"
+            for f in [st["greedy"]] + [st[key] for key, _ in columns]:
+                row += f" {100 * f['exact_structure_rate']:.1f} % | {100 * f['ted_le5']:.1f} % | {f['ted_mean']:.2f} |"
             lines.append(row)
         lines.append("")
     lines += ["## Productions", "", "![productions](productions.png)", ""]
