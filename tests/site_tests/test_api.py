@@ -80,7 +80,22 @@ def test_procedure_edit_validates_and_remeasures(facade_photo, as_alice, alice):
     r = as_alice.patch(url, {"visibility": "everyone"}, format="json")
     assert r.status_code == 400
     assert as_alice.patch(url, '{"title": ', content_type="application/json").status_code == 400
+    for title in (5, True, ["a"], {"a": 1}, None):  # text only: no number stored as "5"
+        r = as_alice.patch(url, {"title": title, "visibility": "public"}, format="json")
+        assert r.status_code == 400 and "title" in r.json(), (title, r.content)
+    assert as_alice.patch(url, {"title": "x" * 201}, format="json").status_code == 400
     assert Procedure.objects.get(id=proc.id).data == sample.procedure.to_dict()  # nothing lost
+    assert Procedure.objects.get(id=proc.id).visibility == "private" and Procedure.objects.get(id=proc.id).title == ""
+    assert as_alice.patch(url, {"title": "Rue de Rivoli 12"}, format="json").json()["title"] == "Rue de Rivoli 12"
+
+
+def test_photo_titles_are_text(facade_photo, as_alice):
+    photo, _ = facade_photo
+    url = f"/api/v1/photos/{photo['code']}/"
+    r = as_alice.patch(url, {"title": 12}, format="json")
+    assert r.status_code == 400 and "Not text" in json.dumps(r.json())
+    assert as_alice.get(url).json()["title"] == photo["title"]
+    assert as_alice.patch(url, {"title": "Rivoli"}, format="json").json()["title"] == "Rivoli"
 
 
 def test_downloads_render_and_variations(facade_photo, as_alice, alice):

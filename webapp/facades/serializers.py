@@ -26,8 +26,24 @@ def parse_procedure(data) -> ProcedureTree:
         raise serializers.ValidationError({"data": str(exc)}) from None
 
 
+class TextField(serializers.CharField):
+    """Text, and only text: DRF's CharField would store a number or a boolean sent as a title as its string."""
+
+    default_error_messages = {"invalid": "Not text: give a string."}
+
+    def to_internal_value(self, data):
+        if not isinstance(data, str):
+            self.fail("invalid")
+        return super().to_internal_value(data)
+
+
+def title_field() -> TextField:
+    return TextField(max_length=200, required=False, allow_blank=True)
+
+
 class PhotoSerializer(serializers.ModelSerializer):
     owner = serializers.CharField(source="owner.username", read_only=True)
+    title = title_field()
     image = serializers.SerializerMethodField()
     rectified = serializers.SerializerMethodField()
     segmentation = serializers.SerializerMethodField()
@@ -54,7 +70,7 @@ class PhotoSerializer(serializers.ModelSerializer):
 
 class PhotoUploadSerializer(serializers.Serializer):
     image = serializers.FileField(allow_empty_file=True)
-    title = serializers.CharField(max_length=200, required=False, allow_blank=True)
+    title = title_field()
     visibility = serializers.ChoiceField(Visibility.choices, default=Visibility.PRIVATE)
 
 
@@ -102,7 +118,7 @@ class ProcedureSummarySerializer(ProcedureSerializer):
 
 
 class ProcedureWriteSerializer(serializers.Serializer):
-    title = serializers.CharField(max_length=200, required=False, allow_blank=True)
+    title = title_field()
     visibility = serializers.ChoiceField(Visibility.choices, required=False)
     data = serializers.JSONField(required=False)
 
