@@ -353,7 +353,8 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
     if r.get("best_of"):
         b = r["best_of"]
         k = b["k"]
-        lines[lines.index("## Noise robustness") - 1:lines.index("## Noise robustness") - 1] = [
+        c = b.get("ceiling")
+        block = [
             "",
             f"Best of {k} (the greedy candidate and {k - 1} samples at temperature {b.get('temperature', 1.0)}, "
             "ranked by how well their execution reproduces the input: pixel accuracy in whole points less a point "
@@ -368,11 +369,12 @@ def write_report(result: dict, out_dir: str | Path, title: str = "Evaluation on 
             f"| inference latency, best of {k}, batch 1 (median / p90) | {b['latency_ms']['median']:.0f} / "
             f"{b['latency_ms']['p90']:.0f} ms |",
         ]
-        c = b.get("ceiling")
         if c:
-            lines += [f"| the truth's pick among the trees best of {k} chose from (the ceiling of its ranking): "
+            block += [f"| the truth's pick among the trees best of {k} chose from (the ceiling of its ranking): "
                       f"exact / TED ≤ 5 / mean TED | {100 * c['exact_structure_rate']:.1f} % / "
                       f"{100 * c['ted_le5']:.1f} % / {c['ted_mean']:.2f} |"]
+        at = lines.index("## Noise robustness") - 1
+        lines[at:at] = block
         for name, curve in ((f"best of {k}", b["noise"]), ("the truth's pick", c["noise"] if c else [])):
             noisy = [p for p in curve if p["mean_ted"] is not None]
             if noisy:
