@@ -32,6 +32,8 @@ def test_layout_rules():
     assert layout([A(40), A(60), F(1)], 50) == [20, 30, 0]  # overflow: fixed scaled down, floats get nothing
     assert layout([A(10), A(30)], 80) == [20, 60]  # no float: fixed scaled to fill
     assert layout([A(0), A(0)], 80) == [0, 0]
+    # a region rounding left a hair below zero long: nothing to share, and no division by zero
+    assert layout([F(0.17)], -1.1e-13) == [0] and layout([A(5), F(1)], -1e-13) == [0, 0]
 
 
 def test_execution_partitions_the_image():

@@ -45,7 +45,9 @@ def expand(node: Node, length: float) -> tuple[list[Size], list[Node], list[bool
 
 
 def layout(sizes: list[Size], length: float) -> list[float]:
-    """Lengths of the children of a split of the given length (see the rules in `procedure`)."""
+    """Lengths of the children of a split of the given length (see the rules in `procedure`). A length below 0
+    (a last child laid out where rounding put its start a hair past its end) counts as 0."""
+    length = max(length, 0.0)
     fixed = 0.0
     weights = 0.0
     for s in sizes:
