@@ -4,7 +4,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import facaid.grammar as grammar_pkg
@@ -32,6 +32,7 @@ def test_generated_procedures_are_valid_and_round_trip(seed, style):
 
 @settings(max_examples=120, deadline=None)
 @given(seeds, styles)
+@example(105458249, None)  # a modernist curtain wall: ribbon windows and balcony bands, no wall showing
 def test_generated_facades_execute_in_bounds_without_overlaps(seed, style):
     sample = generate(seed, style)
     seg = to_segmentation(sample.procedure)
@@ -44,9 +45,10 @@ def test_generated_facades_execute_in_bounds_without_overlaps(seed, style):
     # the stored segmentation is the canonical flattening of the execution
     assert sample.segmentation == flatten(seg)
     assert np.array_equal(rasterize(sample.segmentation), rasterize(seg))
-    # a facade has windows and a wall
+    # a facade has windows, and a wall but for a modernist curtain wall (3 of 24,159 facades of random seeds)
     labels = {LABELS[r.label] for r in seg.rects}
-    assert {"facade", "window"} <= labels
+    assert "window" in labels
+    assert "facade" in labels or sample.style == "modernist"
 
 
 @settings(max_examples=40, deadline=None)
