@@ -104,7 +104,8 @@ def best_of_teds(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, tr
     chosen = tree_edit_distance(truth, ranked[0].procedure.root)
     if not ceiling:
         return chosen, None, seconds
-    return chosen, min([chosen] + [tree_edit_distance(truth, c.procedure.root) for c in ranked[1:]]), seconds
+    others = {tuple(c.ids): c for c in ranked[1:]}  # samples often repeat one another: each tree measured once
+    return chosen, min([chosen] + [tree_edit_distance(truth, c.procedure.root) for c in others.values()]), seconds
 
 
 def measure(model: FacaidModel, tokenizer: Tokenizer, ex: dict, i: int, sums: tuple[float, float, int], *,
@@ -192,29 +193,31 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
     norm_hist = Counter(min(int(x * 20), 20) for x in norm)  # bins of 0.05
     latency = [r["latency"] for r in records]
     best_teds = [r["best"]["ted"] for r in records] if best_of > 1 else []
+    ceiling_teds = ([r["best"]["ceiling"] for r in records]
+                    if best_of > 1 and all("ceiling" in r["best"] for r in records) else [])
 
-    def noise_curve(column: int) -> list[list[float]]:  # per level, the TEDs (column 0 greedy, 2 best of K)
-        clean = [r["ted"] if column == 0 else r["best"]["ted"] for r in noisy]
-        return [clean] + [[r["noise"][j][column] for r in noisy] for j in range(len(NOISE_LEVELS) - 1)]
+    def noise_curve(clean: str | None, column: int) -> list[list[float]]:
+        """Per level, the TEDs of the noisy facades: at 0 % their clean TED (``r["ted"]``, or ``r["best"][clean]``),
+        then column ``column`` of each level's record (0 greedy, 2 best of K, 3 its ceiling)."""
+        first = [r["ted"] if clean is None else r["best"][clean] for r in noisy]
+        return [first] + [[r["noise"][j][column] for r in noisy] for j in range(len(NOISE_LEVELS) - 1)]
+
+    def mean_teds(curve: list[list[float]]) -> list[dict]:
+        return [{"level": lv, "mean_ted": float(np.mean(t)) if t else None, "count": len(t)}
+                for lv, t in zip(NOISE_LEVELS, curve, strict=True)]
 
     measured = [[0.0] * len(noisy)] + [[r["noise"][j][1] for r in noisy] for j in range(len(NOISE_LEVELS) - 1)]
     best = None
     if best_of > 1:
         blat = [r["best"]["latency"] for r in records]
-        curve = noise_curve(2)
         best = {"k": best_of, "temperature": TEMPERATURE, "composed": True,  # `facaid.composition`
                 **ted_figures(best_teds),
                 "latency_ms": {"median": 1000 * statistics.median(blat),
                                "p90": 1000 * float(np.percentile(blat, 90))},
-                "noise": [{"level": lv, "mean_ted": float(np.mean(t)) if t else None, "count": len(t)}
-                          for lv, t in zip(NOISE_LEVELS, curve, strict=True)]}
-        if all("ceiling" in r["best"] for r in records):
-            least = [[r["best"]["ceiling"] for r in noisy]] + [[r["noise"][j][3] for r in noisy]
-                                                               for j in range(len(NOISE_LEVELS) - 1)]
-            best["ceiling"] = {**ted_figures([r["best"]["ceiling"] for r in records]),
-                               "noise": [{"level": lv, "mean_ted": float(np.mean(t)) if t else None,
-                                          "count": len(t)} for lv, t in zip(NOISE_LEVELS, least, strict=True)]}
-    curve = noise_curve(0)
+                "noise": mean_teds(noise_curve("ted", 2))}
+        if ceiling_teds:
+            best["ceiling"] = {**ted_figures(ceiling_teds), "noise": mean_teds(noise_curve("ceiling", 3))}
+    curve = noise_curve(None, 0)
     return {
         "count": len(records),
         "seed": seed,
@@ -237,8 +240,7 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
                        "p90": 1000 * float(np.percentile(latency, 90))},
         "productions": {"truth": dict(truth_counts.most_common()), "predicted": dict(pred_counts.most_common())},
         "best_of": best,
-        "by_style": by_style([r["style"] for r in records], teds.tolist(), best_teds,
-                             [r["best"]["ceiling"] for r in records] if best and "ceiling" in best else None),
+        "by_style": by_style([r["style"] for r in records], teds.tolist(), best_teds, ceiling_teds),
     }
 
 
