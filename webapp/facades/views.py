@@ -132,7 +132,8 @@ def procedure(request, code):
         "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
         "downloads": [(d, api.DOWNLOAD_HELP[d]) for d in api.DOWNLOADS
-                      if photo_visible or d not in api.PHOTO_DOWNLOADS]})
+                      if photo_visible or d not in api.PHOTO_DOWNLOADS],
+        "max_scale": api.MAX_SCALE})
 
 
 @login_required

@@ -110,7 +110,7 @@ document.getElementById("save")?.addEventListener("click", async () => {
 // The CGA rules and the mesh are in metres: a facade width the user knows sets their scale (metres per pixel of
 // the saved procedure); left empty, the server's default makes a storey 3 m tall.
 const widthField = document.getElementById("width-m");
-if (widthField) widthField.max = 100 * Number(widthField.dataset.px);  // the server takes up to 100 m per pixel
+if (widthField) widthField.max = Number(widthField.dataset.maxScale) * Number(widthField.dataset.px);  // the server's bound
 widthField?.addEventListener("input", () => {
   const metres = Number(widthField.value);
   const scaled = widthField.value !== "" && Number.isFinite(metres) && metres > 0 && metres <= Number(widthField.max);
