@@ -154,7 +154,8 @@ def main() -> None:
         # throughput of one CPU worker
         log = open(tmp / "worker.log", "wb")  # noqa: SIM115 (lives as long as the worker)
         procs.append(subprocess.Popen([sys.executable, "-m", "celery", "-A", "webapp.celery", "worker", "-Q",
-                                       "gpu,default", "--pool", "solo", "-l", "info"], cwd=ROOT, env=env,
+                                       "gpu,default", "--pool", "prefork", "--concurrency", "1", "-l", "info"],
+                                      cwd=ROOT, env=env,
                                       stdout=log, stderr=subprocess.STDOUT))
         submit = f"""
 import json

@@ -29,12 +29,16 @@ def _check_corners(corners) -> np.ndarray:
     return pts
 
 
-def output_size(corners) -> tuple[int, int]:
-    """Width and height of the rectified image: the mean lengths of opposite edges."""
+def output_size(corners, max_pixels: int | None = None) -> tuple[int, int]:
+    """Width and height of the rectified image: the mean lengths of opposite edges, shrunk to at most
+    `MAX_SIDE` a side and ``max_pixels`` in all."""
     p = _check_corners(corners)
     w = (np.linalg.norm(p[1] - p[0]) + np.linalg.norm(p[2] - p[3])) / 2
     h = (np.linalg.norm(p[3] - p[0]) + np.linalg.norm(p[2] - p[1])) / 2
     scale = min(1.0, MAX_SIDE / max(w, h))
+    if max_pixels is not None and w * h * scale * scale > max_pixels:
+        scale = math.sqrt(max_pixels / (w * h))
+        return max(1, math.floor(w * scale)), max(1, math.floor(h * scale))
     return max(1, round(w * scale)), max(1, round(h * scale))
 
 
@@ -49,10 +53,12 @@ def homography(src, dst) -> np.ndarray:
     return np.append(h, 1.0).reshape(3, 3)
 
 
-def rectify(image: Image.Image, corners, size: tuple[int, int] | None = None) -> Image.Image:
-    """Warp the quadrilateral ``corners`` (TL, TR, BR, BL, in image pixels) of ``image`` to a rectangle."""
+def rectify(image: Image.Image, corners, size: tuple[int, int] | None = None,
+            max_pixels: int | None = None) -> Image.Image:
+    """Warp the quadrilateral ``corners`` (TL, TR, BR, BL, in image pixels) of ``image`` to a rectangle of
+    ``size`` (by default `output_size`, at most ``max_pixels``)."""
     p = _check_corners(corners)
-    w, h = size or output_size(p)
+    w, h = size or output_size(p, max_pixels)
     if not (0 < w <= MAX_SIDE and 0 < h <= MAX_SIDE):
         raise ValueError(f"the rectified size must be within 1..{MAX_SIDE} pixels a side, got {w}x{h}")
     target = [(0, 0), (w, 0), (w, h), (0, h)]
@@ -60,5 +66,7 @@ def rectify(image: Image.Image, corners, size: tuple[int, int] | None = None) ->
     coeffs = (inverse / inverse[2, 2]).flatten()[:8]
     if not all(math.isfinite(c) for c in coeffs):
         raise ValueError("corners do not define a usable homography")
-    return image.convert("RGB").transform((w, h), Image.Transform.PERSPECTIVE, tuple(coeffs),
+    if image.mode != "RGB":
+        image = image.convert("RGB")  # (an RGB image is used as it is: no full-size copy)
+    return image.transform((w, h), Image.Transform.PERSPECTIVE, tuple(coeffs),
                                           Image.Resampling.BICUBIC)

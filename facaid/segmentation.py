@@ -82,8 +82,12 @@ class Segmentation:
 def _number(value: Any, where: str) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise SegmentationError(f"{where} must be a number, got {type(value).__name__} {value!r}")
-    if not math.isfinite(value):
-        raise SegmentationError(f"{where} must be finite, got {value!r}")
+    try:
+        finite = math.isfinite(value)
+    except OverflowError:  # an integer too large for a float
+        finite = False
+    if not finite:
+        raise SegmentationError(f"{where} must be a finite number, got {str(value)[:40]}")
     return value
 
 

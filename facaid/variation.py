@@ -10,7 +10,7 @@ import random
 
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar.execute import expand, first_boxes, layout
-from facaid.grammar.procedure import MAX_COUNT, Node, Procedure, ProcedureError, Size, validate
+from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Node, Procedure, ProcedureError, Size, validate
 
 
 def _copy(proc: Procedure) -> Procedure:
@@ -56,8 +56,8 @@ def resize(proc: Procedure, width: float, height: float) -> Procedure:
     """The facade at a new size: fixed sizes keep their pixels, floating ones stretch, and every repeat
     lays out as many copies of its pattern as now fit beside its tail (rounded, at least one), as a ``"fill"``
     repeat counts them."""
-    if not (1 <= width <= 100_000 and 1 <= height <= 100_000):
-        raise ValueError(f"size must be between 1 and 100000 pixels, got {width}x{height}")
+    if not (1 <= width <= MAX_EXTENT and 1 <= height <= MAX_EXTENT):
+        raise ValueError(f"size must be between 1 and {MAX_EXTENT:g} pixels, got {width}x{height}")
     old = _regions(proc)
     units = {}  # a repeat's pattern length and its tail's, at the old size
     for _, node in proc.nodes():

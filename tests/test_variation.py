@@ -32,7 +32,7 @@ def test_resize_adapts_repeats():
     proc = generate_procedure(4, "modernist")
     wider = resize(proc, proc.width * 2, proc.height)
     assert windows(wider) > 1.6 * windows(proc)
-    with pytest.raises(ValueError, match="between 1 and 100000"):
+    with pytest.raises(ValueError, match="between 1 and 16384"):
         resize(proc, 0, 10)
 
 

@@ -39,6 +39,7 @@ INSTALLED_APPS = [
 
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
+    "webapp.middleware.RequestSizeLimitMiddleware",  # before anything reads the body
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     "django.middleware.common.CommonMiddleware",
@@ -46,6 +47,7 @@ MIDDLEWARE = [
     "django.contrib.auth.middleware.AuthenticationMiddleware",
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
+    "webapp.middleware.BusyDatabaseMiddleware",
 ]
 
 ROOT_URLCONF = "webapp.urls"
@@ -64,8 +66,12 @@ TEMPLATES = [{
 DATABASES = {"default": dj_database_url.parse(
     env_str("DATABASE_URL", f"sqlite:///{VAR_DIR / 'facaid.sqlite3'}"), conn_max_age=60)}
 if DATABASES["default"]["ENGINE"].endswith("sqlite3"):
-    # the worker and the site write the same file: wait for the lock instead of failing at once
-    DATABASES["default"]["OPTIONS"] = {"timeout": 20, "transaction_mode": "IMMEDIATE"}
+    # the worker and the site write the same file. Write-ahead logging lets reads go on while another process
+    # writes; writers wait for the lock (busy timeout) instead of failing at once, and a write that still finds
+    # it taken is a 503 (webapp.middleware.BusyDatabaseMiddleware)
+    DATABASES["default"]["OPTIONS"] = {
+        "timeout": env_int("FACAID_SQLITE_TIMEOUT", 20), "transaction_mode": "IMMEDIATE",
+        "init_command": "PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL;"}
     DATABASES["default"]["CONN_MAX_AGE"] = 0
     # tests use a file, so that a worker process can share the test database
     DATABASES["default"]["TEST"] = {"NAME": str(VAR_DIR / "test.sqlite3")}
@@ -97,6 +103,7 @@ MEDIA_ROOT = Path(env_str("MEDIA_ROOT", str(VAR_DIR / "media")))
 # uploads: the limits the site promises (checked in facades/uploads.py); Django's own caps sit above them
 FACAID_MAX_UPLOAD_BYTES = env_int("FACAID_MAX_UPLOAD_BYTES", 20 * 1024 * 1024)
 FACAID_MAX_PIXELS = env_int("FACAID_MAX_PIXELS", 40_000_000)
+FACAID_MAX_RECTIFIED_PIXELS = env_int("FACAID_MAX_RECTIFIED_PIXELS", 16_000_000)  # a rectified photo is shrunk to this
 DATA_UPLOAD_MAX_MEMORY_SIZE = 8 * 1024 * 1024  # JSON bodies (segmentations) up to 8 MB
 FILE_UPLOAD_MAX_MEMORY_SIZE = 2_621_440
 

@@ -1,4 +1,5 @@
-"""The Celery app: Redis broker from REDIS_URL, a ``gpu`` queue for model work, late acks, one job at a time.
+"""The Celery app: Redis broker from REDIS_URL, a ``gpu`` queue for model work, late acks, one job at a time,
+soft and hard time limits.
 
 Job state lives in the site's database, not in a result backend: a task takes a job id, claims the row with
 a conditional update and writes its results there. Messages are acknowledged after the task returns
@@ -17,6 +18,25 @@ from kombu import Queue
 GPU_QUEUE = "gpu"
 DEFAULT_QUEUE = "default"
 
+
+def _seconds(name: str, default: int) -> int | None:
+    """A time limit from the environment in whole seconds; 0 turns it off."""
+    raw = os.environ.get(name, "") or str(default)
+    try:
+        value = int(raw)
+    except ValueError:
+        raise ValueError(f"{name} must be a whole number of seconds, got {raw!r}") from None
+    if value < 0:
+        raise ValueError(f"{name} must be 0 (no limit) or more seconds, got {raw!r}")
+    return value or None
+
+
+# A job past the soft limit gets SoftTimeLimitExceeded and ends `failed` with a message; one stuck where that
+# cannot reach it (native code) is killed at the hard limit and failed by the worker's main process. Limits need
+# the prefork pool (`--pool prefork --concurrency 1`): the solo pool ignores them.
+JOB_SOFT_TIME_LIMIT = _seconds("FACAID_JOB_SOFT_TIME_LIMIT", 600)
+JOB_TIME_LIMIT = _seconds("FACAID_JOB_TIME_LIMIT", 660)
+
 app = Celery("facaid")
 app.conf.update(
     broker_url=os.environ.get("REDIS_URL", "redis://127.0.0.1:6379/0"),
@@ -27,6 +47,8 @@ app.conf.update(
     task_reject_on_worker_lost=True,
     task_acks_on_failure_or_timeout=True,
     worker_prefetch_multiplier=1,
+    task_soft_time_limit=JOB_SOFT_TIME_LIMIT,
+    task_time_limit=JOB_TIME_LIMIT,
     task_default_queue=DEFAULT_QUEUE,
     task_queues=(Queue(DEFAULT_QUEUE), Queue(GPU_QUEUE)),
     task_routes={"facaid.run_job": {"queue": GPU_QUEUE}},

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from facaid.labels import LABEL_ID, LABELS
+from facaid.segmentation import MAX_SIDE
 
 FORMAT = "facaid-procedure"
 FORMAT_VERSION = 1
@@ -58,7 +59,7 @@ MAX_NODES = 8192
 MAX_CHILDREN = 64
 MAX_COUNT = 256
 MAX_LEAVES = 100_000  # rectangles after repeats and mirrors are expanded
-MAX_EXTENT = 100_000.0  # pixels
+MAX_EXTENT = float(MAX_SIDE)  # pixels: a procedure executes to a segmentation, whose sides stop there too
 
 
 class ProcedureError(ValueError):
@@ -217,12 +218,20 @@ def _is_number(v: Any) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool)
 
 
+def _finite(v: int | float) -> bool:
+    """`math.isfinite`, where an integer too large for a float (JSON allows any) is not finite."""
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False
+
+
 def _check_size(path: str, i: int, mode: str, value: Any) -> None:
     if mode not in MODES:
         raise ProcedureError(path, f"sizes[{i}] has unknown mode {mode!r}; expected one of {', '.join(MODES)}")
     if not _is_number(value):
         raise ProcedureError(path, f"sizes[{i}] value must be a number, got {value!r}")
-    if not math.isfinite(value):
+    if not _finite(value):
         raise ProcedureError(path, f"sizes[{i}] value must be finite, got {value!r}")
     if value < 0:
         raise ProcedureError(path, f"sizes[{i}] is negative ({value!r})")
@@ -310,7 +319,7 @@ def parse_procedure(obj: Any) -> Procedure:
                              f"made for grammar {obj.get('grammar')!r}; this build runs {GRAMMAR_VERSION!r}")
     for key in ("width", "height"):
         v = obj.get(key)
-        if not _is_number(v) or not math.isfinite(v) or not 1 <= v <= MAX_EXTENT:
+        if not _is_number(v) or not _finite(v) or not 1 <= v <= MAX_EXTENT:
             raise ProcedureError("(document)", f"{key} must be a number from 1 to {MAX_EXTENT:g}, got {v!r}")
     meta = obj.get("meta", {})
     if not isinstance(meta, dict):

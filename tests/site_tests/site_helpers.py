@@ -84,21 +84,29 @@ class Redis:
             self.proc = None
 
 
+def database_url() -> str:
+    """The test database as a DATABASE_URL, for the processes a test starts (a worker)."""
+    from django.db import connection
+
+    d = connection.settings_dict
+    if d["ENGINE"].endswith("sqlite3"):
+        return f"sqlite:///{d['NAME']}"
+    return f"postgres://{d['USER']}:{d['PASSWORD']}@{d['HOST'] or 'localhost'}:{d['PORT'] or 5432}/{d['NAME']}"
+
+
 class Worker:
     def __init__(self, redis: Redis, log: Path):
         self.redis, self.log, self.proc = redis, log, None
 
-    def start(self) -> None:
-        from django.db import connection
-
-        db = connection.settings_dict["NAME"]
-        env = {**os.environ, "REDIS_URL": self.redis.url, "DATABASE_URL": f"sqlite:///{db}",
+    def start(self, **environ: str) -> None:
+        """Start a worker on the test database; ``environ`` overrides its settings (the job timings are short)."""
+        env = {**os.environ, "REDIS_URL": self.redis.url, "DATABASE_URL": database_url(),
                "FACAID_RECOVER_SECONDS": "1", "FACAID_JOB_STALE_SECONDS": "4", "FACAID_HEARTBEAT_SECONDS": "1",
-               "FACAID_JOB_RESEND_SECONDS": "2", "PYTHONUNBUFFERED": "1"}
+               "FACAID_JOB_RESEND_SECONDS": "2", "PYTHONUNBUFFERED": "1", **environ}
         with open(self.log, "ab") as out:  # the worker keeps its own copy of the descriptor
             self.proc = subprocess.Popen(
                 [sys.executable, "-m", "celery", "-A", "webapp.celery", "worker", "-Q", "gpu,default", "--pool",
-                 "solo", "--without-gossip", "--without-mingle", "-l", "info"],
+                 "prefork", "--concurrency", "1", "--without-gossip", "--without-mingle", "-l", "info"],
                 cwd=ROOT, env=env, stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
         deadline = time.time() + 120
         while time.time() < deadline:

@@ -1,5 +1,6 @@
-"""End to end with a real Redis server and real Celery worker processes: a job runs; a worker killed mid-job
-and a Redis restart lose no job."""
+"""End to end with a real Redis server and real Celery worker processes: a job runs; a worker killed mid-job,
+a Redis restart and a submission while Redis is down lose no job; a job past its time limit fails with a
+message."""
 
 from __future__ import annotations
 
@@ -102,3 +103,31 @@ def test_rerun_from_a_prefix_and_a_failure_is_recorded(alice, worker):
     doomed = wait_for(doomed, {"done", "failed"})
     assert doomed.status == "failed" and "DoesNotExist" in doomed.message
     check_done(wait_for(submit(alice), {"done", "failed"}), attempts=1)
+
+
+def test_a_job_submitted_while_redis_is_down_runs_soon_after_it_is_back(alice, redis, worker):
+    redis.stop()
+    started = time.time()
+    job = submit(alice)  # the publish fails; the job is still accepted
+    assert time.time() - started < 15
+    job.refresh_from_db()
+    assert job.status == "queued" and job.sent is None  # not recorded as sent: recovery sends it at once
+    redis.start()
+    worker.start(FACAID_JOB_RESEND_SECONDS="300", FACAID_RECOVER_SECONDS="30")  # the real delays
+    back = time.time()
+    check_done(wait_for(job, {"done", "failed"}, timeout=200), attempts=1)
+    assert time.time() - back < 150  # the worker's first recovery round, not the 300 s resend delay
+
+
+def test_a_job_past_its_soft_time_limit_fails_with_a_message(alice, worker):
+    worker.start(FACAID_JOB_SOFT_TIME_LIMIT="1", FACAID_JOB_TIME_LIMIT="120")
+    job = wait_for(submit(alice, k=32), {"done", "failed"})  # loading the model alone takes longer
+    assert job.status == "failed" and "took longer than 1 s and was stopped" in job.message, job.message
+    assert job.result is None
+
+
+def test_a_job_past_its_hard_time_limit_is_killed_and_fails(alice, worker):
+    worker.start(FACAID_JOB_SOFT_TIME_LIMIT="0", FACAID_JOB_TIME_LIMIT="2")
+    job = wait_for(submit(alice, k=32), {"done", "failed"})
+    assert job.status == "failed" and "hard time limit (2 s)" in job.message, job.message
+    assert worker.proc.poll() is None  # the worker lives on with a new process for the next job

@@ -47,6 +47,22 @@ def photo_visible_to(user, photo: Photo | None) -> bool:
                                   or photo.visibility in READABLE)
 
 
+def procedure_visible_to(user, proc: Procedure | None) -> bool:
+    """May ``user`` see this procedure (for example as the parent of a fork)?"""
+    return proc is not None and ((user.is_authenticated and proc.owner_id == user.id)
+                                 or proc.visibility in READABLE)
+
+
+def visible_lineage(user, proc: Procedure) -> list[Procedure]:
+    """The procedure's ancestors, nearest first, up to the first one ``user`` may not see."""
+    out = []
+    for ancestor in proc.lineage():
+        if not procedure_visible_to(user, ancestor):
+            break
+        out.append(ancestor)
+    return out
+
+
 def get_segmentation_for_user(user, code) -> Segmentation:
     qs = _readable(Segmentation.objects.select_related("photo"), user, "photo__owner", "photo__visibility")
     return _get(qs, code)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import zipfile
 
+from django.conf import settings
 from django.core.files.base import ContentFile
 from django.db import transaction
 from django.db.models import Max, OuterRef, Subquery
@@ -16,18 +17,19 @@ from rest_framework import status
 from rest_framework.decorators import api_view, parser_classes, permission_classes
 from rest_framework.exceptions import NotAuthenticated, ValidationError
 from rest_framework.pagination import LimitOffsetPagination
-from rest_framework.parsers import FormParser, JSONParser, MultiPartParser
+from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
 from facaid.cga import MAX_SCALE, checked_scale, procedure_cga
-from facaid.defaults import DEFAULT_K, MAX_K
+from facaid.defaults import DEFAULT_K
 from facaid.grammar import to_segmentation
 from facaid.mesh import MeshTooLarge, procedure_mesh
 from facaid.rectify import rectify
 from facaid.render import segmentation_svg
 from facaid.variation import vary
 from webapp.facades import access, jobs, rendering
+from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.serializers import (
     JobCreateSerializer,
@@ -38,6 +40,7 @@ from webapp.facades.serializers import (
     ProcedureSummarySerializer,
     ProcedureWriteSerializer,
     RectifySerializer,
+    RerunSerializer,
     SegmentationSerializer,
     VariationsSerializer,
     parse_procedure,
@@ -46,10 +49,14 @@ from webapp.facades.serializers import (
 from webapp.facades.uploads import UploadError, normalize_photo
 
 
+class Pagination(LimitOffsetPagination):
+    max_limit = 100  # ?limit= beyond this gives this many (an unbounded one reached the database as an overflow)
+
+
 def _page(request, queryset, serializer):
-    pager = LimitOffsetPagination()
+    pager = Pagination()
     page = pager.paginate_queryset(queryset, request)
-    return pager.get_paginated_response(serializer(page, many=True).data)
+    return pager.get_paginated_response(serializer(page, many=True, context={"request": request}).data)
 
 
 # --- photos ----------------------------------------------------------------------------------------------------
@@ -132,7 +139,7 @@ def photo_rectify(request, code):
                                               f"{photo.height} photo"})
     with photo.image.open("rb") as f:
         try:
-            out = rectify(Image.open(f), corners)
+            out = rectify(Image.open(f), corners, max_pixels=settings.FACAID_MAX_RECTIFIED_PIXELS)
         except ValueError as exc:
             raise ValidationError({"corners": str(exc)}) from None
     buf = io.BytesIO()
@@ -240,7 +247,7 @@ def procedure_list(request):
     if "data" not in form.validated_data:
         raise ValidationError({"data": "a procedure JSON is required"})
     proc = Procedure.objects.create(owner=request.user, **form.validated_data)
-    return Response(ProcedureSerializer(proc).data, status=status.HTTP_201_CREATED)
+    return Response(ProcedureSerializer(proc, context={"request": request}).data, status=status.HTTP_201_CREATED)
 
 
 @extend_schema(responses=ProcedureSummarySerializer(many=True), summary="Public procedures, newest first")
@@ -276,7 +283,8 @@ def _remeasure(proc: Procedure) -> None:
 @parser_classes([JSONParser])
 def procedure_detail(request, code):
     if request.method == "GET":
-        return Response(ProcedureSerializer(access.get_procedure_for_user(request.user, code)).data)
+        return Response(ProcedureSerializer(access.get_procedure_for_user(request.user, code),
+                                           context={"request": request}).data)
     proc = access.get_rw_procedure_for_user(request.user, code)
     if request.method == "DELETE":
         proc.delete()
@@ -288,7 +296,7 @@ def procedure_detail(request, code):
     if "data" in form.validated_data:
         _remeasure(proc)
     proc.save()
-    return Response(ProcedureSerializer(proc).data)
+    return Response(ProcedureSerializer(proc, context={"request": request}).data)
 
 
 def fork_procedure(user, proc: Procedure) -> Procedure:
@@ -306,7 +314,7 @@ def fork_procedure(user, proc: Procedure) -> Procedure:
 @permission_classes([IsAuthenticated])
 def procedure_fork(request, code):
     fork = fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
-    return Response(ProcedureSerializer(fork).data, status=status.HTTP_201_CREATED)
+    return Response(ProcedureSerializer(fork, context={"request": request}).data, status=status.HTTP_201_CREATED)
 
 
 @extend_schema(request=VariationsSerializer, responses={200: dict},
@@ -411,7 +419,7 @@ def _mesh_zip(tree, scale: float | None) -> bytes:
     return out.getvalue()
 
 
-@extend_schema(request={"application/json": dict}, responses={202: JobSerializer},
+@extend_schema(request=RerunSerializer, responses={202: JobSerializer},
                summary="Re-run inference keeping the procedure's first `nodes` nodes (BFS)")
 @api_view(["POST"])
 @permission_classes([IsAuthenticated])
@@ -420,12 +428,8 @@ def procedure_rerun(request, code):
     proc = access.get_rw_procedure_for_user(request.user, code)
     if proc.segmentation is None:
         raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
-    try:
-        nodes = int(request.data.get("nodes", 1))
-        k = int(request.data.get("k", DEFAULT_K))
-    except (TypeError, ValueError, AttributeError):
-        raise ValidationError({"nodes": "nodes and k must be integers"}) from None
-    if not (1 <= nodes <= 8192 and 1 <= k <= MAX_K):
-        raise ValidationError({"nodes": f"nodes must be within 1..8192 and k within 1..{MAX_K}"})
-    job = submit_job(request.user, proc.segmentation, k=k, seed=0, prefix=proc, prefix_nodes=nodes)
+    form = RerunSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    job = submit_job(request.user, proc.segmentation, k=form.validated_data["k"], seed=0, prefix=proc,
+                     prefix_nodes=form.validated_data["nodes"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)

@@ -30,10 +30,13 @@ def resend_after() -> timedelta:
 
 
 def send(job_id: int) -> None:
+    """Publish the job's task, then record when: a publish that fails (the broker is down) leaves ``sent`` as
+    it was, so recovery sends the job again at its next round instead of after the resend delay."""
     from webapp.facades.tasks import run_job
 
+    # no time limits in the message: the worker's own (FACAID_JOB_*TIME_LIMIT, worker/app.py) apply
+    run_job.apply_async(args=[job_id], time_limit=None, soft_time_limit=None)
     Job.objects.filter(id=job_id).update(sent=timezone.now())
-    run_job.apply_async(args=[job_id])
 
 
 def submit(**fields) -> Job:

@@ -1,16 +1,23 @@
-"""Pictures of procedures and segmentations for the site (PNG bytes)."""
+"""Pictures of procedures and segmentations for the site (PNG bytes), drawn at the size they are sent at.
+
+A request's cost is bounded by what is drawn, not by what a procedure declares: the rectangles are scaled to the
+picture (at most `MAX_RENDER_SIDE` a side) and painted there, so a 16,384 px facade costs what a 2,048 px one
+does. Photos are decoded at reduced size where the format allows (JPEG) and shrunk before they are converted.
+`bench/bench_render_memory.py` measures the peak memory of each picture request."""
 
 from __future__ import annotations
 
 import io
 
+import numpy as np
 from PIL import Image
 
-from facaid.render import overlay, render_segmentation
+from facaid.labels import PRIORITY
+from facaid.render import colorize
 from facaid.segmentation import Segmentation as SegmentationData
-from facaid.segmentation import rasterize
 
 MAX_RENDER_SIDE = 2048
+_PRIORITY = np.asarray(PRIORITY)
 
 
 def _png(image: Image.Image) -> bytes:
@@ -19,18 +26,52 @@ def _png(image: Image.Image) -> bytes:
     return out.getvalue()
 
 
-def _fit(image: Image.Image, max_side: int) -> Image.Image:
-    scale = max_side / max(image.size)
-    if scale >= 1:
-        return image
-    size = (max(1, round(image.width * scale)), max(1, round(image.height * scale)))
-    return image.resize(size, Image.Resampling.NEAREST)
+def fitted_size(width: int, height: int, max_side: int) -> tuple[int, int]:
+    """The size of a ``width`` x ``height`` picture shrunk (never enlarged) to at most ``max_side`` a side."""
+    scale = min(1.0, max_side / max(width, height))
+    return max(1, round(width * scale)), max(1, round(height * scale))
+
+
+def label_map(seg: SegmentationData, max_side: int = MAX_RENDER_SIDE) -> np.ndarray:
+    """The segmentation's (h, w) label map at most ``max_side`` a side, painted at that size: each output pixel
+    takes the label at its centre in the full-size map (what nearest-neighbour shrinking gives)."""
+    w, h = fitted_size(seg.width, seg.height, max_side)
+    out = np.zeros((h, w), dtype=np.uint8)
+    arr = seg.to_array()
+    if len(arr) == 0:
+        return out
+    arr = arr[np.argsort(_PRIORITY[arr[:, 0]], kind="stable")]  # the paint order
+    # output pixel i covers the source pixel at (i + 0.5) / scale: [x0, x1) covers i for ceil(x0 * s - 0.5) <= i
+    sx, sy = w / seg.width, h / seg.height
+    x0 = np.clip(np.ceil(arr[:, 1] * sx - 0.5), 0, w).astype(np.int64)
+    x1 = np.clip(np.ceil(arr[:, 3] * sx - 0.5), 0, w).astype(np.int64)
+    y0 = np.clip(np.ceil(arr[:, 2] * sy - 0.5), 0, h).astype(np.int64)
+    y1 = np.clip(np.ceil(arr[:, 4] * sy - 0.5), 0, h).astype(np.int64)
+    keep = (x0 < x1) & (y0 < y1)
+    for lab, a, b, c, d in zip(arr[keep, 0].tolist(), y0[keep].tolist(), y1[keep].tolist(), x0[keep].tolist(),
+                               x1[keep].tolist(), strict=True):
+        out[a:b, c:d] = lab
+    return out
 
 
 def label_map_png(seg: SegmentationData, max_side: int = MAX_RENDER_SIDE) -> bytes:
-    return _png(_fit(render_segmentation(seg), max_side))
+    return _png(colorize(label_map(seg, max_side)))
+
+
+def photo_at(photo: Image.Image, size: tuple[int, int]) -> Image.Image:
+    """An opened (not yet decoded) photo as RGB at ``size``: a JPEG decodes at the nearest larger DCT scale,
+    and the rest is shrunk in its own mode before the conversion, so no full-size RGB copy is made."""
+    photo.draft("RGB", size)  # JPEG only; a no-op for other formats
+    if photo.size != size:
+        photo = photo.resize(size, Image.Resampling.BILINEAR, reducing_gap=2.0)
+    return photo.convert("RGB")
 
 
 def overlay_png(seg: SegmentationData, photo: Image.Image, alpha: float = 0.5,
                 max_side: int = MAX_RENDER_SIDE) -> bytes:
-    return _png(_fit(overlay(photo, rasterize(seg), alpha), max_side))
+    """The label map over the photo (stretched to the segmentation's size), ``alpha`` opaque."""
+    if not 0.0 <= alpha <= 1.0:
+        raise ValueError(f"alpha must be between 0 and 1, got {alpha!r}")
+    labels = label_map(seg, max_side)
+    size = (labels.shape[1], labels.shape[0])
+    return _png(Image.blend(photo_at(photo, size), colorize(labels), alpha))

@@ -3,12 +3,16 @@ name the offending field or grammar node."""
 
 from __future__ import annotations
 
+import math
+
+from django.contrib.auth.models import AnonymousUser
 from rest_framework import serializers
 
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import Procedure as ProcedureTree
 from facaid.grammar.procedure import ProcedureError
 from facaid.segmentation import Segmentation as SegmentationData
+from webapp.facades import access
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 
 
@@ -74,9 +78,25 @@ class PhotoUploadSerializer(serializers.Serializer):
     visibility = serializers.ChoiceField(Visibility.choices, default=Visibility.PRIVATE)
 
 
+class FiniteFloatField(serializers.FloatField):
+    """A finite number: DRF's FloatField lets an integer too large for a float raise OverflowError (a 500) and
+    takes infinity."""
+
+    default_error_messages = {"invalid": "A finite number is required."}
+
+    def to_internal_value(self, data):
+        try:
+            value = super().to_internal_value(data)
+        except OverflowError:
+            self.fail("invalid")
+        if not math.isfinite(value):
+            self.fail("invalid")
+        return value
+
+
 class RectifySerializer(serializers.Serializer):
     corners = serializers.ListField(
-        child=serializers.ListField(child=serializers.FloatField(), min_length=2, max_length=2),
+        child=serializers.ListField(child=FiniteFloatField(), min_length=2, max_length=2),
         min_length=4, max_length=4, help_text="[[x, y] x 4]: top-left, top-right, bottom-right, bottom-left")
 
 
@@ -102,14 +122,22 @@ class ProcedureSerializer(serializers.ModelSerializer):
         read_only_fields = ["code", "owner", "accuracy", "metrics", "parent", "photo", "segmentation", "created",
                             "updated"]
 
+    # links to other objects are shown only to those who may see them (a fork of a procedure made private later
+    # does not reveal its parent; a public procedure does not reveal its private photo)
+    def _user(self):
+        request = self.context.get("request")
+        return request.user if request is not None else AnonymousUser()
+
     def get_parent(self, proc: Procedure) -> str | None:
-        return str(proc.parent.code) if proc.parent_id else None
+        visible = proc.parent_id and access.procedure_visible_to(self._user(), proc.parent)
+        return str(proc.parent.code) if visible else None
 
     def get_photo(self, proc: Procedure) -> str | None:
-        return str(proc.photo.code) if proc.photo_id else None
+        return str(proc.photo.code) if access.photo_visible_to(self._user(), proc.photo) else None
 
     def get_segmentation(self, proc: Procedure) -> str | None:
-        return str(proc.segmentation.code) if proc.segmentation_id else None
+        visible = proc.segmentation_id and access.photo_visible_to(self._user(), proc.photo)
+        return str(proc.segmentation.code) if visible else None
 
 
 class ProcedureSummarySerializer(ProcedureSerializer):
@@ -140,12 +168,27 @@ class JobSerializer(serializers.ModelSerializer):
         return str(job.result.code) if job.result_id else None
 
 
+def k_field() -> serializers.IntegerField:
+    return serializers.IntegerField(min_value=1, max_value=MAX_K, default=DEFAULT_K,
+                                    help_text="candidates decoded and compared")
+
+
+MAX_PREFIX_NODES = 8192  # facaid.grammar.procedure.MAX_NODES
+
+
 class JobCreateSerializer(serializers.Serializer):
     segmentation = serializers.UUIDField()
-    k = serializers.IntegerField(min_value=1, max_value=MAX_K, default=DEFAULT_K)
+    k = k_field()
     seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
     prefix_procedure = serializers.UUIDField(required=False, allow_null=True, default=None)
-    prefix_nodes = serializers.IntegerField(min_value=0, max_value=8192, default=0)
+    prefix_nodes = serializers.IntegerField(min_value=0, max_value=MAX_PREFIX_NODES, default=0)
+
+
+class RerunSerializer(serializers.Serializer):
+    """A re-run keeps the procedure's first ``nodes`` nodes (breadth first); the same integers as a job's."""
+
+    nodes = serializers.IntegerField(min_value=1, max_value=MAX_PREFIX_NODES, default=1)
+    k = k_field()
 
 
 class VariationsSerializer(serializers.Serializer):

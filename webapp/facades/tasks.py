@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import threading
 
+from celery.exceptions import SoftTimeLimitExceeded, TimeLimitExceeded
 from celery.signals import worker_ready
 from django.conf import settings
 from django.db import OperationalError, close_old_connections, transaction
@@ -39,7 +40,18 @@ class _Heartbeat(threading.Thread):
                 close_old_connections()
 
 
-@app.task(name="facaid.run_job", bind=True, max_retries=jobs.MAX_ATTEMPTS)
+class JobTask(app.Task):
+    def on_failure(self, exc, task_id, args, kwargs, einfo) -> None:
+        """The worker's main process calls this when it killed the task's process at the hard time limit."""
+        if isinstance(exc, TimeLimitExceeded) and args:
+            try:
+                jobs.fail(args[0], f"the job ran longer than the worker's hard time limit ({exc.args[0]:g} s) "
+                                   "and was stopped")
+            finally:
+                close_old_connections()
+
+
+@app.task(name="facaid.run_job", bind=True, base=JobTask, max_retries=jobs.MAX_ATTEMPTS)
 def run_job(self, job_id: int) -> None:
     if not jobs.claim(job_id):
         return  # done, failed, or another worker has it: a duplicate delivery
@@ -56,6 +68,10 @@ def run_job(self, job_id: int) -> None:
             jobs.fail(job_id, f"gave up after {self.request.retries + 1} tries: {exc}")
             return
         raise self.retry(exc=exc, countdown=2 ** self.request.retries) from exc
+    except SoftTimeLimitExceeded:
+        log.warning("job %s ran past the soft time limit", job_id)
+        jobs.fail(job_id, f"the job took longer than {self.soft_time_limit or app.conf.task_soft_time_limit:g} s "
+                          "and was stopped; try fewer candidates (k) or a smaller segmentation")
     except Exception as exc:
         log.exception("job %s failed", job_id)
         jobs.fail(job_id, f"{type(exc).__name__}: {exc}")

@@ -1,4 +1,4 @@
-"""Checking and normalizing uploaded photos: JPEG, PNG or WebP only, size and pixel limits, EXIF orientation
+"""Checking and normalizing uploaded photos: JPEG (MPO from phones: its first frame), PNG or WebP only, size and pixel limits, EXIF orientation
 applied, decompression bombs refused before anything is decoded."""
 
 from __future__ import annotations
@@ -11,6 +11,7 @@ from django.core.files.images import ImageFile
 from PIL import Image, ImageOps, UnidentifiedImageError
 
 FORMATS = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
+ALIASES = {"MPO": "JPEG"}  # a phone's JPEG with more frames (a second view, depth): the first is the photo
 
 
 class UploadError(ValueError):
@@ -33,7 +34,7 @@ def normalize_photo(upload) -> tuple[ImageFile, int, int]:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
             img = Image.open(io.BytesIO(raw))  # reads the header only
-            fmt = img.format
+            fmt = ALIASES.get(img.format, img.format)
             if fmt not in FORMATS:
                 raise UploadError(f"{fmt or 'this'} images are not accepted; upload a JPEG, PNG or WebP photo")
             w, h = img.size
@@ -51,7 +52,7 @@ def normalize_photo(upload) -> tuple[ImageFile, int, int]:
         raise UploadError("the file is not an image we can read; upload a JPEG, PNG or WebP photo") from None
     except (OSError, SyntaxError, ValueError) as exc:
         raise UploadError(f"the image is damaged or truncated ({exc})") from None
-    img = ImageOps.exif_transpose(img)  # upright, and the orientation tag dropped
+    ImageOps.exif_transpose(img, in_place=True)  # upright, and the orientation tag dropped; no copy
     if img.mode not in ("RGB", "RGBA", "L"):
         img = img.convert("RGBA" if "A" in img.getbands() else "RGB")
     if fmt == "JPEG" and img.mode == "RGBA":

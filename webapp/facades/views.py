@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
 from django.contrib import messages
 from django.contrib.auth.decorators import login_required
 from django.core.paginator import Paginator
@@ -11,7 +9,7 @@ from django.shortcuts import redirect, render
 from django.views.decorators.http import require_POST
 from rest_framework.exceptions import ValidationError
 
-from webapp.facades import access, api
+from webapp.facades import access, api, jsonbody
 from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
 from webapp.facades.models import Job, Photo, Procedure
 
@@ -85,10 +83,9 @@ def photo_segmentation(request, code):
     if form.is_valid():
         raw = form.cleaned_data["file"].read() if form.cleaned_data["file"] else form.cleaned_data["text"]
         try:
-            data = json.loads(raw)
-            seg = api.add_segmentation(photo, data)
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            messages.error(request, f"The segmentation is not valid JSON: {exc}")
+            seg = api.add_segmentation(photo, jsonbody.loads(raw))
+        except jsonbody.JSONError as exc:
+            messages.error(request, f"The segmentation could not be read: {exc}")
         except ValidationError as exc:
             messages.error(request, _error_text(exc))
         else:
@@ -128,8 +125,8 @@ def procedure(request, code):
     owner = request.user == proc.owner
     photo_visible = access.photo_visible_to(request.user, proc.photo)
     return render(request, "facades/procedure.html", {
-        "proc": proc, "owner": owner, "photo_visible": photo_visible, "lineage": proc.lineage(),
-        "data_json": proc.data, "rerun_form": RerunForm(),
+        "proc": proc, "owner": owner, "photo_visible": photo_visible,
+        "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
         "downloads": [(d, api.DOWNLOAD_HELP[d]) for d in api.DOWNLOADS
                       if photo_visible or d not in api.PHOTO_DOWNLOADS],

@@ -1,0 +1,182 @@
+"""Peak memory of each picture (and download) a request can ask for, with the largest inputs the site accepts.
+
+    .venv/bin/python bench/bench_render_memory.py [--repeat 3] [--case NAME ...]
+
+Each case runs in a fresh Python process on a scratch SQLite database: Django is set up, the objects the request
+needs are made (a procedure of the largest declared size, 16,384 px a side; 97,200 leaves; a 40-megapixel photo
+as JPEG and as PNG), the same request is made once at a small size to warm imports and caches, then the
+process's peak resident set is reset (Linux `/proc/self/clear_refs`) and the request is made through Django's
+test client. The figure is the peak resident memory above what the process held just before the request
+(VmHWM after − VmRSS before), the median of ``--repeat`` fresh processes. Target: ≤ 300 MB for every case.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+LIMIT_MB = 300
+
+CASES = {  # name: what the request is
+    "render-16384": "POST /api/v1/render, a 16,384 x 16,384 procedure (one wall leaf), anonymous",
+    "render-97200-leaves": "POST /api/v1/render, 16,384 px, 180 x 180 repeated tiles of 3 leaves (97,200 leaves)",
+    "render-declared-20000": "POST /api/v1/render, 20,000 x 20,000 declared (refused: 400)",
+    "labels.png-16384": "GET labels.png of a stored public 16,384 px procedure (a gallery card), anonymous",
+    "labels.svg-97200-leaves": "GET labels.svg of the 97,200-leaf procedure",
+    "segmentation.json-97200-leaves": "GET segmentation.json of the 97,200-leaf procedure",
+    "overlay.png-40MP-jpeg": "GET overlay.png over a 40-megapixel JPEG photo (8,000 x 5,000)",
+    "overlay.png-40MP-png": "GET overlay.png over a 40-megapixel PNG photo",
+    "rectify-40MP-png": "POST rectify of a 40-megapixel PNG photo (its four corners)",
+    "photo-image-40MP-png": "GET the 40-megapixel PNG photo's image file",
+    "upload-40MP-png": "POST a 40-megapixel PNG photo (the largest accepted)",
+}
+
+CHILD = r"""
+import io, json, os, sys, gc
+os.environ["DJANGO_SETTINGS_MODULE"] = "webapp.settings"
+import django
+django.setup()
+from django.core.management import call_command
+call_command("migrate", verbosity=0)
+from django.contrib.auth import get_user_model
+from django.core.files.images import ImageFile
+from django.core.files.uploadedfile import SimpleUploadedFile
+from PIL import Image
+from rest_framework.test import APIClient
+from webapp.facades.models import Photo, Procedure, Segmentation
+
+case = sys.argv[1]
+user = get_user_model().objects.create_user("bench", "b@example.com", "bench-password-1")
+owner = APIClient(); owner.force_login(user)
+anon = APIClient()
+
+def facade(side_w, side_h, windows=0):
+    wall = {"rule": "leaf", "label": "facade"}
+    if not windows:
+        return {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR, "width": side_w, "height": side_h,
+                "root": wall}
+    tile = {"rule": "split", "axis": "x", "sizes": [["flt", 1], ["flt", 2],
+            ["flt", 1]], "children": [wall, {"rule": "leaf", "label": "window"}, wall]}
+    row = {"rule": "repeat", "axis": "x", "count": windows, "sizes": [["flt", 1]],
+           "children": [tile]}
+    return {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR, "width": side_w, "height": side_h,
+            "root": {"rule": "repeat", "axis": "y", "count": windows, "sizes": [["flt", 1]],
+                     "children": [row]}}
+
+from facaid.grammar.procedure import GRAMMAR_VERSION as GRAMMAR
+
+def photo(fmt, w=8000, h=5000):
+    img = Image.new("RGB", (w, h), (150, 140, 130))
+    img.paste((90, 100, 120), (w // 4, h // 4, w // 2, h // 2))
+    buf = io.BytesIO(); img.save(buf, fmt, **({"quality": 90} if fmt == "JPEG" else {})); del img
+    p = Photo(owner=user, title="big", visibility="public")
+    p.image.save("photo." + ("jpg" if fmt == "JPEG" else "png"), ImageFile(io.BytesIO(buf.getvalue()), name="photo"),
+                 save=False)
+    p.save()
+    seg = Segmentation.objects.create(photo=p, version=1, data={"width": w, "height": h, "rects": []})
+    proc = Procedure.objects.create(owner=user, data=facade(w, h, 0), photo=p, segmentation=seg,
+                                    visibility="public")
+    return p, proc, buf.getvalue()
+
+def stored(data):
+    return Procedure.objects.create(owner=user, data=data, visibility="public")
+
+small = facade(100, 80, 0)
+if case == "render-16384":
+    warm = lambda: anon.post("/api/v1/render", small, format="json")
+    run = lambda: anon.post("/api/v1/render", facade(16384, 16384), format="json")
+elif case == "render-97200-leaves":
+    body = facade(16384, 16384, 180)
+    warm = lambda: anon.post("/api/v1/render", facade(100, 80, 2), format="json")
+    run = lambda: anon.post("/api/v1/render", body, format="json")
+elif case == "render-declared-20000":
+    warm = lambda: anon.post("/api/v1/render", small, format="json")
+    run = lambda: anon.post("/api/v1/render", facade(20000, 20000), format="json")
+elif case in ("labels.png-16384", "labels.svg-97200-leaves", "segmentation.json-97200-leaves"):
+    name = case.split("-")[0]
+    big = stored(facade(16384, 16384, 180 if "leaves" in case else 0))
+    little = stored(small)
+    warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/download/{name}")
+    run = lambda: anon.get(f"/api/v1/procedures/{big.code}/download/{name}")
+elif case.startswith("overlay.png"):
+    p, proc, _ = photo("JPEG" if case.endswith("jpeg") else "PNG")
+    sp, sproc, _ = photo("JPEG" if case.endswith("jpeg") else "PNG", 100, 80)
+    warm = lambda: anon.get(f"/api/v1/procedures/{sproc.code}/download/overlay.png")
+    run = lambda: anon.get(f"/api/v1/procedures/{proc.code}/download/overlay.png")
+elif case == "rectify-40MP-png":
+    p, _, _ = photo("PNG")
+    sp, _, _ = photo("PNG", 100, 80)
+    corners = [[100, 50], [7900, 0], [8000, 5000], [0, 4950]]
+    warm = lambda: owner.post(f"/api/v1/photos/{sp.code}/rectify", {"corners": [[1, 1], [99, 0], [100, 80], [0, 79]]},
+                              format="json")
+    run = lambda: owner.post(f"/api/v1/photos/{p.code}/rectify", {"corners": corners}, format="json")
+elif case == "photo-image-40MP-png":
+    p, _, _ = photo("PNG")
+    sp, _, _ = photo("PNG", 100, 80)
+    warm = lambda: b"".join(anon.get(f"/api/v1/photos/{sp.code}/image").streaming_content)
+    run = lambda: b"".join(anon.get(f"/api/v1/photos/{p.code}/image").streaming_content)
+elif case == "upload-40MP-png":
+    _, _, raw = photo("PNG")
+    _, _, little_raw = photo("PNG", 100, 80)
+    warm = lambda: owner.post("/api/v1/photos/", {"image": SimpleUploadedFile("s.png", little_raw)}, format="multipart")
+    run = lambda: owner.post("/api/v1/photos/", {"image": SimpleUploadedFile("b.png", raw)}, format="multipart")
+else:
+    raise SystemExit(f"unknown case {case}")
+
+def status():
+    out = {}
+    for line in open("/proc/self/status"):
+        key, _, value = line.partition(":")
+        if key in ("VmRSS", "VmHWM"):
+            out[key] = int(value.split()[0]) / 1024
+    return out
+
+r = warm()
+gc.collect()
+before = status()["VmRSS"]
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")  # reset the peak (VmHWM) to the current resident set
+r = run()
+code = getattr(r, "status_code", 200)
+peak = status()["VmHWM"]
+print(json.dumps({"case": case, "status": code, "peak_mb": peak - before}))
+"""
+
+
+def run_case(case: str) -> dict:
+    with tempfile.TemporaryDirectory(prefix="facaid-mem-") as tmp:
+        env = {**os.environ, "FACAID_VAR": tmp, "MEDIA_ROOT": str(Path(tmp) / "media"),
+               "DATABASE_URL": f"sqlite:///{Path(tmp) / 'db.sqlite3'}", "SECRET_KEY": "bench-" * 10,
+               "DEBUG": "0", "FACAID_HTTPS": "0"}
+        out = subprocess.run([sys.executable, "-c", CHILD, case], cwd=ROOT, env=env, capture_output=True,
+                             text=True)
+        if out.returncode != 0:
+            raise RuntimeError(f"{case} failed:\n{out.stderr[-3000:]}")
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--case", nargs="*", choices=sorted(CASES), help="only these cases")
+    args = ap.parse_args()
+    worst = 0.0
+    print(f"{'case':32s} {'status':>6s} {'peak MB (median)':>17s}  runs")
+    for case in args.case or CASES:
+        runs = [run_case(case) for _ in range(args.repeat)]
+        peaks = [r["peak_mb"] for r in runs]
+        worst = max(worst, statistics.median(peaks))
+        print(f"{case:32s} {runs[0]['status']:6d} {statistics.median(peaks):17.1f}  "
+              f"{', '.join(f'{p:.0f}' for p in peaks)}   {CASES[case]}")
+    print(f"worst median peak: {worst:.1f} MB (target ≤ {LIMIT_MB} MB): {'met' if worst <= LIMIT_MB else 'NOT met'}")
+
+
+if __name__ == "__main__":
+    main()

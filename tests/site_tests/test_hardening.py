@@ -1,0 +1,265 @@
+"""The site against hostile input: pictures cost what is drawn, not what is declared; deeply nested JSON, numbers
+too large for a float and unbounded pages are 400s naming the problem with nothing stored; oversized bodies are
+refused before they are read; a parent is shown only to those who may see it; CSRF and escaping hold."""
+
+from __future__ import annotations
+
+import io
+import json
+import socket
+
+import numpy as np
+import pytest
+from PIL import Image
+from site_helpers import image_bytes, upload
+
+from facaid.generator import generate
+from facaid.grammar.procedure import GRAMMAR_VERSION
+from facaid.segmentation import rasterize
+from webapp.facades.models import Job, Photo, Procedure, Segmentation
+from webapp.facades.rendering import label_map
+
+pytestmark = pytest.mark.django_db
+
+DEEP = "[" * 100_000 + "]" * 100_000
+DEEP_OBJECT = '{"a":' * 70 + "1" + "}" * 70  # parses, but deeper than the site reads
+HUGE = "1" + "0" * 400  # an integer too large for a float
+
+
+def wall(width, height) -> dict:
+    return {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR_VERSION, "width": width,
+            "height": height, "root": {"rule": "leaf", "label": "facade"}}
+
+
+def counts() -> tuple[int, ...]:
+    return tuple(m.objects.count() for m in (Photo, Segmentation, Procedure, Job))
+
+
+# --- pictures cost what is drawn ----------------------------------------------------------------------------------
+
+def test_label_map_at_scale_is_the_nearest_neighbour_shrink_of_the_full_map():
+    seg = generate(11).segmentation
+    full = rasterize(seg)
+    assert np.array_equal(label_map(seg, max(seg.width, seg.height)), full)  # at full size: the same map
+    small = label_map(seg, max(seg.width, seg.height) // 3)
+    h, w = small.shape
+    shrunk = np.asarray(Image.fromarray(full).resize((w, h), Image.Resampling.NEAREST))
+    assert (small == shrunk).mean() > 0.98  # PIL rounds a few pixel centres the other way
+
+
+def test_declared_sizes_are_capped_and_pictures_drawn_at_their_output_size(as_charlie, alice):
+    r = as_charlie.post("/api/v1/render", wall(20_000, 20_000), format="json")
+    assert r.status_code == 400 and "width must be a number from 1 to 16384" in json.dumps(r.json())
+    r = as_charlie.post("/api/v1/render", wall(16_384, 8_192), format="json")
+    assert r.status_code == 200 and Image.open(io.BytesIO(r.content)).size == (1024, 512)
+    proc = Procedure.objects.create(owner=alice, data=wall(16_384, 16_384), visibility="public")
+    r = as_charlie.get(f"/api/v1/procedures/{proc.code}/download/labels.png")
+    img = Image.open(io.BytesIO(r.content))
+    assert r.status_code == 200 and img.size == (2048, 2048) and img.getpixel((5, 5)) != (0, 0, 0)
+    r = as_charlie.post("/api/v1/procedures/", wall(20_000, 100), format="json")
+    assert r.status_code in (401, 403)  # anonymous cannot store; the owner's size cap is tested below
+
+
+def test_a_procedure_larger_than_the_cap_cannot_be_stored(as_alice):
+    before = counts()
+    r = as_alice.post("/api/v1/procedures/", {"data": wall(16_385, 100)}, format="json")
+    assert r.status_code == 400 and "16384" in json.dumps(r.json())
+    assert counts() == before
+
+
+def test_a_rectified_photo_is_at_most_the_rectified_pixel_limit(as_alice, settings):
+    settings.FACAID_MAX_RECTIFIED_PIXELS = 1000
+    photo = upload(as_alice, image_bytes(size=(200, 100))).json()
+    r = as_alice.post(f"/api/v1/photos/{photo['code']}/rectify",
+                      {"corners": [[0, 0], [200, 0], [200, 100], [0, 100]]}, format="json")
+    assert r.status_code == 200, r.content
+    img = Image.open(io.BytesIO(as_alice.get(r.json()["rectified"]).getvalue()))
+    assert img.width * img.height <= 1000 and abs(img.width / img.height - 2) < 0.1
+
+
+# --- no 500 from input ----------------------------------------------------------------------------------------------
+
+def test_deeply_nested_json_is_a_400_everywhere_and_stores_nothing(facade_photo, as_alice, alice):
+    photo, seg = facade_photo
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(),
+                                    segmentation=Segmentation.objects.get(code=seg["code"]))
+    posts = ["/api/v1/render", f"/api/v1/photos/{photo['code']}/segmentations/", "/api/v1/jobs/",
+             "/api/v1/procedures/", f"/api/v1/procedures/{proc.code}/rerun",
+             f"/api/v1/procedures/{proc.code}/variations", f"/api/v1/photos/{photo['code']}/rectify"]
+    before = counts()
+    for body in (DEEP, DEEP_OBJECT):
+        for url in posts:
+            r = as_alice.post(url, body, content_type="application/json")
+            assert r.status_code == 400 and "levels deep" in r.json()["detail"], (url, r.content[:200])
+        r = as_alice.patch(f"/api/v1/procedures/{proc.code}/", body, content_type="application/json")
+        assert r.status_code == 400 and "levels deep" in r.json()["detail"]
+        r = as_alice.post(f"/photos/{photo['code']}/segmentation", {"text": body}, follow=True)
+        assert r.status_code == 200 and "levels deep" in r.content.decode()
+    assert counts() == before
+    assert Procedure.objects.get(id=proc.id).data == generate(3).procedure.to_dict()
+
+
+def test_numbers_too_large_for_a_float_are_a_400(facade_photo, as_alice, alice):
+    photo, seg = facade_photo
+    before = counts()
+    data = json.loads(json.dumps(seg["data"]))
+    data["rects"][0]["x1"] = int(HUGE)
+    r = as_alice.post(f"/api/v1/photos/{photo['code']}/segmentations/", json.dumps(data),
+                      content_type="application/json")
+    assert r.status_code == 400 and "rects[0].x1 must be a finite number" in json.dumps(r.json()), r.content
+    tree = generate(3).procedure.to_dict()
+    for key in ("width", "height"):
+        r = as_alice.post("/api/v1/procedures/", json.dumps({"data": {**tree, key: int(HUGE)}}),
+                          content_type="application/json")
+        assert r.status_code == 400 and key in json.dumps(r.json())
+    tree["root"]["sizes"][0][1] = int(HUGE)
+    r = as_alice.post("/api/v1/render", json.dumps(tree), content_type="application/json")
+    assert r.status_code == 400 and "must be finite" in json.dumps(r.json())
+    for x in (HUGE, "1e999"):  # the second is infinity once parsed
+        r = as_alice.post(f"/api/v1/photos/{photo['code']}/rectify",
+                          f'{{"corners": [[{x}, 0], [10, 0], [10, 10], [0, 10]]}}', content_type="application/json")
+        assert r.status_code == 400 and "corners" in r.json(), r.content
+    assert counts() == before
+
+
+@pytest.mark.parametrize("query", ["limit=99999999999999999999", "limit=100000", "offset=99999999999999999999",
+                                   "limit=-5", "limit=abc&offset=-1"])
+def test_pages_are_bounded(as_charlie, alice, query):
+    for i in range(3):
+        Procedure.objects.create(owner=alice, title=f"p{i}", data=wall(100, 100), visibility="public")
+    r = as_charlie.get(f"/api/v1/gallery/?{query}")
+    assert r.status_code == 200, r.content
+    assert r.json()["count"] == 3 and len(r.json()["results"]) <= 100
+
+
+def test_many_public_procedures_are_served_at_most_100_a_page(as_charlie, alice):
+    Procedure.objects.bulk_create([Procedure(owner=alice, title=f"p{i}", data=wall(10, 10), visibility="public")
+                                   for i in range(120)])
+    assert len(as_charlie.get("/api/v1/gallery/?limit=99999999999999999999").json()["results"]) == 100
+
+
+@pytest.mark.parametrize("body", [{"nodes": 1.9}, {"nodes": True}, {"nodes": 0}, {"nodes": 9000}, {"nodes": "x"},
+                                  {"nodes": int(HUGE)}, {"k": 1.5}, {"k": 99}, {"k": False}])
+def test_rerun_takes_the_same_integers_as_a_job(facade_photo, as_alice, alice, body):
+    _, seg = facade_photo
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(),
+                                    segmentation=Segmentation.objects.get(code=seg["code"]))
+    before = counts()
+    r = as_alice.post(f"/api/v1/procedures/{proc.code}/rerun", json.dumps(body), content_type="application/json")
+    assert r.status_code == 400 and set(r.json()) == set(body), r.content
+    assert counts() == before
+    r = as_alice.post(f"/api/v1/procedures/{proc.code}/rerun", {"nodes": 3, "k": 2}, format="json")
+    assert r.status_code == 202 and r.json()["params"]["prefix_nodes"] == 3
+
+
+# --- uploads --------------------------------------------------------------------------------------------------------
+
+def test_a_photo_from_a_phone_in_mpo_is_taken_as_its_first_frame(as_alice):
+    first, second = Image.new("RGB", (64, 48), (200, 10, 10)), Image.new("RGB", (64, 48), (10, 200, 10))
+    out = io.BytesIO()
+    first.save(out, "MPO", save_all=True, append_images=[second])
+    assert Image.open(io.BytesIO(out.getvalue())).format == "MPO"
+    r = upload(as_alice, out.getvalue(), name="IMG_0001.jpg")
+    assert r.status_code == 201, r.content
+    stored = Image.open(io.BytesIO(as_alice.get(r.json()["image"]).getvalue()))
+    assert stored.format == "JPEG" and stored.size == (64, 48)
+    red, green, _ = stored.getpixel((30, 20))
+    assert red > 150 and green < 60
+
+
+def test_an_oversized_body_is_refused_before_it_is_read(live_server, alice):
+    """A 200 MB upload: the answer (413) comes after the headers and 1 MB, and the server reads no further."""
+    host, port = live_server.url.removeprefix("http://").split(":")
+    with socket.create_connection((host, int(port)), timeout=30) as s:
+        s.sendall(b"POST /api/v1/photos/ HTTP/1.1\r\nHost: localhost\r\nContent-Type: multipart/form-data; "
+                  b"boundary=x\r\nContent-Length: 209715200\r\n\r\n" + b"x" * (1 << 20))
+        s.settimeout(10)
+        answer = b""
+        while b"accepted" not in answer:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            answer += chunk
+        answer = answer.decode("latin-1")
+    assert answer.startswith("HTTP/1.1 413"), answer[:200]
+    assert "at most 21 MB are accepted" in answer
+    assert Photo.objects.count() == 0
+
+
+def test_a_declared_length_over_the_limit_is_413_on_every_path(as_alice):
+    for url in ("/api/v1/photos/", "/photos/new", "/api/v1/render"):
+        r = as_alice.generic("POST", url, b"{}", content_type="application/json", CONTENT_LENGTH=str(300 << 20))
+        assert r.status_code == 413 and b"MB are accepted" in r.content, url
+    r = as_alice.generic("POST", "/api/v1/render", b"{}", content_type="application/json", CONTENT_LENGTH="lots")
+    assert r.status_code == 400
+
+
+# --- lineage --------------------------------------------------------------------------------------------------------
+
+def test_a_parent_made_private_is_hidden_from_its_forks(alice, bob, as_alice, as_bob):
+    original = Procedure.objects.create(owner=alice, title="Rivoli 12", data=wall(100, 100), visibility="public")
+    fork = as_bob.post(f"/api/v1/procedures/{original.code}/fork").json()
+    assert fork["parent"] == str(original.code)
+    page = as_bob.get(f"/procedures/{fork['code']}").content.decode()
+    assert "Rivoli 12" in page and str(original.code) in page
+    as_alice.patch(f"/api/v1/procedures/{original.code}/", {"visibility": "private", "title": "Secret plan"},
+                   format="json")
+    page = as_bob.get(f"/procedures/{fork['code']}").content.decode()
+    assert "Secret plan" not in page and str(original.code) not in page and "forked from" not in page
+    assert as_bob.get(f"/api/v1/procedures/{fork['code']}/").json()["parent"] is None
+    assert as_bob.get("/api/v1/procedures/").json()["results"][0]["parent"] is None
+    # the fork's own copy is untouched, and alice still sees her own procedure's lineage where she may
+    assert as_bob.get(f"/api/v1/procedures/{fork['code']}/").json()["title"] == "Fork of Rivoli 12"
+
+
+def test_a_public_procedure_does_not_name_its_private_photo(facade_photo, alice, as_charlie, as_alice):
+    photo, seg = facade_photo
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="public",
+                                    photo=Photo.objects.get(code=photo["code"]),
+                                    segmentation=Segmentation.objects.get(code=seg["code"]))
+    body = as_charlie.get(f"/api/v1/procedures/{proc.code}/").json()
+    assert body["photo"] is None and body["segmentation"] is None
+    body = as_alice.get(f"/api/v1/procedures/{proc.code}/").json()
+    assert body["photo"] == photo["code"] and body["segmentation"] == seg["code"]
+
+
+# --- CSRF and escaping ----------------------------------------------------------------------------------------------
+
+def test_csrf_is_enforced_on_pages_and_the_api(alice, facade_photo):
+    from rest_framework.test import APIClient
+
+    photo, _ = facade_photo
+    client = APIClient(enforce_csrf_checks=True)
+    client.force_login(alice)
+    before = counts()
+    r = client.post("/api/v1/procedures/", {"data": wall(10, 10)}, format="json")
+    assert r.status_code == 403 and "CSRF" in r.json()["detail"]
+    r = client.post(f"/photos/{photo['code']}/visibility", {"visibility": "public"})
+    assert r.status_code == 403
+    assert Photo.objects.get(code=photo["code"]).visibility == "private" and counts() == before
+    # with the token from a page, the same requests pass
+    client.get("/")
+    token = client.cookies["csrftoken"].value
+    r = client.post("/api/v1/procedures/", {"data": wall(10, 10)}, format="json", HTTP_X_CSRFTOKEN=token)
+    assert r.status_code == 201
+
+
+def test_titles_are_escaped_on_every_page(alice, as_alice, as_charlie):
+    evil = '<script>alert("x")</script><img src=x onerror=alert(1)>'
+    proc = Procedure.objects.create(owner=alice, title=evil, data=wall(100, 100), visibility="public")
+    photo = upload(as_alice, image_bytes(), title=evil, visibility="public").json()
+    fork = as_alice.post(f"/api/v1/procedures/{proc.code}/fork").json()
+    for client, url in ((as_charlie, "/"), (as_charlie, f"/procedures/{proc.code}"), (as_alice, "/"),
+                        (as_charlie, f"/photos/{photo['code']}"), (as_alice, f"/procedures/{fork['code']}")):
+        page = client.get(url).content.decode()
+        assert "<script>alert" not in page and "<img src=x" not in page, url
+        assert "&lt;script&gt;alert" in page, url
+
+
+def test_json_bodies_parse_as_before(as_alice, facade_photo):
+    """The bounded parser is DRF's: strict (no NaN), and a plain document passes."""
+    photo, seg = facade_photo
+    r = as_alice.post(f"/api/v1/photos/{photo['code']}/segmentations/", seg["data"], format="json")
+    assert r.status_code == 201
+    r = as_alice.post("/api/v1/render", '{"width": NaN}', content_type="application/json")
+    assert r.status_code == 400 and "NaN" in r.json()["detail"]

@@ -1,0 +1,66 @@
+"""Site-wide guards that answer before a view runs or when the database cannot: a request body larger than any
+the site accepts is refused from its Content-Length (413) before a byte of it is read, and a database that is
+locked or unreachable is a 503 that says so instead of a 500."""
+
+from __future__ import annotations
+
+import logging
+
+from django.conf import settings
+from django.db import OperationalError
+from django.http import HttpResponse, JsonResponse
+
+log = logging.getLogger(__name__)
+
+MULTIPART_SLACK = 1024 * 1024  # form fields and multipart boundaries around an upload of the largest size
+
+
+def max_request_bytes() -> int:
+    return max(settings.FACAID_MAX_UPLOAD_BYTES, settings.DATA_UPLOAD_MAX_MEMORY_SIZE) + MULTIPART_SLACK
+
+
+def _answer(request, status: int, message: str, **headers: str) -> HttpResponse:
+    if request.path.startswith("/api/"):
+        response = JsonResponse({"detail": message}, status=status)
+    else:
+        response = HttpResponse(f"{message}\n", status=status, content_type="text/plain; charset=utf-8")
+    for name, value in headers.items():
+        response[name] = value
+    return response
+
+
+class RequestSizeLimitMiddleware:
+    """413 for a declared body over the largest the site accepts (a photo upload, or a JSON body). Django reads
+    no more than Content-Length, so a body without one is read as empty."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+
+    def __call__(self, request):
+        try:
+            length = int(request.META.get("CONTENT_LENGTH") or 0)
+        except ValueError:
+            return _answer(request, 400, "Content-Length must be a whole number of bytes")
+        limit = max_request_bytes()
+        if length > limit:
+            return _answer(request, 413, f"the request is {length / 2**20:.1f} MB; at most "
+                                         f"{limit / 2**20:.0f} MB are accepted (photos up to "
+                                         f"{settings.FACAID_MAX_UPLOAD_BYTES / 2**20:.0f} MB)")
+        return self.get_response(request)
+
+
+class BusyDatabaseMiddleware:
+    """503 with Retry-After when the database is locked past its timeout or unreachable."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+
+    def __call__(self, request):
+        return self.get_response(request)
+
+    def process_exception(self, request, exception):
+        if not isinstance(exception, OperationalError):
+            return None
+        log.warning("database unavailable for %s %s: %s", request.method, request.path, exception)
+        return _answer(request, 503, "the database is busy or unavailable; try again in a few seconds",
+                       **{"Retry-After": "5"})
