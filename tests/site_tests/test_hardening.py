@@ -263,3 +263,36 @@ def test_json_bodies_parse_as_before(as_alice, facade_photo):
     assert r.status_code == 201
     r = as_alice.post("/api/v1/render", '{"width": NaN}', content_type="application/json")
     assert r.status_code == 400 and "NaN" in r.json()["detail"]
+
+
+# --- the database under a write lock ------------------------------------------------------------------------------
+
+SQLITE = "sqlite3" in __import__("django.conf").conf.settings.DATABASES["default"]["ENGINE"]
+
+
+@pytest.mark.skipif(not SQLITE, reason="SQLite's locking")
+@pytest.mark.django_db(transaction=True)
+def test_reads_go_on_while_another_process_holds_the_write_lock(alice, as_alice, as_charlie):
+    import sqlite3
+
+    from django.db import connection
+
+    Procedure.objects.create(owner=alice, title="Rivoli", data=wall(100, 100), visibility="public")
+    options = connection.settings_dict["OPTIONS"]
+    holder = sqlite3.connect(connection.settings_dict["NAME"], timeout=1, isolation_level=None)
+    connection.close()
+    options["timeout"] = 1  # a writer waits this long for the lock, then is told to come back
+    holder.execute("BEGIN EXCLUSIVE")  # another process writing: without write-ahead logging, readers wait too
+    holder.execute("UPDATE facades_procedure SET title = 'being written'")
+    try:
+        r = as_charlie.get("/api/v1/gallery/")
+        assert r.status_code == 200 and r.json()["results"][0]["title"] == "Rivoli"  # the last committed state
+        assert as_charlie.get("/").status_code == 200
+        r = as_alice.post("/api/v1/procedures/", {"data": wall(10, 10)}, format="json")
+        assert r.status_code == 503 and r["Retry-After"] == "5" and "busy" in r.json()["detail"]
+    finally:
+        holder.execute("ROLLBACK")
+        holder.close()
+        connection.close()
+        options["timeout"] = 20
+    assert as_alice.post("/api/v1/procedures/", {"data": wall(10, 10)}, format="json").status_code == 201
