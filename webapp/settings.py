@@ -3,26 +3,53 @@ DATABASE_URL (SQLite in var/ by default), REDIS_URL (a local Redis by default), 
 
 from __future__ import annotations
 
+from datetime import timedelta
 from pathlib import Path
 
 import dj_database_url
+from django.core.exceptions import ImproperlyConfigured
 
-from webapp.env import env_bool, env_int, env_list, env_str
+from webapp.env import env_bool, env_int, env_list, env_rate, env_str
 
 BASE_DIR = Path(__file__).resolve().parent.parent
 VAR_DIR = Path(env_str("FACAID_VAR", str(BASE_DIR / "var")))
 VAR_DIR.mkdir(parents=True, exist_ok=True)
 
 DEBUG = env_bool("DEBUG", False)
+DEVELOPMENT_SECRET_KEY = "facaid-local-development-key-not-for-production"
 SECRET_KEY = env_str("SECRET_KEY", "")
-if not SECRET_KEY:
-    if not DEBUG and env_bool("FACAID_REQUIRE_SECRET", False):
-        from django.core.exceptions import ImproperlyConfigured
-
-        raise ImproperlyConfigured("SECRET_KEY must be set in production (FACAID_REQUIRE_SECRET=1)")
-    SECRET_KEY = "facaid-local-development-key-not-for-production"
+if not DEBUG and SECRET_KEY in ("", DEVELOPMENT_SECRET_KEY):
+    raise ImproperlyConfigured(
+        "SECRET_KEY is not set: with DEBUG off the site needs a secret key of its own. Set SECRET_KEY to a long "
+        "random string (e.g. export SECRET_KEY=\"$(python3 -c 'import secrets; print(secrets.token_urlsafe(50))')\"; "
+        "bash scripts/run keeps one in var/secret_key), or set DEBUG=1 for local development only.")
+SECRET_KEY = SECRET_KEY or DEVELOPMENT_SECRET_KEY
 ALLOWED_HOSTS = env_list("ALLOWED_HOSTS", ["127.0.0.1", "localhost", "testserver"])
 CSRF_TRUSTED_ORIGINS = env_list("CSRF_TRUSTED_ORIGINS", [])
+
+# HTTPS. With DEBUG off the site is https-only by default: secure cookies, a redirect of http to https, HSTS.
+# FACAID_HTTPS=0 serves plain http (scripts/run on 127.0.0.1); DEBUG=1 does too. Behind a TLS-terminating proxy,
+# FACAID_PROXY_SSL_HEADER names the header the proxy sets to "https" (e.g. X-Forwarded-Proto); only set it when
+# the proxy overwrites that header on every request, as a client could send it otherwise.
+HTTPS = not DEBUG and env_bool("FACAID_HTTPS", True)
+SESSION_COOKIE_SECURE = HTTPS
+CSRF_COOKIE_SECURE = HTTPS
+CSRF_COOKIE_HTTPONLY = True  # the pages read the token from <meta name="csrf-token">, never from the cookie
+SECURE_SSL_REDIRECT = HTTPS
+SECURE_HSTS_SECONDS = env_int("FACAID_HSTS_SECONDS", 365 * 24 * 3600) if HTTPS else 0
+SECURE_HSTS_INCLUDE_SUBDOMAINS = env_bool("FACAID_HSTS_INCLUDE_SUBDOMAINS", True)
+SECURE_HSTS_PRELOAD = env_bool("FACAID_HSTS_PRELOAD", True)
+_proxy_ssl_header = env_str("FACAID_PROXY_SSL_HEADER", "").strip()
+if _proxy_ssl_header:
+    SECURE_PROXY_SSL_HEADER = ("HTTP_" + _proxy_ssl_header.upper().replace("-", "_"), "https")
+SECURE_CONTENT_TYPE_NOSNIFF = True
+SECURE_REFERRER_POLICY = "same-origin"
+SECURE_CROSS_ORIGIN_OPENER_POLICY = "same-origin"
+X_FRAME_OPTIONS = "DENY"
+# proxies in front of the site that append the client's address to X-Forwarded-For: the address that the login
+# lockouts and the API's anonymous throttle count is the one the outermost of them saw (0: REMOTE_ADDR, and a
+# client's own X-Forwarded-For is ignored)
+FACAID_PROXY_COUNT = env_int("FACAID_PROXY_COUNT", 0)
 
 INSTALLED_APPS = [
     "django.contrib.admin",
@@ -32,7 +59,9 @@ INSTALLED_APPS = [
     "django.contrib.messages",
     "django.contrib.staticfiles",
     "rest_framework",
+    "rest_framework.authtoken",
     "drf_spectacular",
+    "axes",
     "webapp.accounts",
     "webapp.facades",
 ]
@@ -47,6 +76,7 @@ MIDDLEWARE = [
     "django.contrib.auth.middleware.AuthenticationMiddleware",
     "django.contrib.messages.middleware.MessageMiddleware",
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
+    "axes.middleware.AxesMiddleware",  # turns a login lockout into the 429 page
     "webapp.middleware.BusyDatabaseMiddleware",
 ]
 
@@ -84,6 +114,19 @@ AUTH_PASSWORD_VALIDATORS = [
     {"NAME": "django.contrib.auth.password_validation.NumericPasswordValidator"},
 ]
 LOGIN_URL = "login"
+AUTHENTICATION_BACKENDS = [
+    "axes.backends.AxesStandaloneBackend",  # first: refuses a locked-out username or address before the password
+    "django.contrib.auth.backends.ModelBackend",
+]
+# Login lockouts (django-axes, counted in the database): FACAID_LOGIN_FAILURE_LIMIT failed logins for one
+# username, from any addresses, or from one address, for any usernames, lock that username or that address out
+# for FACAID_LOGIN_COOLOFF_MINUTES after the last attempt (an attempt during a lockout starts the wait again),
+# with a 429 page. It covers the login page, the admin's login and anything else that calls authenticate().
+AXES_FAILURE_LIMIT = env_int("FACAID_LOGIN_FAILURE_LIMIT", 10)
+AXES_COOLOFF_TIME = timedelta(minutes=env_int("FACAID_LOGIN_COOLOFF_MINUTES", 15))
+AXES_LOCKOUT_PARAMETERS = ["username", "ip_address"]
+AXES_LOCKOUT_CALLABLE = "webapp.accounts.views.lockout"
+AXES_CLIENT_IP_CALLABLE = "webapp.accounts.views.client_ip"
 LOGIN_REDIRECT_URL = "home"
 LOGOUT_REDIRECT_URL = "home"
 
@@ -108,14 +151,25 @@ DATA_UPLOAD_MAX_MEMORY_SIZE = 8 * 1024 * 1024  # JSON bodies (segmentations) up 
 FILE_UPLOAD_MAX_MEMORY_SIZE = 2_621_440
 
 REDIS_URL = env_str("REDIS_URL", "redis://127.0.0.1:6379/0")
+# The API's throttle counts live in each process's memory: no request depends on Redis being up, and a limit
+# holds per gunicorn worker (scripts/run's 2 workers let a client up to twice the rate through)
+CACHES = {"default": {"BACKEND": "django.core.cache.backends.locmem.LocMemCache", "LOCATION": "facaid"}}
 FACAID_CHECKPOINT = env_str("FACAID_CHECKPOINT", str(BASE_DIR / "checkpoints" / "facaid-small"))
 
 REST_FRAMEWORK = {
     "DEFAULT_AUTHENTICATION_CLASSES": [
+        # a token first: its "Token" challenge makes a missing or wrong token a 401 (Basic is gone: a password
+        # per request can't be throttled like the login page is)
+        "rest_framework.authentication.TokenAuthentication",
         "rest_framework.authentication.SessionAuthentication",
-        "rest_framework.authentication.BasicAuthentication",
     ],
     "DEFAULT_PERMISSION_CLASSES": ["rest_framework.permissions.IsAuthenticatedOrReadOnly"],
+    # per client address (anonymous) and per account; counted in the default cache (see CACHES)
+    "DEFAULT_THROTTLE_CLASSES": ["rest_framework.throttling.AnonRateThrottle",
+                                 "rest_framework.throttling.UserRateThrottle"],
+    "DEFAULT_THROTTLE_RATES": {"anon": env_rate("FACAID_API_ANON_RATE", "300/min"),
+                               "user": env_rate("FACAID_API_USER_RATE", "1200/min")},
+    "NUM_PROXIES": FACAID_PROXY_COUNT,
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
     "DEFAULT_PAGINATION_CLASS": "rest_framework.pagination.LimitOffsetPagination",
     "PAGE_SIZE": 24,

@@ -26,6 +26,7 @@ def test_compose_services_healthchecks_volumes_and_gpu():
     for name, service in services.items():
         assert service["healthcheck"]["test"], name
     assert "--appendonly" in services["redis"]["command"]
+    assert "'X-Forwarded-Proto': 'https'" in services["web"]["healthcheck"]["test"][-1]  # passes https-only too
     assert "gunicorn webapp.wsgi" in services["web"]["command"]
     assert services["worker"]["command"][:3] == ["celery", "-A", "webapp.celery"]
     assert "gpu" in services["worker"]["command"][services["worker"]["command"].index("-Q") + 1].split(",")
@@ -35,6 +36,12 @@ def test_compose_services_healthchecks_volumes_and_gpu():
         env = services[name]["environment"]
         assert env["DATABASE_URL"].startswith("postgres://") and "@postgres:5432/" in env["DATABASE_URL"]
         assert env["REDIS_URL"] == "redis://redis:6379/0"
+        # the settings refuse to start without a key when DEBUG is off; compose refuses before that
+        assert env["SECRET_KEY"].startswith("${SECRET_KEY:?") and "DEBUG" not in env
+        assert "FACAID_REQUIRE_SECRET" not in env  # gone: a key is always required in production
+        # plain http on port 8000 unless the operator puts a TLS proxy in front (docs/site.md, Security)
+        assert env["FACAID_HTTPS"] == "${FACAID_HTTPS:-0}"
+        assert {"FACAID_PROXY_SSL_HEADER", "FACAID_PROXY_COUNT"} <= set(env)
         for dep in ("postgres", "redis"):
             assert services[name]["depends_on"][dep]["condition"] == "service_healthy"
     used = {v.split(":")[0] for s in services.values() for v in s.get("volumes", [])}
