@@ -87,7 +87,7 @@ def _number(value: Any, where: str) -> float:
     except OverflowError:  # an integer too large for a float
         finite = False
     if not finite:
-        raise SegmentationError(f"{where} must be a finite number, got {str(value)[:40]}")
+        raise SegmentationError(f"{where} must be finite, got {str(value)[:40]}")
     return value
 
 

@@ -1,5 +1,5 @@
-"""Checking and normalizing uploaded photos: JPEG (MPO from phones: its first frame), PNG or WebP only, size and pixel limits, EXIF orientation
-applied, decompression bombs refused before anything is decoded."""
+"""Checking and normalizing uploaded photos: JPEG (MPO from phones: its first frame), PNG or WebP only, size and
+pixel limits, EXIF orientation applied, decompression bombs refused before anything is decoded."""
 
 from __future__ import annotations
 
