@@ -102,7 +102,8 @@ if DATABASES["default"]["ENGINE"].endswith("sqlite3"):
     DATABASES["default"]["OPTIONS"] = {
         "timeout": env_int("FACAID_SQLITE_TIMEOUT", 20), "transaction_mode": "IMMEDIATE",
         "init_command": "PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL;"}
-    DATABASES["default"]["CONN_MAX_AGE"] = 0
+    # connections are kept for a minute, as with PostgreSQL (opening one per request, with its pragmas, cost the
+    # site a fifth of its throughput under load: bench/bench_site.py)
     # tests use a file, so that a worker process can share the test database
     DATABASES["default"]["TEST"] = {"NAME": str(VAR_DIR / "test.sqlite3")}
 DEFAULT_AUTO_FIELD = "django.db.models.BigAutoField"
@@ -170,6 +171,9 @@ REST_FRAMEWORK = {
     "DEFAULT_THROTTLE_RATES": {"anon": env_rate("FACAID_API_ANON_RATE", "300/min"),
                                "user": env_rate("FACAID_API_USER_RATE", "1200/min")},
     "NUM_PROXIES": FACAID_PROXY_COUNT,
+    # JSON with bounded nesting (a RecursionError would be a 500), then forms and uploads
+    "DEFAULT_PARSER_CLASSES": ["webapp.facades.jsonbody.JSONParser", "rest_framework.parsers.FormParser",
+                               "rest_framework.parsers.MultiPartParser"],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
     "DEFAULT_PAGINATION_CLASS": "rest_framework.pagination.LimitOffsetPagination",
     "PAGE_SIZE": 24,

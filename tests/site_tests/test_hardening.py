@@ -296,3 +296,26 @@ def test_reads_go_on_while_another_process_holds_the_write_lock(alice, as_alice,
         connection.close()
         options["timeout"] = 20
     assert as_alice.post("/api/v1/procedures/", {"data": wall(10, 10)}, format="json").status_code == 201
+
+
+def test_the_gallery_is_the_publics_view_and_follows_every_change(alice, as_alice, as_charlie):
+    parent = Procedure.objects.create(owner=alice, title="draft", data=wall(100, 100))  # private
+    child = Procedure.objects.create(owner=alice, title="final", data=wall(100, 100), parent=parent,
+                                     visibility="public")
+    for client in (as_alice, as_charlie):  # the same listing for everyone: no private parent named
+        assert client.get("/api/v1/gallery/").json()["results"][0]["parent"] is None
+    assert as_alice.get(f"/api/v1/procedures/{child.code}/").json()["parent"] == str(parent.code)
+    as_alice.patch(f"/api/v1/procedures/{child.code}/", {"title": "final, renamed"}, format="json")
+    assert as_charlie.get("/api/v1/gallery/").json()["results"][0]["title"] == "final, renamed"
+    parent.visibility = "public"
+    parent.save()
+    listed = {p["title"]: p["parent"] for p in as_charlie.get("/api/v1/gallery/").json()["results"]}
+    assert listed == {"draft": None, "final, renamed": str(parent.code)}
+    Procedure.objects.filter(id=parent.id).delete()
+    assert [p["title"] for p in as_charlie.get("/api/v1/gallery/").json()["results"]] == ["final, renamed"]
+
+
+def test_deep_json_on_the_default_parser_is_a_400(facade_photo, as_alice):
+    photo, _ = facade_photo
+    r = as_alice.patch(f"/api/v1/photos/{photo['code']}/", DEEP, content_type="application/json")
+    assert r.status_code == 400 and "levels deep" in r.json()["detail"]

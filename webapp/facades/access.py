@@ -10,6 +10,9 @@ from django.http import Http404
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 
 READABLE = (Visibility.PUBLIC, Visibility.UNLISTED)  # by link; only public ones are listed
+# large JSON columns that lists and job statuses never show: not read at all (they were most of a gallery page's time)
+LISTED_WITHOUT = ("data", "metrics", "parent__data", "parent__metrics")
+JOB_WITHOUT = ("segmentation__data", "result__data", "result__metrics")
 
 
 def _readable(qs: QuerySet, user, owner_field: str = "owner", visibility_field: str = "visibility") -> QuerySet:
@@ -80,8 +83,12 @@ def get_rw_procedure_for_user(user, code) -> Procedure:
 def get_job_for_user(user, code) -> Job:
     if not user.is_authenticated:
         raise Http404("no such job")
-    return _get(Job.objects.filter(owner=user).select_related("result", "segmentation__photo"), code)
+    return _get(Job.objects.filter(owner=user).select_related("result", "segmentation__photo").defer(
+        *JOB_WITHOUT), code)
+
+
 
 
 def public_procedures() -> QuerySet:
-    return Procedure.objects.filter(visibility=Visibility.PUBLIC).select_related("owner", "parent")
+    return Procedure.objects.filter(visibility=Visibility.PUBLIC).select_related("owner", "parent").defer(
+        *LISTED_WITHOUT)

@@ -3,18 +3,20 @@
 
 from __future__ import annotations
 
+import hashlib
 import io
 import zipfile
 
 from django.conf import settings
+from django.core.cache import cache
 from django.core.files.base import ContentFile
 from django.db import transaction
-from django.db.models import Max, OuterRef, Subquery
+from django.db.models import Count, Max, OuterRef, Q, Subquery
 from django.http import FileResponse, Http404, HttpResponse
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from PIL import Image
 from rest_framework import status
-from rest_framework.decorators import api_view, parser_classes, permission_classes
+from rest_framework.decorators import api_view, authentication_classes, parser_classes, permission_classes
 from rest_framework.exceptions import NotAuthenticated, ValidationError
 from rest_framework.pagination import LimitOffsetPagination
 from rest_framework.parsers import FormParser, MultiPartParser
@@ -47,6 +49,8 @@ from webapp.facades.serializers import (
     parse_segmentation,
 )
 from webapp.facades.uploads import UploadError, normalize_photo
+
+GALLERY_CACHE_SECONDS = 300  # how long an unchanged gallery page stays in a process's memory
 
 
 class Pagination(LimitOffsetPagination):
@@ -209,8 +213,8 @@ def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Pr
 @parser_classes([JSONParser])
 def job_list(request):
     if request.method == "GET":
-        return _page(request, Job.objects.filter(owner=request.user).select_related("segmentation", "result"),
-                     JobSerializer)
+        return _page(request, Job.objects.filter(owner=request.user).select_related("segmentation", "result").defer(
+            *access.JOB_WITHOUT), JobSerializer)
     form = JobCreateSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     v = form.validated_data
@@ -240,8 +244,8 @@ def job_detail(request, code):
 @parser_classes([JSONParser])
 def procedure_list(request):
     if request.method == "GET":
-        return _page(request, Procedure.objects.filter(owner=request.user).select_related("owner", "parent"),
-                     ProcedureSummarySerializer)
+        return _page(request, Procedure.objects.filter(owner=request.user).select_related("owner", "parent").defer(
+            *access.LISTED_WITHOUT), ProcedureSummarySerializer)
     form = ProcedureWriteSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     if "data" not in form.validated_data:
@@ -250,11 +254,23 @@ def procedure_list(request):
     return Response(ProcedureSerializer(proc, context={"request": request}).data, status=status.HTTP_201_CREATED)
 
 
-@extend_schema(responses=ProcedureSummarySerializer(many=True), summary="Public procedures, newest first")
+@extend_schema(responses=ProcedureSummarySerializer(many=True), auth=[],
+               summary="Public procedures, newest first (the same for everyone)")
 @api_view(["GET"])
+@authentication_classes([])  # the listing is the public's: no session or token is read
 @permission_classes([AllowAny])
 def gallery(request):
-    return _page(request, access.public_procedures(), ProcedureSummarySerializer)
+    """Served from each process's memory while no procedure has changed: the key holds the time of the latest
+    change and the counts, one aggregate query, so a procedure made private leaves the listing at once."""
+    changed = Procedure.objects.aggregate(at=Max("updated"), n=Count("id"),
+                                          public=Count("id", filter=Q(visibility=Visibility.PUBLIC)))
+    key = "gallery:" + hashlib.sha256(f"{changed['at']} {changed['n']} {changed['public']} {request.get_host()} "
+                                      f"{request.get_full_path()}".encode()).hexdigest()
+    page = cache.get(key)
+    if page is None:
+        page = _page(request, access.public_procedures(), ProcedureSummarySerializer).data
+        cache.set(key, page, GALLERY_CACHE_SECONDS)
+    return Response(page)
 
 
 def _remeasure(proc: Procedure) -> None:
