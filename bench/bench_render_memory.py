@@ -28,7 +28,11 @@ CASES = {  # name: what the request is
     "render-16384": "POST /api/v1/render, a 16,384 x 16,384 procedure (one wall leaf), anonymous",
     "render-97200-leaves": "POST /api/v1/render, 16,384 px, 180 x 180 repeated tiles of 3 leaves (97,200 leaves)",
     "render-declared-20000": "POST /api/v1/render, 20,000 x 20,000 declared (refused: 400)",
-    "labels.png-16384": "GET labels.png of a stored public 16,384 px procedure (a gallery card), anonymous",
+    "labels.png-16384": "GET labels.png of a stored public 16,384 px procedure, anonymous",
+    "thumbnail-16384": "GET the thumbnail of a stored public 16,384 px procedure (a gallery card), anonymous",
+    "labels.png-unrendered-16384": "GET labels.png of a 16,384 px procedure whose pictures were not kept yet",
+    "save-16384": "POST /api/v1/procedures/ a 16,384 px procedure (its pictures are rendered as it is saved)",
+    "save-97200-leaves": "POST /api/v1/procedures/ the 97,200-leaf procedure (pictures rendered as it is saved)",
     "labels.svg-97200-leaves": "GET labels.svg of the 97,200-leaf procedure",
     "segmentation.json-97200-leaves": "GET segmentation.json of the 97,200-leaf procedure",
     "overlay.png-40MP-jpeg": "GET overlay.png over a 40-megapixel JPEG photo (8,000 x 5,000)",
@@ -105,6 +109,21 @@ elif case in ("labels.png-16384", "labels.svg-97200-leaves", "segmentation.json-
     little = stored(small)
     warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/download/{name}")
     run = lambda: anon.get(f"/api/v1/procedures/{big.code}/download/{name}")
+elif case == "thumbnail-16384":
+    big, little = stored(facade(16384, 16384, 0)), stored(small)
+    warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/thumbnail.png")
+    run = lambda: anon.get(f"/api/v1/procedures/{big.code}/thumbnail.png")
+elif case == "labels.png-unrendered-16384":
+    big, little = stored(facade(16384, 16384, 0)), stored(small)
+    from django.core.files.storage import default_storage
+    for name in default_storage.listdir(f"pictures/{big.code}")[1]:
+        default_storage.delete(f"pictures/{big.code}/{name}")
+    warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/download/labels.png")
+    run = lambda: anon.get(f"/api/v1/procedures/{big.code}/download/labels.png")
+elif case.startswith("save-"):
+    body = {"data": facade(16384, 16384, 180 if "leaves" in case else 0)}
+    warm = lambda: owner.post("/api/v1/procedures/", {"data": facade(100, 80, 2)}, format="json")
+    run = lambda: owner.post("/api/v1/procedures/", body, format="json")
 elif case.startswith("overlay.png"):
     p, proc, _ = photo("JPEG" if case.endswith("jpeg") else "PNG")
     sp, sproc, _ = photo("JPEG" if case.endswith("jpeg") else "PNG", 100, 80)
@@ -120,8 +139,8 @@ elif case == "rectify-40MP-png":
 elif case == "photo-image-40MP-png":
     p, _, _ = photo("PNG")
     sp, _, _ = photo("PNG", 100, 80)
-    warm = lambda: b"".join(anon.get(f"/api/v1/photos/{sp.code}/image").streaming_content)
-    run = lambda: b"".join(anon.get(f"/api/v1/photos/{p.code}/image").streaming_content)
+    warm = lambda: anon.get(f"/api/v1/photos/{sp.code}/image")
+    run = lambda: anon.get(f"/api/v1/photos/{p.code}/image")
 elif case == "upload-40MP-png":
     _, _, raw = photo("PNG")
     _, _, little_raw = photo("PNG", 100, 80)
@@ -144,6 +163,8 @@ before = status()["VmRSS"]
 with open("/proc/self/clear_refs", "w") as f:
     f.write("5")  # reset the peak (VmHWM) to the current resident set
 r = run()
+if getattr(r, "streaming", False):
+    b"".join(r.streaming_content)  # a file response is read as a client would
 code = getattr(r, "status_code", 200)
 peak = status()["VmHWM"]
 print(json.dumps({"case": case, "status": code, "peak_mb": peak - before}))

@@ -15,8 +15,12 @@ log = logging.getLogger(__name__)
 MULTIPART_SLACK = 1024 * 1024  # form fields and multipart boundaries around an upload of the largest size
 
 
-def max_request_bytes() -> int:
-    return max(settings.FACAID_MAX_UPLOAD_BYTES, settings.DATA_UPLOAD_MAX_MEMORY_SIZE) + MULTIPART_SLACK
+def max_request_bytes(content_type: str) -> tuple[int, str]:
+    """The largest body of this content type the site reads, and what it is."""
+    if content_type.startswith("multipart/form-data"):
+        return (settings.FACAID_MAX_UPLOAD_BYTES + MULTIPART_SLACK,
+                f"uploads (photos up to {settings.FACAID_MAX_UPLOAD_BYTES / 2**20:.0f} MB)")
+    return settings.DATA_UPLOAD_MAX_MEMORY_SIZE, "JSON and form bodies"
 
 
 def _answer(request, status: int, message: str, **headers: str) -> HttpResponse:
@@ -30,8 +34,8 @@ def _answer(request, status: int, message: str, **headers: str) -> HttpResponse:
 
 
 class RequestSizeLimitMiddleware:
-    """413 for a declared body over the largest the site accepts (a photo upload, or a JSON body). Django reads
-    no more than Content-Length, so a body without one is read as empty."""
+    """413 for a declared body over the largest the site accepts of its kind (a photo upload, or a JSON or form
+    body). Django reads no more than Content-Length, so a body without one is read as empty."""
 
     def __init__(self, get_response):
         self.get_response = get_response
@@ -41,11 +45,10 @@ class RequestSizeLimitMiddleware:
             length = int(request.META.get("CONTENT_LENGTH") or 0)
         except ValueError:
             return _answer(request, 400, "Content-Length must be a whole number of bytes")
-        limit = max_request_bytes()
+        limit, what = max_request_bytes(request.META.get("CONTENT_TYPE", ""))
         if length > limit:
             return _answer(request, 413, f"the request is {length / 2**20:.1f} MB; at most "
-                                         f"{limit / 2**20:.0f} MB are accepted (photos up to "
-                                         f"{settings.FACAID_MAX_UPLOAD_BYTES / 2**20:.0f} MB)")
+                                         f"{limit / 2**20:.0f} MB are accepted for {what}")
         return self.get_response(request)
 
 

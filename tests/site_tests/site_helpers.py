@@ -100,7 +100,10 @@ class Worker:
 
     def start(self, **environ: str) -> None:
         """Start a worker on the test database; ``environ`` overrides its settings (the job timings are short)."""
+        from django.conf import settings
+
         env = {**os.environ, "REDIS_URL": self.redis.url, "DATABASE_URL": database_url(),
+               "MEDIA_ROOT": str(settings.MEDIA_ROOT),  # the test's: the worker keeps the pictures it renders there
                "FACAID_RECOVER_SECONDS": "1", "FACAID_JOB_STALE_SECONDS": "4", "FACAID_HEARTBEAT_SECONDS": "1",
                "FACAID_JOB_RESEND_SECONDS": "2", "PYTHONUNBUFFERED": "1", **environ}
         with open(self.log, "ab") as out:  # the worker keeps its own copy of the descriptor

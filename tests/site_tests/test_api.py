@@ -112,7 +112,7 @@ def test_downloads_render_and_variations(facade_photo, as_alice, alice):
     seg = json.loads(as_alice.get(base + "segmentation.json").content)
     assert seg == sample.segmentation.to_dict() or (seg["width"], seg["height"]) == (photo["width"], photo["height"])
     for name in ("labels.png", "overlay.png"):
-        img = Image.open(io.BytesIO(as_alice.get(base + name).content))
+        img = Image.open(io.BytesIO(as_alice.get(base + name).getvalue()))
         assert img.size == (photo["width"], photo["height"])
     r = as_alice.get(base + "labels.svg")
     assert r["Content-Type"] == "image/svg+xml" and r["Content-Disposition"].endswith('-labels.svg"')

@@ -54,7 +54,7 @@ def test_declared_sizes_are_capped_and_pictures_drawn_at_their_output_size(as_ch
     assert r.status_code == 200 and Image.open(io.BytesIO(r.content)).size == (1024, 512)
     proc = Procedure.objects.create(owner=alice, data=wall(16_384, 16_384), visibility="public")
     r = as_charlie.get(f"/api/v1/procedures/{proc.code}/download/labels.png")
-    img = Image.open(io.BytesIO(r.content))
+    img = Image.open(io.BytesIO(r.getvalue()))
     assert r.status_code == 200 and img.size == (2048, 2048) and img.getpixel((5, 5)) != (0, 0, 0)
     r = as_charlie.post("/api/v1/procedures/", wall(20_000, 100), format="json")
     assert r.status_code in (401, 403)  # anonymous cannot store; the owner's size cap is tested below
@@ -188,8 +188,13 @@ def test_an_oversized_body_is_refused_before_it_is_read(live_server, alice):
 
 def test_a_declared_length_over_the_limit_is_413_on_every_path(as_alice):
     for url in ("/api/v1/photos/", "/photos/new", "/api/v1/render"):
-        r = as_alice.generic("POST", url, b"{}", content_type="application/json", CONTENT_LENGTH=str(300 << 20))
-        assert r.status_code == 413 and b"MB are accepted" in r.content, url
+        r = as_alice.generic("POST", url, b"{}", content_type="multipart/form-data; boundary=x",
+                             CONTENT_LENGTH=str(300 << 20))
+        assert r.status_code == 413 and b"at most 21 MB are accepted for uploads" in r.content, url
+    body = '{"a": "' + "x" * (9 << 20) + '"}'  # over the 8 MB of a JSON body, far under an upload's
+    for client, url in ((as_alice, "/api/v1/procedures/"), (as_alice, "/api/v1/render")):
+        r = client.post(url, body, content_type="application/json")
+        assert r.status_code == 413 and "at most 8 MB are accepted for JSON" in r.json()["detail"], url
     r = as_alice.generic("POST", "/api/v1/render", b"{}", content_type="application/json", CONTENT_LENGTH="lots")
     assert r.status_code == 400
 

@@ -89,6 +89,10 @@ def get_job_for_user(user, code) -> Job:
 
 
 
+def listed(procedures: QuerySet) -> QuerySet:
+    """Procedures as lists show them: with their owner and parent, without the JSON columns."""
+    return procedures.select_related("owner", "parent").defer(*LISTED_WITHOUT)
+
+
 def public_procedures() -> QuerySet:
-    return Procedure.objects.filter(visibility=Visibility.PUBLIC).select_related("owner", "parent").defer(
-        *LISTED_WITHOUT)
+    return listed(Procedure.objects.filter(visibility=Visibility.PUBLIC))

@@ -10,6 +10,7 @@ import zipfile
 from django.conf import settings
 from django.core.cache import cache
 from django.core.files.base import ContentFile
+from django.core.files.storage import default_storage
 from django.db import transaction
 from django.db.models import Count, Max, OuterRef, Q, Subquery
 from django.http import FileResponse, Http404, HttpResponse
@@ -30,7 +31,7 @@ from facaid.mesh import MeshTooLarge, procedure_mesh
 from facaid.rectify import rectify
 from facaid.render import segmentation_svg
 from facaid.variation import vary
-from webapp.facades import access, jobs, rendering
+from webapp.facades import access, jobs, pictures, rendering
 from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.serializers import (
@@ -244,8 +245,7 @@ def job_detail(request, code):
 @parser_classes([JSONParser])
 def procedure_list(request):
     if request.method == "GET":
-        return _page(request, Procedure.objects.filter(owner=request.user).select_related("owner", "parent").defer(
-            *access.LISTED_WITHOUT), ProcedureSummarySerializer)
+        return _page(request, access.listed(Procedure.objects.filter(owner=request.user)), ProcedureSummarySerializer)
     form = ProcedureWriteSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     if "data" not in form.validated_data:
@@ -385,6 +385,10 @@ def procedure_download(request, code, name):
     if name not in DOWNLOADS:
         raise Http404(f"no download named {name!r}; there are {', '.join(DOWNLOADS)}")
     stem = f"facaid-{str(proc.code)[:8]}"
+    if name == "labels.png":  # kept in storage: served as a file
+        resp = _picture(request, proc, "labels.png")
+        resp["Content-Disposition"] = f'attachment; filename="{stem}-{name}"'
+        return resp
     tree = parse_procedure(proc.data)
     if name == "procedure.json":
         resp = HttpResponse(tree.to_json(indent=2), content_type="application/json")
@@ -407,8 +411,6 @@ def procedure_download(request, code, name):
         seg = to_segmentation(tree)
         if name == "segmentation.json":
             resp = HttpResponse(seg.to_json(), content_type="application/json")
-        elif name == "labels.png":
-            resp = HttpResponse(rendering.label_map_png(seg), content_type="image/png")
         elif name == "labels.svg":
             resp = HttpResponse(segmentation_svg(seg), content_type="image/svg+xml")
         else:
@@ -424,6 +426,28 @@ def procedure_download(request, code, name):
                 resp = HttpResponse(rendering.overlay_png(seg, Image.open(f), alpha), content_type="image/png")
     resp["Content-Disposition"] = f'attachment; filename="{stem}-{name}"'
     return resp
+
+
+def _picture(request, proc: Procedure, kind: str) -> HttpResponse:
+    """A stored picture of the procedure, with its digest as the ETag (a 304 when the client has it); shared
+    caches may keep a public procedure's a minute."""
+    name, tag = pictures.stored(proc, kind)
+    etag = f'"{tag}"'
+    if etag in request.headers.get("If-None-Match", ""):
+        resp = HttpResponse(status=304)
+    else:
+        resp = FileResponse(default_storage.open(name, "rb"), content_type="image/png")
+    resp["ETag"] = etag
+    resp["Cache-Control"] = "public, max-age=60" if proc.visibility == Visibility.PUBLIC else "private, no-cache"
+    return resp
+
+
+@extend_schema(responses={(200, "image/png"): bytes, 304: None},
+               summary="The procedure's thumbnail (its label map, at most 320 px a side), as the gallery shows it")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def procedure_thumbnail(request, code):
+    return _picture(request, access.get_procedure_for_user(request.user, code), "thumbnail.png")
 
 
 def _mesh_zip(tree, scale: float | None) -> bytes:

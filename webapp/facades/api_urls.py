@@ -17,6 +17,7 @@ urlpatterns = [
     path("procedures/<str:code>/variations", api.procedure_variations, name="api-procedure-variations"),
     path("procedures/<str:code>/rerun", api.procedure_rerun, name="api-procedure-rerun"),
     path("procedures/<str:code>/download/<str:name>", api.procedure_download, name="api-procedure-download"),
+    path("procedures/<str:code>/thumbnail.png", api.procedure_thumbnail, name="api-procedure-thumbnail"),
     path("gallery/", api.gallery, name="api-gallery"),
     path("render", api.render_preview, name="api-render"),
 ]

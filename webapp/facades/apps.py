@@ -5,3 +5,8 @@ class FacadesConfig(AppConfig):
     name = "webapp.facades"
     label = "facades"
     default_auto_field = "django.db.models.BigAutoField"
+
+    def ready(self) -> None:
+        from webapp.facades import pictures
+
+        pictures.connect()

@@ -35,7 +35,7 @@ def home(request):
     context = {"gallery": gallery}
     if request.user.is_authenticated:
         context.update(photos=Photo.objects.filter(owner=request.user)[:12],
-                       procedures=Procedure.objects.filter(owner=request.user)[:12],
+                       procedures=access.listed(Procedure.objects.filter(owner=request.user))[:12],
                        jobs=Job.objects.filter(owner=request.user).select_related("result")[:8])
     return render(request, "facades/home.html", context)
 
@@ -60,8 +60,8 @@ def photo(request, code):
     owner = request.user == photo.owner
     segmentation = photo.latest_segmentation()
     context = {"photo": photo, "owner": owner, "segmentation": segmentation,
-               "procedures": photo.procedures.filter(owner=photo.owner) if owner else
-               photo.procedures.filter(visibility="public"),
+               "procedures": access.listed(photo.procedures.filter(owner=photo.owner) if owner else
+                                           photo.procedures.filter(visibility="public")),
                "jobs": Job.objects.filter(segmentation__photo=photo).select_related("result")[:10] if owner
                else Job.objects.none(),
                "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
