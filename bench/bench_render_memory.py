@@ -38,8 +38,13 @@ CASES = {  # name: what the request is
     "overlay.png-40MP-jpeg": "GET overlay.png over a 40-megapixel JPEG photo (8,000 x 5,000)",
     "overlay.png-40MP-png": "GET overlay.png over a 40-megapixel PNG photo",
     "rectify-40MP-png": "POST rectify of a 40-megapixel PNG photo (its four corners)",
+    "rectify-40MP-rgba-png": "POST rectify of a 40-megapixel PNG photo with an alpha channel",
     "photo-image-40MP-png": "GET the 40-megapixel PNG photo's image file",
     "upload-40MP-png": "POST a 40-megapixel PNG photo (the largest accepted)",
+    "upload-40MP-jpeg-rotated": "POST a 40-megapixel JPEG photo whose EXIF says it is turned (upright on upload)",
+    "json-4MB-of-objects": "POST /api/v1/render, 4 MB of [{},{},...] (the most objects a body can hold), anonymous",
+    "segmentation-list-100": "GET a photo's 100 segmentation versions of 20,000 rectangles each (a page)",
+    "remeasure-40MP": "PATCH the data of a procedure made from a 40 MP segmentation (2,000 windows), re-measured",
 }
 
 CHILD = r"""
@@ -76,10 +81,10 @@ def facade(side_w, side_h, windows=0):
 
 from facaid.grammar.procedure import GRAMMAR_VERSION as GRAMMAR
 
-def photo(fmt, w=8000, h=5000):
-    img = Image.new("RGB", (w, h), (150, 140, 130))
-    img.paste((90, 100, 120), (w // 4, h // 4, w // 2, h // 2))
-    buf = io.BytesIO(); img.save(buf, fmt, **({"quality": 90} if fmt == "JPEG" else {})); del img
+def photo(fmt, w=8000, h=5000, mode="RGB", **save):
+    img = Image.new(mode, (w, h), (150, 140, 130, 255)[:len(mode)])
+    img.paste((90, 100, 120, 200)[:len(mode)], (w // 4, h // 4, w // 2, h // 2))
+    buf = io.BytesIO(); img.save(buf, fmt, **({"quality": 90} if fmt == "JPEG" else {}), **save); del img
     p = Photo(owner=user, title="big", visibility="public")
     p.image.save("photo." + ("jpg" if fmt == "JPEG" else "png"), ImageFile(io.BytesIO(buf.getvalue()), name="photo"),
                  save=False)
@@ -129,8 +134,8 @@ elif case.startswith("overlay.png"):
     sp, sproc, _ = photo("JPEG" if case.endswith("jpeg") else "PNG", 100, 80)
     warm = lambda: anon.get(f"/api/v1/procedures/{sproc.code}/download/overlay.png")
     run = lambda: anon.get(f"/api/v1/procedures/{proc.code}/download/overlay.png")
-elif case == "rectify-40MP-png":
-    p, _, _ = photo("PNG")
+elif case.startswith("rectify-40MP"):
+    p, _, _ = photo("PNG", mode="RGBA" if "rgba" in case else "RGB")
     sp, _, _ = photo("PNG", 100, 80)
     corners = [[100, 50], [7900, 0], [8000, 5000], [0, 4950]]
     warm = lambda: owner.post(f"/api/v1/photos/{sp.code}/rectify", {"corners": [[1, 1], [99, 0], [100, 80], [0, 79]]},
@@ -141,11 +146,42 @@ elif case == "photo-image-40MP-png":
     sp, _, _ = photo("PNG", 100, 80)
     warm = lambda: anon.get(f"/api/v1/photos/{sp.code}/image")
     run = lambda: anon.get(f"/api/v1/photos/{p.code}/image")
-elif case == "upload-40MP-png":
-    _, _, raw = photo("PNG")
-    _, _, little_raw = photo("PNG", 100, 80)
+elif case.startswith("upload-40MP"):
+    fmt = "JPEG" if "jpeg" in case else "PNG"
+    turned = {}
+    if "rotated" in case:
+        exif = Image.Exif(); exif[0x0112] = 6; turned = {"exif": exif.tobytes()}
+    _, _, raw = photo(fmt, **turned)
+    _, _, little_raw = photo(fmt, 100, 80, **turned)
     warm = lambda: owner.post("/api/v1/photos/", {"image": SimpleUploadedFile("s.png", little_raw)}, format="multipart")
     run = lambda: owner.post("/api/v1/photos/", {"image": SimpleUploadedFile("b.png", raw)}, format="multipart")
+elif case == "json-4MB-of-objects":
+    body = "[" + ",".join(["{}"] * ((4 * 2**20 - 8) // 3)) + "]"
+    warm = lambda: anon.post("/api/v1/render", "[{}]", content_type="application/json")
+    run = lambda: anon.post("/api/v1/render", body, content_type="application/json")
+elif case == "segmentation-list-100":
+    p, _, _ = photo("PNG", 2000, 2000)
+    rects = [{"label": "window", "x0": (i % 140) * 14, "y0": (i // 140) * 13, "x1": (i % 140) * 14 + 10,
+              "y1": (i // 140) * 13 + 10} for i in range(20000)]
+    data = {"width": 2000, "height": 2000, "rects": rects}
+    Segmentation.objects.bulk_create([Segmentation(photo=p, version=v, data=data, rect_count=20000)
+                                      for v in range(2, 102)])
+    warm = lambda: anon.get(f"/api/v1/photos/{p.code}/segmentations/?limit=1")
+    run = lambda: anon.get(f"/api/v1/photos/{p.code}/segmentations/?limit=100")
+elif case == "remeasure-40MP":
+    from facaid.grammar.decompose import procedure_from_segmentation
+    from facaid.segmentation import Segmentation as SegData
+    w, h = 8000, 5000
+    rects = [{"label": "window", "x0": (i % 50) * 160, "y0": (i // 50) * 125, "x1": (i % 50) * 160 + 100,
+              "y1": (i // 50) * 125 + 80} for i in range(2000)]
+    data = {"width": w, "height": h, "rects": [{"label": "facade", "x0": 0, "y0": 0, "x1": w, "y1": h}] + rects}
+    p, _, _ = photo("PNG", w, h)
+    seg = Segmentation.objects.create(photo=p, version=2, data=data, rect_count=len(data["rects"]))
+    tree = procedure_from_segmentation(SegData.from_dict(data)).to_dict()
+    proc = Procedure.objects.create(owner=user, data=tree, photo=p, segmentation=seg)
+    little = Procedure.objects.create(owner=user, data=small)
+    warm = lambda: owner.patch(f"/api/v1/procedures/{little.code}/", {"data": small}, format="json")
+    run = lambda: owner.patch(f"/api/v1/procedures/{proc.code}/", {"data": tree}, format="json")
 else:
     raise SystemExit(f"unknown case {case}")
 

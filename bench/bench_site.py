@@ -129,7 +129,7 @@ def main() -> None:
            # as scripts/run: DEBUG off over plain http with a key of its own; the API's throttles off, as the
            # 50 clients share one session and one address (this measures the site, not the throttle)
            "SECRET_KEY": secrets.token_urlsafe(50), "FACAID_HTTPS": "0", "FACAID_API_ANON_RATE": "none",
-           "FACAID_API_USER_RATE": "none"}
+           "FACAID_API_USER_RATE": "none", "FACAID_API_HEAVY_RATE": "none"}
     procs = []
     try:
         redis = subprocess.run(["bash", "scripts/redis-server-path"], cwd=ROOT, capture_output=True, text=True,

@@ -66,7 +66,8 @@ def rectify(image: Image.Image, corners, size: tuple[int, int] | None = None,
     coeffs = (inverse / inverse[2, 2]).flatten()[:8]
     if not all(math.isfinite(c) for c in coeffs):
         raise ValueError("corners do not define a usable homography")
-    if image.mode != "RGB":
-        image = image.convert("RGB")  # (an RGB image is used as it is: no full-size copy)
-    return image.transform((w, h), Image.Transform.PERSPECTIVE, tuple(coeffs),
-                                          Image.Resampling.BICUBIC)
+    if image.mode not in ("RGB", "RGBA", "L"):
+        image = image.convert("RGB")
+    # warped in its own mode and converted after: no full-size copy of the photo is made
+    out = image.transform((w, h), Image.Transform.PERSPECTIVE, tuple(coeffs), Image.Resampling.BICUBIC)
+    return out if out.mode == "RGB" else out.convert("RGB")

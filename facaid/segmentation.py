@@ -9,13 +9,13 @@ overlap; `flatten` resolves overlaps by the paint order of `facaid.labels` and `
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
 
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
+from facaid.numbers import finite
 
 MAX_SIDE = 16384  # pixels, either side
 MAX_PIXELS = 64_000_000
@@ -82,11 +82,7 @@ class Segmentation:
 def _number(value: Any, where: str) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise SegmentationError(f"{where} must be a number, got {type(value).__name__} {value!r}")
-    try:
-        finite = math.isfinite(value)
-    except OverflowError:  # an integer too large for a float
-        finite = False
-    if not finite:
+    if not finite(value):
         raise SegmentationError(f"{where} must be finite, got {str(value)[:40]}")
     return value
 

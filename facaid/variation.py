@@ -144,26 +144,34 @@ def _box_sizes(proc: Procedure) -> dict[int, tuple[float, float]]:
 
 def vary(proc: Procedure, n: int = 8, seed: int = 0) -> list[Procedure]:
     """``n`` variants: counts of floors and tiles changed, the facade resized with its repeats adapting,
-    tiles or floors swapped within the style. Deterministic by seed; every variant is valid."""
+    tiles or floors swapped within the style. Deterministic by seed; every variant is valid. A draw that would
+    cross the grammar's limits (a count past them, a facade at its largest made larger) is drawn again, so fewer
+    than ``n`` come back only when that keeps happening."""
     if not 1 <= n <= 64:
         raise ValueError(f"n must be between 1 and 64, got {n}")
     rng = random.Random(f"facaid-vary:{seed}")
     repeats = [p for p, node in proc.nodes() if node.rule == "repeat" and node.count != "fill"]
     roles = [r for r in ("tile", "floor") if any(node.role == r for _, node in proc.nodes())]
     style = proc.meta.get("style")
+    kinds = ["resize"] + (["count"] if repeats else []) + (["swap"] if roles else [])
     out = []
-    for i in range(n):
-        kinds = ["resize"] + (["count"] if repeats else []) + (["swap"] if roles else [])
-        kind = kinds[i % len(kinds)] if i < len(kinds) else rng.choice(kinds)
-        if kind == "count":
-            path = rng.choice(repeats)
-            delta = rng.choice([-2, -1, 1, 2])
-            variant = change_count(proc, path, delta)
-        elif kind == "swap":
-            variant = swap(proc, rng.choice(roles), rng, style)
-        else:
-            variant = resize(proc, round(proc.width * rng.uniform(0.7, 1.5)),
-                             round(proc.height * rng.uniform(0.8, 1.3)))
+    for attempt in range(4 * n):  # a variant past the grammar's limits (a facade at its largest) is drawn again
+        if len(out) == n:
+            break
+        i = len(out)
+        kind = kinds[i % len(kinds)] if attempt < len(kinds) else rng.choice(kinds)
+        try:
+            if kind == "count":
+                path = rng.choice(repeats)
+                delta = rng.choice([-2, -1, 1, 2])
+                variant = change_count(proc, path, delta)
+            elif kind == "swap":
+                variant = swap(proc, rng.choice(roles), rng, style)
+            else:
+                variant = resize(proc, min(MAX_EXTENT, round(proc.width * rng.uniform(0.7, 1.5))),
+                                 min(MAX_EXTENT, round(proc.height * rng.uniform(0.8, 1.3))))
+        except (ProcedureError, ValueError):
+            continue
         variant.meta = {**proc.meta, "variation": kind, "variation_seed": seed, "variation_index": i}
         out.append(variant)
     return out

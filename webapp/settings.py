@@ -148,13 +148,19 @@ MEDIA_ROOT = Path(env_str("MEDIA_ROOT", str(VAR_DIR / "media")))
 FACAID_MAX_UPLOAD_BYTES = env_int("FACAID_MAX_UPLOAD_BYTES", 20 * 1024 * 1024)
 FACAID_MAX_PIXELS = env_int("FACAID_MAX_PIXELS", 40_000_000)
 FACAID_MAX_RECTIFIED_PIXELS = env_int("FACAID_MAX_RECTIFIED_PIXELS", 16_000_000)  # a rectified photo is shrunk to this
-DATA_UPLOAD_MAX_MEMORY_SIZE = 8 * 1024 * 1024  # JSON bodies (segmentations) up to 8 MB
+# JSON and form bodies up to 4 MB: a segmentation of the most rectangles (20,000) is about 1.5 MB, a procedure of the
+# most nodes about 1 MB; what a body may cost once parsed grows with it (bench/bench_render_memory.py)
+DATA_UPLOAD_MAX_MEMORY_SIZE = 4 * 1024 * 1024
 FILE_UPLOAD_MAX_MEMORY_SIZE = 2_621_440
 
 REDIS_URL = env_str("REDIS_URL", "redis://127.0.0.1:6379/0")
+FACAID_MAX_ACTIVE_JOBS = env_int("FACAID_MAX_ACTIVE_JOBS", 5)  # a user's jobs waiting or running at once
 # The API's throttle counts live in each process's memory: no request depends on Redis being up, and a limit
-# holds per gunicorn worker (scripts/run's 2 workers let a client up to twice the rate through)
-CACHES = {"default": {"BACKEND": "django.core.cache.backends.locmem.LocMemCache", "LOCATION": "facaid"}}
+# holds per gunicorn worker (scripts/run's 2 workers let a client up to twice the rate through). Pages served from
+# memory (the gallery) have a cache of their own, so that many of them never push throttle counts out.
+CACHES = {"default": {"BACKEND": "django.core.cache.backends.locmem.LocMemCache", "LOCATION": "facaid"},
+          "pages": {"BACKEND": "django.core.cache.backends.locmem.LocMemCache", "LOCATION": "facaid-pages",
+                    "OPTIONS": {"MAX_ENTRIES": 500}}}
 FACAID_CHECKPOINT = env_str("FACAID_CHECKPOINT", str(BASE_DIR / "checkpoints" / "facaid-small"))
 
 REST_FRAMEWORK = {
@@ -169,14 +175,17 @@ REST_FRAMEWORK = {
     "DEFAULT_THROTTLE_CLASSES": ["rest_framework.throttling.AnonRateThrottle",
                                  "rest_framework.throttling.UserRateThrottle"],
     "DEFAULT_THROTTLE_RATES": {"anon": env_rate("FACAID_API_ANON_RATE", "300/min"),
-                               "user": env_rate("FACAID_API_USER_RATE", "1200/min")},
+                               "user": env_rate("FACAID_API_USER_RATE", "1200/min"),
+                               # rendering, variations, rectifying, downloads (webapp/facades/throttling.py)
+                               "heavy": env_rate("FACAID_API_HEAVY_RATE", "120/min"),
+                               "signup": env_rate("FACAID_SIGNUP_RATE", "10/hour")},  # accounts/views.signup
     "NUM_PROXIES": FACAID_PROXY_COUNT,
     # JSON with bounded nesting (a RecursionError would be a 500), then forms and uploads
     "DEFAULT_PARSER_CLASSES": ["webapp.facades.jsonbody.JSONParser", "rest_framework.parsers.FormParser",
                                "rest_framework.parsers.MultiPartParser"],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
-    "DEFAULT_PAGINATION_CLASS": "rest_framework.pagination.LimitOffsetPagination",
-    "PAGE_SIZE": 24,
+    "DEFAULT_PAGINATION_CLASS": "webapp.facades.paging.Pagination",
+    "PAGE_SIZE": 24,  # (webapp.facades.paging.Pagination: at most 100)
 }
 SPECTACULAR_SETTINGS = {
     "TITLE": "FaçAID API",

@@ -23,12 +23,12 @@ exactly. Every node may carry a ``role`` (what it stands for: floor, tile, ...);
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
 from facaid.labels import LABEL_ID, LABELS
+from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
 
 FORMAT = "facaid-procedure"
@@ -59,6 +59,7 @@ MAX_NODES = 8192
 MAX_CHILDREN = 64
 MAX_COUNT = 256
 MAX_LEAVES = 100_000  # rectangles after repeats and mirrors are expanded
+MAX_META_CHARS = 65_536
 MAX_EXTENT = float(MAX_SIDE)  # pixels: a procedure executes to a segmentation, whose sides stop there too
 
 
@@ -218,20 +219,12 @@ def _is_number(v: Any) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool)
 
 
-def _finite(v: int | float) -> bool:
-    """`math.isfinite`, where an integer too large for a float (JSON allows any) is not finite."""
-    try:
-        return math.isfinite(v)
-    except OverflowError:
-        return False
-
-
 def _check_size(path: str, i: int, mode: str, value: Any) -> None:
     if mode not in MODES:
         raise ProcedureError(path, f"sizes[{i}] has unknown mode {mode!r}; expected one of {', '.join(MODES)}")
     if not _is_number(value):
         raise ProcedureError(path, f"sizes[{i}] value must be a number, got {value!r}")
-    if not _finite(value):
+    if not finite(value):
         raise ProcedureError(path, f"sizes[{i}] value must be finite, got {value!r}")
     if value < 0:
         raise ProcedureError(path, f"sizes[{i}] is negative ({value!r})")
@@ -239,6 +232,21 @@ def _check_size(path: str, i: int, mode: str, value: Any) -> None:
         raise ProcedureError(path, f"sizes[{i}] is a relative size above 1 ({value!r})")
     if value > MAX_EXTENT:
         raise ProcedureError(path, f"sizes[{i}] is too large ({value!r} > {MAX_EXTENT:g})")
+
+
+def _check_meta(meta: dict) -> None:
+    """Free-form notes, but plain JSON that every database stores and every encoder writes back: finite numbers,
+    text without NUL or unpaired surrogates, at most `MAX_META_CHARS` written out."""
+    try:
+        text = json.dumps(meta, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
+        text.encode("utf-8")
+    except (ValueError, TypeError, UnicodeEncodeError, RecursionError) as exc:
+        raise ProcedureError("(document)", f"meta must be plain JSON text and finite numbers ({exc})") from None
+    if "\\u0000" in text:
+        raise ProcedureError("(document)", "meta must not hold NUL characters")
+    if len(text) > MAX_META_CHARS:
+        raise ProcedureError("(document)", f"meta is too long ({len(text)} characters written out; at most "
+                                           f"{MAX_META_CHARS})")
 
 
 def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
@@ -319,11 +327,12 @@ def parse_procedure(obj: Any) -> Procedure:
                              f"made for grammar {obj.get('grammar')!r}; this build runs {GRAMMAR_VERSION!r}")
     for key in ("width", "height"):
         v = obj.get(key)
-        if not _is_number(v) or not _finite(v) or not 1 <= v <= MAX_EXTENT:
+        if not _is_number(v) or not finite(v) or not 1 <= v <= MAX_EXTENT:
             raise ProcedureError("(document)", f"{key} must be a number from 1 to {MAX_EXTENT:g}, got {v!r}")
     meta = obj.get("meta", {})
     if not isinstance(meta, dict):
         raise ProcedureError("(document)", f"meta must be an object, got {type(meta).__name__}")
+    _check_meta(meta)
     extra = sorted(set(obj) - {"format", "version", "grammar", "width", "height", "root", "meta"})
     if extra:
         raise ProcedureError("(document)", f"unexpected key(s): {', '.join(extra)}")

@@ -15,12 +15,14 @@ def media_root(settings, tmp_path):
 
 @pytest.fixture(autouse=True)
 def fresh_cache():
-    """The API's throttle counts (in the default cache) start from zero in each test."""
-    from django.core.cache import cache
+    """The API's throttle counts and the pages kept in memory start from nothing in each test."""
+    from django.core.cache import caches
 
-    cache.clear()
+    for alias in ("default", "pages"):
+        caches[alias].clear()
     yield
-    cache.clear()
+    for alias in ("default", "pages"):
+        caches[alias].clear()
 
 
 @pytest.fixture

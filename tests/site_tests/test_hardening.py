@@ -22,7 +22,7 @@ from webapp.facades.rendering import label_map
 pytestmark = pytest.mark.django_db
 
 DEEP = "[" * 100_000 + "]" * 100_000
-DEEP_OBJECT = '{"a":' * 70 + "1" + "}" * 70  # parses, but deeper than the site reads
+DEEP_OBJECT = '{"a":' * 80 + "1" + "}" * 80  # parses, but deeper than the site reads
 HUGE = "1" + "0" * 400  # an integer too large for a float
 
 
@@ -90,13 +90,26 @@ def test_deeply_nested_json_is_a_400_everywhere_and_stores_nothing(facade_photo,
     for body in (DEEP, DEEP_OBJECT):
         for url in posts:
             r = as_alice.post(url, body, content_type="application/json")
-            assert r.status_code == 400 and "levels deep" in r.json()["detail"], (url, r.content[:200])
+            assert r.status_code == 400 and "levels deep" in r.json().get("detail", ""), (url, r.content[:300])
         r = as_alice.patch(f"/api/v1/procedures/{proc.code}/", body, content_type="application/json")
         assert r.status_code == 400 and "levels deep" in r.json()["detail"]
         r = as_alice.post(f"/photos/{photo['code']}/segmentation", {"text": body}, follow=True)
         assert r.status_code == 200 and "levels deep" in r.content.decode()
     assert counts() == before
     assert Procedure.objects.get(id=proc.id).data == generate(3).procedure.to_dict()
+
+
+def test_the_deepest_procedure_the_grammar_allows_is_read(as_alice):
+    from facaid.grammar.procedure import MAX_DEPTH
+
+    node = {"rule": "leaf", "label": "window"}
+    for _ in range(MAX_DEPTH):
+        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
+    r = as_alice.post("/api/v1/procedures/", {"data": {**wall(100, 100), "root": node}}, format="json")
+    assert r.status_code == 201, r.content[:300]
+    node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
+    r = as_alice.post("/api/v1/procedures/", {"data": {**wall(100, 100), "root": node}}, format="json")
+    assert r.status_code == 400 and "too deep" in json.dumps(r.json())  # the grammar's own limit names it
 
 
 def test_numbers_too_large_for_a_float_are_a_400(facade_photo, as_alice, alice):
@@ -191,10 +204,10 @@ def test_a_declared_length_over_the_limit_is_413_on_every_path(as_alice):
         r = as_alice.generic("POST", url, b"{}", content_type="multipart/form-data; boundary=x",
                              CONTENT_LENGTH=str(300 << 20))
         assert r.status_code == 413 and b"at most 21 MB are accepted for uploads" in r.content, url
-    body = '{"a": "' + "x" * (9 << 20) + '"}'  # over the 8 MB of a JSON body, far under an upload's
+    body = '{"a": "' + "x" * (5 << 20) + '"}'  # over the 4 MB of a JSON body, far under an upload's
     for client, url in ((as_alice, "/api/v1/procedures/"), (as_alice, "/api/v1/render")):
         r = client.post(url, body, content_type="application/json")
-        assert r.status_code == 413 and "at most 8 MB are accepted for JSON" in r.json()["detail"], url
+        assert r.status_code == 413 and "at most 4 MB are accepted for JSON" in r.json()["detail"], url
     r = as_alice.generic("POST", "/api/v1/render", b"{}", content_type="application/json", CONTENT_LENGTH="lots")
     assert r.status_code == 400
 
@@ -215,6 +228,18 @@ def test_a_parent_made_private_is_hidden_from_its_forks(alice, bob, as_alice, as
     assert as_bob.get("/api/v1/procedures/").json()["results"][0]["parent"] is None
     # the fork's own copy is untouched, and alice still sees her own procedure's lineage where she may
     assert as_bob.get(f"/api/v1/procedures/{fork['code']}/").json()["title"] == "Fork of Rivoli 12"
+
+
+def test_an_unlisted_parent_is_named_only_to_the_forks_owner(alice, bob, as_bob, as_charlie, django_user_model):
+    original = Procedure.objects.create(owner=alice, title="by link", data=wall(100, 100), visibility="unlisted")
+    fork = as_bob.post(f"/api/v1/procedures/{original.code}/fork").json()
+    assert as_bob.get(f"/api/v1/procedures/{fork['code']}/").json()["parent"] == str(original.code)
+    as_bob.patch(f"/api/v1/procedures/{fork['code']}/", {"visibility": "public"}, format="json")
+    assert as_charlie.get(f"/api/v1/procedures/{fork['code']}/").json()["parent"] is None  # the link stays private
+    assert as_charlie.get("/api/v1/gallery/").json()["results"][0]["parent"] is None
+    page = as_charlie.get(f"/procedures/{fork['code']}").content.decode()
+    assert str(original.code) not in page and "forked from" not in page  # (its title was copied by the fork)
+    assert str(original.code) in as_bob.get(f"/procedures/{fork['code']}").content.decode()
 
 
 def test_a_public_procedure_does_not_name_its_private_photo(facade_photo, alice, as_charlie, as_alice):
@@ -324,3 +349,35 @@ def test_deep_json_on_the_default_parser_is_a_400(facade_photo, as_alice):
     photo, _ = facade_photo
     r = as_alice.patch(f"/api/v1/photos/{photo['code']}/", DEEP, content_type="application/json")
     assert r.status_code == 400 and "levels deep" in r.json()["detail"]
+
+
+@pytest.mark.parametrize("meta, message", [('{"note": "a\\u0000b"}', "NUL"), ('{"note": "\\ud800"}', "plain JSON"),
+                                           ('{"n": 1e999}', "valid JSON"), (f'{{"n": "{"x" * 70000}"}}', "too long")])
+def test_procedure_notes_are_plain_json_that_every_database_stores(as_alice, meta, message):
+    tree = json.dumps(wall(100, 100))[:-1] + f', "meta": {meta}}}'
+    before = counts()
+    r = as_alice.post("/api/v1/procedures/", f'{{"data": {tree}}}', content_type="application/json")
+    assert r.status_code == 400 and message in json.dumps(r.json()), r.content[:300]
+    assert counts() == before
+
+
+def test_the_page_form_reads_an_integer_of_too_many_digits_as_bad_json(facade_photo, as_alice):
+    photo, _ = facade_photo
+    r = as_alice.post(f"/photos/{photo['code']}/segmentation", {"text": '{"width": ' + "1" * 5000 + "}"},
+                      follow=True)
+    assert r.status_code == 200 and "not valid JSON" in r.content.decode()
+    assert Segmentation.objects.count() == 1
+
+
+def test_a_user_has_at_most_five_jobs_waiting_or_running(facade_photo, as_alice, as_bob, settings):
+    photo, seg = facade_photo
+    codes = [as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "k": 1}, format="json").status_code
+             for _ in range(settings.FACAID_MAX_ACTIVE_JOBS)]
+    assert codes == [202] * settings.FACAID_MAX_ACTIVE_JOBS
+    r = as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "k": 1}, format="json")
+    assert r.status_code == 429 and "5 reconstructions waiting or running" in r.json()["detail"]
+    r = as_alice.post(f"/photos/{photo['code']}/reconstruct", {"k": 1, "seed": 0}, follow=True)
+    assert "5 reconstructions waiting or running" in r.content.decode()
+    assert Job.objects.count() == 5
+    Job.objects.filter(id=Job.objects.first().id).update(status="done")
+    assert as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "k": 1}, format="json").status_code == 202

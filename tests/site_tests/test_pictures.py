@@ -22,32 +22,74 @@ def kept(proc) -> list[str]:
     return sorted(default_storage.listdir(folder)[1]) if default_storage.exists(folder) else []
 
 
-def test_pictures_are_kept_from_the_save_and_follow_the_tree(alice, as_alice):
+def test_pictures_are_kept_from_the_save_and_follow_the_tree(alice, as_alice, django_capture_on_commit_callbacks):
     tree = generate(3).procedure
-    proc = Procedure.objects.create(owner=alice, data=tree.to_dict())
+    with django_capture_on_commit_callbacks(execute=True):  # rendered once the save commits
+        proc = Procedure.objects.create(owner=alice, data=tree.to_dict())
     tag = pictures.digest(proc.data)
     assert kept(proc) == [f"{tag}-labels.png", f"{tag}-thumbnail.png"]  # rendered by the save itself
     thumb = Image.open(default_storage.open(f"pictures/{proc.code}/{tag}-thumbnail.png"))
     assert max(thumb.size) == 320 and abs(thumb.width / thumb.height - tree.width / tree.height) < 0.02
     edited = generate(4).procedure.to_dict()
-    assert as_alice.patch(f"/api/v1/procedures/{proc.code}/", {"data": edited}, format="json").status_code == 200
+    with django_capture_on_commit_callbacks(execute=True):
+        r = as_alice.patch(f"/api/v1/procedures/{proc.code}/", {"data": edited}, format="json")
+    assert r.status_code == 200
     new = pictures.digest(Procedure.objects.get(id=proc.id).data)
     assert new != tag and kept(proc) == [f"{new}-labels.png", f"{new}-thumbnail.png"]  # the old ones are gone
-    as_alice.patch(f"/api/v1/procedures/{proc.code}/", {"title": "renamed"}, format="json")
+    with django_capture_on_commit_callbacks(execute=True):
+        as_alice.patch(f"/api/v1/procedures/{proc.code}/", {"title": "renamed"}, format="json")
     assert kept(proc) == [f"{new}-labels.png", f"{new}-thumbnail.png"]
     r = as_alice.get(f"/api/v1/procedures/{proc.code}/download/labels.png")
     served = Image.open(io.BytesIO(r.getvalue()))
     assert r.status_code == 200 and served.size == (round(edited["width"]), round(edited["height"]))
-    as_alice.delete(f"/api/v1/procedures/{proc.code}/")
-    assert kept(proc) == []
+    with django_capture_on_commit_callbacks(execute=True):
+        as_alice.delete(f"/api/v1/procedures/{proc.code}/")
+    assert kept(proc) == [] and not default_storage.exists(f"pictures/{proc.code}")
 
 
 def test_a_missing_picture_is_rendered_on_its_first_request(alice, as_alice):
-    proc = Procedure.objects.create(owner=alice, data=generate(5).procedure.to_dict())
-    for name in kept(proc):
-        default_storage.delete(f"pictures/{proc.code}/{name}")
+    proc = Procedure.objects.create(owner=alice, data=generate(5).procedure.to_dict())  # not committed: none kept
+    assert kept(proc) == []
     r = as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png")
     assert r.status_code == 200 and r["Content-Type"] == "image/png" and len(kept(proc)) == 1
+    again = as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png")
+    assert again.getvalue() == r.content and again.streaming  # now served from the kept file
+
+
+def test_refresh_keeps_the_pictures_of_the_committed_tree(alice):
+    """Two saves' refreshes running late, in either order: the pictures left are those of the tree stored."""
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
+    first = pictures.digest(proc.data)
+    pictures.refresh(proc.id)
+    proc.data = generate(4).procedure.to_dict()
+    proc.save()
+    second = pictures.digest(proc.data)
+    pictures.refresh(proc.id)
+    pictures.refresh(proc.id)  # the first save's refresh, late: it reads the stored tree, not its own
+    assert kept(proc) == [f"{second}-labels.png", f"{second}-thumbnail.png"] and first != second
+
+
+def test_a_procedure_stored_past_the_size_cap_is_scaled_by_the_migration(alice, as_alice):
+    import importlib
+
+    from django.apps import apps
+
+    from facaid.grammar import Procedure as Tree
+
+    data = generate(3).procedure.to_dict()
+    factor = 20_000 / data["width"]
+    data["width"], data["height"] = 20_000, data["height"] * factor
+    for node in [data["root"]]:
+        node["sizes"] = [[m, v * factor if m == "abs" else v] for m, v in node.get("sizes", [])]
+    proc = Procedure.objects.create(owner=alice, data=data)  # as stored before the cap (the model checks nothing)
+    r = as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png")
+    assert r.status_code == 400 and "cannot be drawn" in r.json()["data"]  # a 400 naming it, not a 500
+    importlib.import_module("webapp.facades.migrations.0002_procedures_within_the_size_cap").scale_down(apps, None)
+    scaled = Tree.from_dict(Procedure.objects.get(id=proc.id).data)
+    shrink = 16384 / max(data["width"], data["height"])
+    assert max(scaled.width, scaled.height) == 16384
+    assert abs(scaled.width - data["width"] * shrink) < 1e-6 and abs(scaled.height - data["height"] * shrink) < 1e-6
+    assert as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png").status_code == 200
 
 
 def test_pictures_are_cached_by_visibility_and_revalidated_by_digest(alice, as_alice, as_bob, as_charlie):

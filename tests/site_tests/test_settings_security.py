@@ -89,14 +89,17 @@ def test_proxy_settings_hsts_and_throttle_rates_come_from_the_environment(monkey
     s = load_settings(monkeypatch, tmp_path, DEBUG="0", SECRET_KEY=production_key(),
                       FACAID_PROXY_SSL_HEADER="X-Forwarded-Proto", FACAID_PROXY_COUNT="1",
                       FACAID_HSTS_SECONDS="3600", FACAID_HSTS_INCLUDE_SUBDOMAINS="0", FACAID_HSTS_PRELOAD="0",
-                      FACAID_API_ANON_RATE="60/min", FACAID_API_USER_RATE="none")
+                      FACAID_API_ANON_RATE="60/min", FACAID_API_USER_RATE="none", FACAID_API_HEAVY_RATE="30/min",
+                      FACAID_SIGNUP_RATE="2/day")
     assert s["SECURE_PROXY_SSL_HEADER"] == ("HTTP_X_FORWARDED_PROTO", "https")
     assert s["REST_FRAMEWORK"]["NUM_PROXIES"] == 1
     assert s["SECURE_HSTS_SECONDS"] == 3600
     assert not s["SECURE_HSTS_INCLUDE_SUBDOMAINS"] and not s["SECURE_HSTS_PRELOAD"]
-    assert s["REST_FRAMEWORK"]["DEFAULT_THROTTLE_RATES"] == {"anon": "60/min", "user": None}
+    assert s["REST_FRAMEWORK"]["DEFAULT_THROTTLE_RATES"] == {"anon": "60/min", "user": None, "heavy": "30/min",
+                                                              "signup": "2/day"}
     defaults = load_settings(monkeypatch, tmp_path, DEBUG="1")
-    assert defaults["REST_FRAMEWORK"]["DEFAULT_THROTTLE_RATES"] == {"anon": "300/min", "user": "1200/min"}
+    assert defaults["REST_FRAMEWORK"]["DEFAULT_THROTTLE_RATES"] == {"anon": "300/min", "user": "1200/min",
+                                                                     "heavy": "120/min", "signup": "10/hour"}
     assert defaults["AXES_FAILURE_LIMIT"] == 10 and defaults["AXES_COOLOFF_TIME"].total_seconds() == 15 * 60
     with pytest.raises(ImproperlyConfigured, match="FACAID_API_ANON_RATE must be a rate like 120/min"):
         load_settings(monkeypatch, tmp_path, DEBUG="1", FACAID_API_ANON_RATE="fast")

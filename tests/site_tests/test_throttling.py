@@ -132,7 +132,8 @@ def test_token_page_needs_csrf(alice):
 @pytest.fixture
 def low_rates(monkeypatch):
     """The real throttles at low rates (DRF reads the rates into the class when it is imported)."""
-    monkeypatch.setattr(SimpleRateThrottle, "THROTTLE_RATES", {"anon": "5/min", "user": "8/min"})
+    monkeypatch.setattr(SimpleRateThrottle, "THROTTLE_RATES", {"anon": "5/min", "user": "8/min", "heavy": "3/min",
+                                                               "signup": "2/hour"})
 
 
 def test_anonymous_api_clients_are_throttled_per_address(low_rates, db):
@@ -155,3 +156,41 @@ def test_users_are_throttled_per_account(low_rates, alice, bob):
     r = as_alice.get("/api/v1/photos/", REMOTE_ADDR="10.3.3.3")  # from another address: the same account
     assert r.status_code == 429 and "throttled" in r.json()["detail"]
     assert as_bob.get("/api/v1/photos/").status_code == 200
+
+
+def test_costly_requests_have_a_rate_of_their_own(low_rates, alice):
+    """Rendering is throttled at the 'heavy' rate (3/min here) before the general one (8/min) is reached."""
+    as_alice = client_for(alice)
+    tree = generate(1).procedure.to_dict()
+    statuses = [as_alice.post("/api/v1/render", tree, format="json").status_code for _ in range(4)]
+    assert statuses == [200, 200, 200, 429]
+    assert as_alice.get("/api/v1/photos/").status_code == 200  # cheap requests go on
+    anonymous = APIClient()
+    statuses = [anonymous.post("/api/v1/render", tree, format="json", REMOTE_ADDR="10.4.4.4").status_code
+                for _ in range(4)]
+    assert statuses == [200, 200, 200, 429]
+
+
+def test_new_accounts_are_limited_per_address(low_rates, db, django_user_model):
+    from django.test import Client
+
+    def signup(name, address):
+        return Client().post("/accounts/signup/", {"username": name, "password1": "a-long-passphrase-9",
+                                                   "password2": "a-long-passphrase-9"}, REMOTE_ADDR=address)
+
+    assert [signup(f"user{i}", "10.5.5.5").status_code for i in range(2)] == [302, 302]
+    r = signup("user2", "10.5.5.5")
+    assert r.status_code == 429 and "Too many new accounts" in r.content.decode() and int(r["Retry-After"]) > 0
+    assert not django_user_model.objects.filter(username="user2").exists()
+    assert signup("user3", "10.5.5.6").status_code == 302  # another address
+
+
+def test_the_token_page_is_never_cached_and_takes_a_double_click(alice):
+    page = client_for(alice)
+    r = page.get("/accounts/token/")
+    assert "no-store" in r["Cache-Control"]
+    for _ in range(2):
+        assert page.post("/accounts/token/", {"action": "create"}).status_code == 302
+    from rest_framework.authtoken.models import Token
+
+    assert Token.objects.filter(user=alice).count() == 1

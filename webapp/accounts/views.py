@@ -2,21 +2,38 @@ import math
 
 from django.conf import settings
 from django.contrib import messages
-from django.contrib.auth import login
+from django.contrib.auth import get_user_model, login
 from django.contrib.auth.decorators import login_required
+from django.db import transaction
 from django.shortcuts import redirect, render
 from django.utils import timezone
+from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_http_methods
 from rest_framework.authtoken.models import Token
-from rest_framework.throttling import BaseThrottle
+from rest_framework.throttling import AnonRateThrottle, BaseThrottle
 
 from webapp.accounts.forms import SignupForm
+
+
+class SignupThrottle(AnonRateThrottle):
+    """New accounts per address (FACAID_SIGNUP_RATE): each account brings fresh API and login allowances."""
+
+    scope = "signup"
 
 
 def signup(request):
     if request.user.is_authenticated:
         return redirect("home")
     form = SignupForm(request.POST or None)
+    if request.method == "POST":
+        throttle = SignupThrottle()
+        if not throttle.allow_request(request, None):
+            wait = math.ceil(throttle.wait() or 60)
+            form.add_error(None, f"Too many new accounts from your address; try again in {math.ceil(wait / 60)} "
+                                 "minutes.")
+            response = render(request, "registration/signup.html", {"form": form}, status=429)
+            response["Retry-After"] = str(wait)
+            return response
     if request.method == "POST" and form.is_valid():
         user = form.save()
         login(request, user, backend="django.contrib.auth.backends.ModelBackend")
@@ -24,16 +41,20 @@ def signup(request):
     return render(request, "registration/signup.html", {"form": form})
 
 
+@never_cache  # the page shows the secret
 @login_required
 @require_http_methods(["GET", "POST"])
 def api_token(request):
     """The user's API token (Authorization: Token <key>): see it, create or regenerate it, revoke it."""
     if request.method == "POST":
-        Token.objects.filter(user=request.user).delete()  # a new token replaces the old one at once
+        with transaction.atomic():  # one change at a time per user (a double click is two POSTs)
+            get_user_model().objects.select_for_update().filter(pk=request.user.pk).first()
+            Token.objects.filter(user=request.user).delete()  # a new token replaces the old one at once
+            if request.POST.get("action") != "revoke":
+                Token.objects.create(user=request.user)
         if request.POST.get("action") == "revoke":
             messages.success(request, "Your API token is revoked: requests with it are refused now.")
         else:
-            Token.objects.create(user=request.user)
             messages.success(request, "A new API token is made; the previous one, if any, no longer works.")
         return redirect("api-token")
     token = Token.objects.filter(user=request.user).first()

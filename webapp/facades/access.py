@@ -50,19 +50,28 @@ def photo_visible_to(user, photo: Photo | None) -> bool:
                                   or photo.visibility in READABLE)
 
 
-def procedure_visible_to(user, proc: Procedure | None) -> bool:
-    """May ``user`` see this procedure (for example as the parent of a fork)?"""
-    return proc is not None and ((user.is_authenticated and proc.owner_id == user.id)
-                                 or proc.visibility in READABLE)
+def _owns(user, obj) -> bool:
+    return user.is_authenticated and obj.owner_id == user.id
+
+
+def parent_named_to(user, child: Procedure, parent: Procedure | None) -> bool:
+    """May ``child``'s page or JSON name ``parent`` to ``user``? A public parent, or one of the user's own; an
+    unlisted one only to the owner of the fork (who had its link), as naming it publishes the link."""
+    if parent is None:
+        return False
+    if parent.visibility == Visibility.PUBLIC or _owns(user, parent):
+        return True
+    return parent.visibility == Visibility.UNLISTED and _owns(user, child)
 
 
 def visible_lineage(user, proc: Procedure) -> list[Procedure]:
-    """The procedure's ancestors, nearest first, up to the first one ``user`` may not see."""
-    out = []
+    """The procedure's ancestors, nearest first, up to the first one ``user`` may not be shown."""
+    out, child = [], proc
     for ancestor in proc.lineage():
-        if not procedure_visible_to(user, ancestor):
+        if not parent_named_to(user, child, ancestor):
             break
         out.append(ancestor)
+        child = ancestor
     return out
 
 
@@ -73,6 +82,11 @@ def get_segmentation_for_user(user, code) -> Segmentation:
 
 def get_procedure_for_user(user, code) -> Procedure:
     return _get(_readable(Procedure.objects.select_related("owner", "parent"), user), code)
+
+
+def get_procedure_picture_for_user(user, code) -> Procedure:
+    """The procedure as its pictures need it: the tree is read only if a picture has to be drawn."""
+    return _get(_readable(Procedure.objects.defer("data", "metrics"), user), code)
 
 
 def get_rw_procedure_for_user(user, code) -> Procedure:

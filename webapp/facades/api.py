@@ -8,7 +8,7 @@ import io
 import zipfile
 
 from django.conf import settings
-from django.core.cache import cache
+from django.core.cache import caches
 from django.core.files.base import ContentFile
 from django.core.files.storage import default_storage
 from django.db import transaction
@@ -17,9 +17,14 @@ from django.http import FileResponse, Http404, HttpResponse
 from drf_spectacular.utils import OpenApiParameter, extend_schema
 from PIL import Image
 from rest_framework import status
-from rest_framework.decorators import api_view, authentication_classes, parser_classes, permission_classes
-from rest_framework.exceptions import NotAuthenticated, ValidationError
-from rest_framework.pagination import LimitOffsetPagination
+from rest_framework.decorators import (
+    api_view,
+    authentication_classes,
+    parser_classes,
+    permission_classes,
+    throttle_classes,
+)
+from rest_framework.exceptions import NotAuthenticated, Throttled, ValidationError
 from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
@@ -27,6 +32,7 @@ from rest_framework.response import Response
 from facaid.cga import MAX_SCALE, checked_scale, procedure_cga
 from facaid.defaults import DEFAULT_K
 from facaid.grammar import to_segmentation
+from facaid.grammar.procedure import ProcedureError
 from facaid.mesh import MeshTooLarge, procedure_mesh
 from facaid.rectify import rectify
 from facaid.render import segmentation_svg
@@ -34,6 +40,7 @@ from facaid.variation import vary
 from webapp.facades import access, jobs, pictures, rendering
 from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.paging import Pagination
 from webapp.facades.serializers import (
     JobCreateSerializer,
     JobSerializer,
@@ -45,17 +52,16 @@ from webapp.facades.serializers import (
     RectifySerializer,
     RerunSerializer,
     SegmentationSerializer,
+    SegmentationSummarySerializer,
     VariationsSerializer,
     parse_procedure,
     parse_segmentation,
 )
+from webapp.facades.throttling import HEAVY
 from webapp.facades.uploads import UploadError, normalize_photo
 
-GALLERY_CACHE_SECONDS = 300  # how long an unchanged gallery page stays in a process's memory
-
-
-class Pagination(LimitOffsetPagination):
-    max_limit = 100  # ?limit= beyond this gives this many (an unbounded one reached the database as an overflow)
+GALLERY_CACHE_SECONDS = 60  # how long an unchanged gallery page stays in a process's memory (the most a title edit
+# committed out of order with another change could show late)
 
 
 def _page(request, queryset, serializer):
@@ -131,6 +137,7 @@ def photo_image(request, code):
 @extend_schema(request=RectifySerializer, responses=PhotoSerializer,
                summary="Rectify the photo from four corners (a homography); the result is stored")
 @api_view(["POST"])
+@throttle_classes(HEAVY)
 @permission_classes([IsAuthenticated])
 @parser_classes([JSONParser])
 def photo_rectify(request, code):
@@ -171,7 +178,8 @@ def add_segmentation(photo: Photo, data) -> Segmentation:
                                            rect_count=len(seg.rects))
 
 
-@extend_schema(methods=["GET"], responses=SegmentationSerializer(many=True), summary="Versions, newest first")
+@extend_schema(methods=["GET"], responses=SegmentationSummarySerializer(many=True),
+               summary="Versions, newest first (without their rectangles: GET segmentations/<code>/ for those)")
 @extend_schema(methods=["POST"], request={"application/json": dict}, responses={201: SegmentationSerializer},
                summary="Save a new version (the segmentation JSON contract; sizes must match the photo)")
 @api_view(["GET", "POST"])
@@ -180,7 +188,8 @@ def add_segmentation(photo: Photo, data) -> Segmentation:
 def photo_segmentations(request, code):
     if request.method == "GET":
         photo = access.get_photo_for_user(request.user, code)
-        return _page(request, photo.segmentations.order_by("-version"), SegmentationSerializer)
+        return _page(request, photo.segmentations.select_related("photo").defer("data").order_by("-version"),
+                     SegmentationSummarySerializer)
     if not request.user.is_authenticated:
         raise NotAuthenticated()
     photo = access.get_rw_photo_for_user(request.user, code)
@@ -199,6 +208,12 @@ def segmentation_detail(request, code):
 
 def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
                prefix_nodes: int = 0) -> Job:
+    """Queue a reconstruction; `Throttled` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
+    running, so that one account cannot fill the workers' queue."""
+    active = Job.objects.filter(owner=user, status__in=(Job.Status.QUEUED, Job.Status.RUNNING)).count()
+    if active >= settings.FACAID_MAX_ACTIVE_JOBS:
+        raise Throttled(wait=10, detail=f"You have {active} reconstructions waiting or running (at most "
+                                        f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
     params = {"k": k, "seed": seed}
     if prefix is not None and prefix_nodes > 0:
         params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id)
@@ -264,12 +279,15 @@ def gallery(request):
     change and the counts, one aggregate query, so a procedure made private leaves the listing at once."""
     changed = Procedure.objects.aggregate(at=Max("updated"), n=Count("id"),
                                           public=Count("id", filter=Q(visibility=Visibility.PUBLIC)))
-    key = "gallery:" + hashlib.sha256(f"{changed['at']} {changed['n']} {changed['public']} {request.get_host()} "
-                                      f"{request.get_full_path()}".encode()).hexdigest()
-    page = cache.get(key)
+    pager = Pagination()
+    where = (changed["at"], changed["n"], changed["public"], request.scheme, request.get_host(),
+             pager.get_limit(request), pager.get_offset(request))  # the page's own parameters, not the raw query
+    key = "gallery:" + hashlib.sha256(repr(where).encode()).hexdigest()
+    pages = caches["pages"]
+    page = pages.get(key)
     if page is None:
         page = _page(request, access.public_procedures(), ProcedureSummarySerializer).data
-        cache.set(key, page, GALLERY_CACHE_SECONDS)
+        pages.set(key, page, GALLERY_CACHE_SECONDS)
     return Response(page)
 
 
@@ -336,19 +354,24 @@ def procedure_fork(request, code):
 @extend_schema(request=VariationsSerializer, responses={200: dict},
                summary="Variants of a procedure (counts, resizes, swaps), deterministic by seed; not stored")
 @api_view(["POST"])
+@throttle_classes(HEAVY)
 @permission_classes([AllowAny])
 @parser_classes([JSONParser])
 def procedure_variations(request, code):
     proc = access.get_procedure_for_user(request.user, code)
     form = VariationsSerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    variants = vary(parse_procedure(proc.data), form.validated_data["n"], form.validated_data["seed"])
+    try:
+        variants = vary(parse_procedure(proc.data), form.validated_data["n"], form.validated_data["seed"])
+    except (ProcedureError, ValueError) as exc:
+        raise ValidationError({"data": f"no variations of this procedure: {exc}"}) from None
     return Response({"variants": [v.to_dict() for v in variants]})
 
 
 @extend_schema(request={"application/json": dict}, responses={(200, "image/png"): bytes},
                summary="Render a procedure JSON (the live preview of edited parameters)")
 @api_view(["POST"])
+@throttle_classes(HEAVY)
 @permission_classes([AllowAny])
 @parser_classes([JSONParser])
 def render_preview(request):
@@ -379,13 +402,17 @@ DOWNLOAD_HELP = {  # what each download is, for the procedure page's buttons
                        "of rectangles per class), procedure.cga (CityEngine CGA rules), mesh.zip (a relief mesh: "
                        "facade.obj and facade.mtl), overlay.png")
 @api_view(["GET"])
+@throttle_classes(HEAVY)
 @permission_classes([AllowAny])
 def procedure_download(request, code, name):
-    proc = access.get_procedure_for_user(request.user, code)
     if name not in DOWNLOADS:
         raise Http404(f"no download named {name!r}; there are {', '.join(DOWNLOADS)}")
+    if name == "labels.png":  # kept in storage: served as a file, the tree read only if it must be drawn
+        proc = access.get_procedure_picture_for_user(request.user, code)
+    else:
+        proc = access.get_procedure_for_user(request.user, code)
     stem = f"facaid-{str(proc.code)[:8]}"
-    if name == "labels.png":  # kept in storage: served as a file
+    if name == "labels.png":
         resp = _picture(request, proc, "labels.png")
         resp["Content-Disposition"] = f'attachment; filename="{stem}-{name}"'
         return resp
@@ -431,12 +458,20 @@ def procedure_download(request, code, name):
 def _picture(request, proc: Procedure, kind: str) -> HttpResponse:
     """A stored picture of the procedure, with its digest as the ETag (a 304 when the client has it); shared
     caches may keep a public procedure's a minute."""
-    name, tag = pictures.stored(proc, kind)
-    etag = f'"{tag}"'
-    if etag in request.headers.get("If-None-Match", ""):
-        resp = HttpResponse(status=304)
-    else:
-        resp = FileResponse(default_storage.open(name, "rb"), content_type="image/png")
+    try:
+        name, tag, png = pictures.stored(proc, kind)
+        etag = f'"{tag}"'
+        if etag in request.headers.get("If-None-Match", ""):
+            resp = HttpResponse(status=304)
+        elif png is not None:  # just rendered
+            resp = HttpResponse(png, content_type="image/png")
+        else:
+            try:
+                resp = FileResponse(default_storage.open(name, "rb"), content_type="image/png")
+            except FileNotFoundError:  # an edit's refresh replaced it a moment ago: this tree's, drawn again
+                resp = HttpResponse(pictures.render(proc.data, kind), content_type="image/png")
+    except ProcedureError as exc:  # stored before a limit it now breaks
+        raise ValidationError({"data": f"this procedure cannot be drawn: {exc}"}) from None
     resp["ETag"] = etag
     resp["Cache-Control"] = "public, max-age=60" if proc.visibility == Visibility.PUBLIC else "private, no-cache"
     return resp
@@ -447,7 +482,7 @@ def _picture(request, proc: Procedure, kind: str) -> HttpResponse:
 @api_view(["GET"])
 @permission_classes([AllowAny])
 def procedure_thumbnail(request, code):
-    return _picture(request, access.get_procedure_for_user(request.user, code), "thumbnail.png")
+    return _picture(request, access.get_procedure_picture_for_user(request.user, code), "thumbnail.png")
 
 
 def _mesh_zip(tree, scale: float | None) -> bytes:

@@ -1,6 +1,7 @@
 from django import forms
 
 from facaid.defaults import DEFAULT_K, MAX_K
+from facaid.grammar.procedure import MAX_NODES
 from webapp.facades.models import Visibility
 
 
@@ -26,5 +27,5 @@ class ReconstructForm(forms.Form):
 
 
 class RerunForm(forms.Form):
-    nodes = forms.IntegerField(min_value=1, max_value=8192, initial=1,
+    nodes = forms.IntegerField(min_value=1, max_value=MAX_NODES, initial=1,
                                help_text="nodes kept, breadth first: #0 to #N-1 in the tree above (click a # to pick)")

@@ -34,7 +34,8 @@ def send(job_id: int) -> None:
     it was, so recovery sends the job again at its next round instead of after the resend delay."""
     from webapp.facades.tasks import run_job
 
-    # no time limits in the message: the worker's own (FACAID_JOB_*TIME_LIMIT, worker/app.py) apply
+    # None, explicitly: otherwise the sender's configured limits travel in the message and override the
+    # worker's own (FACAID_JOB_*TIME_LIMIT, worker/app.py)
     run_job.apply_async(args=[job_id], time_limit=None, soft_time_limit=None)
     Job.objects.filter(id=job_id).update(sent=timezone.now())
 

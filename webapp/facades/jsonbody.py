@@ -10,7 +10,11 @@ from typing import Any
 from rest_framework import parsers
 from rest_framework.exceptions import ParseError
 
-MAX_DEPTH = 64  # procedures nest at most 32 nodes deep (facaid.grammar.procedure.MAX_DEPTH), each an object and a list
+from facaid.grammar.procedure import MAX_DEPTH as GRAMMAR_MAX_DEPTH
+
+# A procedure's node at grammar depth d lies 3 + 2d containers deep in a request ({"data": {"root": {"children":
+# [...]}}}) and its sizes' pairs 2 deeper; the grammar allows d <= 32 (facaid.grammar.procedure.MAX_DEPTH)
+MAX_DEPTH = 2 * GRAMMAR_MAX_DEPTH + 8
 
 
 class JSONError(ValueError):
@@ -18,14 +22,18 @@ class JSONError(ValueError):
 
 
 def depth_error(obj: Any, limit: int = MAX_DEPTH) -> str | None:
-    """The message for a document nested deeper than ``limit`` containers, else None (walked without recursion)."""
-    stack = [(obj, 1)]
+    """The message for a document nested deeper than ``limit`` containers, else None. Walked without recursion,
+    with one iterator per open container: memory grows with the depth, not with the size."""
+    stack = [iter((obj,))]
     while stack:
-        value, depth = stack.pop()
-        if isinstance(value, dict | list):
-            if depth > limit:
-                return f"JSON nested more than {limit} levels deep"
-            stack.extend((v, depth + 1) for v in (value.values() if isinstance(value, dict) else value))
+        for value in stack[-1]:
+            if isinstance(value, dict | list):
+                if len(stack) > limit:
+                    return f"JSON nested more than {limit} levels deep"
+                stack.append(iter(value.values() if isinstance(value, dict) else value))
+                break
+        else:
+            stack.pop()
     return None
 
 
@@ -35,7 +43,7 @@ def loads(raw: str | bytes) -> Any:
         obj = json.loads(raw)
     except RecursionError:
         raise JSONError(f"JSON nested more than {MAX_DEPTH} levels deep") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+    except ValueError as exc:  # malformed, not UTF-8, or an integer of more digits than Python converts
         raise JSONError(f"not valid JSON: {exc}") from None
     message = depth_error(obj)
     if message:

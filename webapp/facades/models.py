@@ -84,6 +84,8 @@ class Procedure(models.Model):
     parent = models.ForeignKey("self", on_delete=models.SET_NULL, null=True, blank=True, related_name="forks")
     accuracy = models.FloatField(null=True, blank=True)  # pixel accuracy against the segmentation
     metrics = models.JSONField(default=dict, blank=True)
+    # names the tree in `data` (facades.pictures.digest): its kept pictures' names and ETags, read without `data`
+    digest = models.CharField(max_length=16, blank=True, editable=False)
     visibility = models.CharField(max_length=10, choices=Visibility.choices, default=Visibility.PRIVATE)
     created = models.DateTimeField(default=timezone.now)
     updated = models.DateTimeField(auto_now=True)
@@ -96,6 +98,15 @@ class Procedure(models.Model):
 
     def get_absolute_url(self) -> str:
         return reverse("procedure", args=[self.code])
+
+    def save(self, *args, **kwargs) -> None:
+        from webapp.facades.pictures import digest
+
+        if "data" not in self.get_deferred_fields():
+            self.digest = digest(self.data)
+            if kwargs.get("update_fields") is not None and "data" in kwargs["update_fields"]:
+                kwargs["update_fields"] = {*kwargs["update_fields"], "digest"}
+        super().save(*args, **kwargs)
 
     def lineage(self) -> list[Procedure]:
         """Ancestors, nearest first (forks of forks), stopping at a cycle or a deleted parent."""

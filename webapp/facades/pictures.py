@@ -1,16 +1,23 @@
 """A procedure's pictures kept in storage: its label map (``labels.png``, at most 2,048 px a side) and the
-gallery card's thumbnail (``thumbnail.png``, at most 320 px), rendered when the procedure is saved and served as
-files. A picture is named by a digest of the tree it shows, so it never outlives an edit; one missing (a
-procedure saved before pictures were kept, or a failed render) is rendered on its first request and kept."""
+gallery card's thumbnail (``thumbnail.png``, at most 320 px), rendered when a save of the procedure commits and
+served as files. A picture is named by a digest of the tree it shows, so it never outlives an edit; one missing
+(a procedure saved before pictures were kept, or a failed render) is rendered on its first request and kept.
+
+Files are written whole or not at all (a temporary name, then a rename), and the pictures a save leaves behind
+are decided from the tree the database holds once it commits, so saves racing each other keep the last one's."""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import logging
+import os
+import uuid
 
 from django.core.files.base import ContentFile
 from django.core.files.storage import default_storage
+from django.db import transaction
 
 from webapp.facades import rendering
 
@@ -25,56 +32,101 @@ def digest(data: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def _folder(proc) -> str:
-    return f"pictures/{proc.code}"
+def _folder(code) -> str:
+    return f"pictures/{code}"
 
 
-def stored(proc, kind: str) -> tuple[str, str]:
-    """(storage name, digest) of the procedure's picture ``kind``, rendered and saved first if missing."""
+def _local_path(name: str) -> str | None:
+    try:
+        return default_storage.path(name)
+    except NotImplementedError:  # a storage without local files
+        return None
+
+
+def _write(name: str, png: bytes) -> None:
+    """Store the picture whole: a reader finds all of it or nothing."""
+    path = _local_path(name)
+    if path is None:
+        if not default_storage.exists(name):
+            default_storage.save(name, ContentFile(png))
+        return
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    partial = f"{path}.{uuid.uuid4().hex}.partial"
+    with open(partial, "wb") as f:
+        f.write(png)
+    os.replace(partial, path)
+
+
+def render(data: dict, kind: str) -> bytes:
+    """The picture ``kind`` of a procedure JSON; raises `ProcedureError` for one that no longer validates."""
     from facaid.grammar import Procedure as Tree
     from facaid.grammar import to_segmentation
 
-    tag = digest(proc.data)
-    name = f"{_folder(proc)}/{tag}-{kind}"
-    if not default_storage.exists(name):
-        png = rendering.label_map_png(to_segmentation(Tree.from_dict(proc.data)), SIDES[kind])
-        saved = default_storage.save(name, ContentFile(png))
-        if saved != name:  # another request saved the same picture meanwhile: keep one
-            default_storage.delete(saved)
-    return name, tag
+    return rendering.label_map_png(to_segmentation(Tree.from_dict(data)), SIDES[kind])
 
 
-def _others(proc, keep: set[str]) -> list[str]:
-    folder = _folder(proc)
+def stored(proc, kind: str) -> tuple[str, str, bytes | None]:
+    """(storage name, digest, the PNG when this call had to render it) of the procedure's picture ``kind``. The
+    tree (``proc.data``, which may be deferred) is read only when the picture has to be rendered."""
+    tag = proc.digest or digest(proc.data)
+    name = f"{_folder(proc.code)}/{tag}-{kind}"
+    if default_storage.exists(name):
+        return name, tag, None
+    png = render(proc.data, kind)
+    _write(name, png)
+    return name, tag, png
+
+
+def _files(code) -> list[str]:
+    folder = _folder(code)
     if not default_storage.exists(folder):
         return []
-    return [f"{folder}/{f}" for f in default_storage.listdir(folder)[1] if f"{folder}/{f}" not in keep]
+    return [f"{folder}/{f}" for f in default_storage.listdir(folder)[1]]
 
 
-def refresh(proc) -> None:
-    """Render what the procedure's current tree lacks and delete the pictures of its earlier trees. A failure
-    is logged and left to the first request, never raised into the save that called this."""
+def refresh(procedure_id: int) -> None:
+    """Give the procedure the pictures of the tree the database holds now and delete the rest (all of them when
+    it is gone). A failure is logged and left to the first request, never raised into the save."""
+    from webapp.facades.models import Procedure
+
+    row = Procedure.objects.filter(id=procedure_id).values_list("code", "data").first()
     try:
-        keep = {stored(proc, kind)[0] for kind in SIDES}
-        for name in _others(proc, keep):
-            default_storage.delete(name)
+        if row is None:
+            return
+        code, data = row
+        tag = digest(data)
+        keep = set()
+        for kind in SIDES:
+            name = f"{_folder(code)}/{tag}-{kind}"
+            if not default_storage.exists(name):
+                _write(name, render(data, kind))
+            keep.add(name)
+        for name in _files(code):
+            if name not in keep and not name.endswith(".partial"):
+                default_storage.delete(name)
     except Exception:
-        log.exception("could not render the pictures of procedure %s", proc.code)
+        log.exception("could not render the pictures of procedure %s", procedure_id)
 
 
-def remove(proc) -> None:
-    for name in _others(proc, set()):
+def remove(code) -> None:
+    for name in _files(code):
         default_storage.delete(name)
+    path = _local_path(_folder(code))
+    if path is not None:
+        with contextlib.suppress(OSError):  # not empty (a render in flight) or already gone
+            os.rmdir(path)
 
 
 def _saved(sender, instance, update_fields=None, raw=False, **_) -> None:
     if raw or (update_fields is not None and "data" not in update_fields):
         return
-    refresh(instance)
+    procedure_id = instance.id
+    transaction.on_commit(lambda: refresh(procedure_id))  # outside the write's lock, and only if it commits
 
 
 def _deleted(sender, instance, **_) -> None:
-    remove(instance)
+    code = instance.code
+    transaction.on_commit(lambda: remove(code))
 
 
 def connect() -> None:

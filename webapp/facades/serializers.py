@@ -3,14 +3,13 @@ name the offending field or grammar node."""
 
 from __future__ import annotations
 
-import math
-
 from django.contrib.auth.models import AnonymousUser
 from rest_framework import serializers
 
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import Procedure as ProcedureTree
-from facaid.grammar.procedure import ProcedureError
+from facaid.grammar.procedure import MAX_NODES, ProcedureError
+from facaid.numbers import finite
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
@@ -89,7 +88,7 @@ class FiniteFloatField(serializers.FloatField):
             value = super().to_internal_value(data)
         except OverflowError:
             self.fail("invalid")
-        if not math.isfinite(value):
+        if not finite(value):
             self.fail("invalid")
         return value
 
@@ -106,6 +105,14 @@ class SegmentationSerializer(serializers.ModelSerializer):
     class Meta:
         model = Segmentation
         fields = ["code", "photo", "version", "rect_count", "data", "created"]
+        read_only_fields = fields
+
+
+class SegmentationSummarySerializer(SegmentationSerializer):
+    """A version as lists show it: its rectangles are fetched one version at a time (up to 20,000 each)."""
+
+    class Meta(SegmentationSerializer.Meta):
+        fields = ["code", "photo", "version", "rect_count", "created"]
         read_only_fields = fields
 
 
@@ -129,7 +136,7 @@ class ProcedureSerializer(serializers.ModelSerializer):
         return request.user if request is not None else AnonymousUser()
 
     def get_parent(self, proc: Procedure) -> str | None:
-        visible = proc.parent_id and access.procedure_visible_to(self._user(), proc.parent)
+        visible = proc.parent_id and access.parent_named_to(self._user(), proc, proc.parent)
         return str(proc.parent.code) if visible else None
 
     def get_photo(self, proc: Procedure) -> str | None:
@@ -173,7 +180,7 @@ def k_field() -> serializers.IntegerField:
                                     help_text="candidates decoded and compared")
 
 
-MAX_PREFIX_NODES = 8192  # facaid.grammar.procedure.MAX_NODES
+MAX_PREFIX_NODES = MAX_NODES  # a prefix keeps at most the whole tree
 
 
 class JobCreateSerializer(serializers.Serializer):

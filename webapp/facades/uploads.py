@@ -29,11 +29,10 @@ def normalize_photo(upload) -> tuple[ImageFile, int, int]:
     if size > max_bytes:
         raise UploadError(f"the file is {size / 2**20:.1f} MB; at most {max_bytes / 2**20:.0f} MB are accepted")
     upload.seek(0)
-    raw = upload.read()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
-            img = Image.open(io.BytesIO(raw))  # reads the header only
+            img = Image.open(upload)  # reads the header only; decoded from the upload's own file, not a copy
             fmt = ALIASES.get(img.format, img.format)
             if fmt not in FORMATS:
                 raise UploadError(f"{fmt or 'this'} images are not accepted; upload a JPEG, PNG or WebP photo")

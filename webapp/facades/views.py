@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from django.conf import settings
 from django.contrib import messages
 from django.contrib.auth.decorators import login_required
 from django.core.paginator import Paginator
 from django.shortcuts import redirect, render
 from django.views.decorators.http import require_POST
-from rest_framework.exceptions import ValidationError
+from rest_framework.exceptions import Throttled, ValidationError
 
 from webapp.facades import access, api, jsonbody
 from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
@@ -36,7 +37,8 @@ def home(request):
     if request.user.is_authenticated:
         context.update(photos=Photo.objects.filter(owner=request.user)[:12],
                        procedures=access.listed(Procedure.objects.filter(owner=request.user))[:12],
-                       jobs=Job.objects.filter(owner=request.user).select_related("result")[:8])
+                       jobs=Job.objects.filter(owner=request.user).select_related("result").defer(
+                           *access.JOB_WITHOUT)[:8])
     return render(request, "facades/home.html", context)
 
 
@@ -62,7 +64,8 @@ def photo(request, code):
     context = {"photo": photo, "owner": owner, "segmentation": segmentation,
                "procedures": access.listed(photo.procedures.filter(owner=photo.owner) if owner else
                                            photo.procedures.filter(visibility="public")),
-               "jobs": Job.objects.filter(segmentation__photo=photo).select_related("result")[:10] if owner
+               "jobs": Job.objects.filter(segmentation__photo=photo).select_related("result").defer(
+                   *access.JOB_WITHOUT)[:10] if owner
                else Job.objects.none(),
                "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
                "visibility_form": VisibilityForm(initial={"visibility": photo.visibility})}
@@ -81,7 +84,12 @@ def photo_segmentation(request, code):
     photo = access.get_rw_photo_for_user(request.user, code)
     form = SegmentationForm(request.POST, request.FILES)
     if form.is_valid():
-        raw = form.cleaned_data["file"].read() if form.cleaned_data["file"] else form.cleaned_data["text"]
+        upload, limit = form.cleaned_data["file"], settings.DATA_UPLOAD_MAX_MEMORY_SIZE
+        if upload and upload.size > limit:
+            messages.error(request, f"The segmentation file is {upload.size / 2**20:.1f} MB; at most "
+                                    f"{limit / 2**20:.0f} MB are read.")
+            return redirect(photo)
+        raw = upload.read() if upload else form.cleaned_data["text"]
         try:
             seg = api.add_segmentation(photo, jsonbody.loads(raw))
         except jsonbody.JSONError as exc:
@@ -105,7 +113,11 @@ def photo_reconstruct(request, code):
     if not form.is_valid():
         messages.error(request, "Check the reconstruction settings.")
         return redirect(photo)
-    job = api.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"])
+    try:
+        job = api.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"])
+    except Throttled as exc:
+        messages.error(request, str(exc.detail))
+        return redirect(photo)
     return redirect(job)
 
 
@@ -155,7 +167,11 @@ def procedure_rerun(request, code):
     if not form.is_valid() or proc.segmentation is None:
         messages.error(request, "Re-running needs the procedure's segmentation and a node count of at least 1.")
         return redirect(proc)
-    job = api.submit_job(request.user, proc.segmentation, prefix=proc, prefix_nodes=form.cleaned_data["nodes"])
+    try:
+        job = api.submit_job(request.user, proc.segmentation, prefix=proc, prefix_nodes=form.cleaned_data["nodes"])
+    except Throttled as exc:
+        messages.error(request, str(exc.detail))
+        return redirect(proc)
     return redirect(job)
 
 
