@@ -66,8 +66,18 @@ def rectify(image: Image.Image, corners, size: tuple[int, int] | None = None,
     coeffs = (inverse / inverse[2, 2]).flatten()[:8]
     if not all(math.isfinite(c) for c in coeffs):
         raise ValueError("corners do not define a usable homography")
-    if image.mode not in ("RGB", "RGBA", "L"):
-        image = image.convert("RGB")
-    # warped in its own mode and converted after: no full-size copy of the photo is made
+    if image.mode not in ("RGB", "L"):
+        image = image.convert("RGB")  # (a transparent photo would be premultiplied, a full-size copy, anyway)
     out = image.transform((w, h), Image.Transform.PERSPECTIVE, tuple(coeffs), Image.Resampling.BICUBIC)
     return out if out.mode == "RGB" else out.convert("RGB")
+
+
+def rectify_file(fp, corners, max_pixels: int | None = None) -> Image.Image:
+    """`rectify` of the image in an open file, holding one full-size copy of its pixels at a time: a photo with
+    transparency or a palette is converted to RGB and the decoded original let go before the warp."""
+    image = Image.open(fp)
+    _check_corners(corners)  # before anything is decoded
+    image.load()
+    if image.mode not in ("RGB", "L"):
+        image = image.convert("RGB")
+    return rectify(image, corners, max_pixels=max_pixels)

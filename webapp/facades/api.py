@@ -34,7 +34,7 @@ from facaid.defaults import DEFAULT_K
 from facaid.grammar import to_segmentation
 from facaid.grammar.procedure import ProcedureError
 from facaid.mesh import MeshTooLarge, procedure_mesh
-from facaid.rectify import rectify
+from facaid.rectify import rectify_file
 from facaid.render import segmentation_svg
 from facaid.variation import vary
 from webapp.facades import access, jobs, pictures, rendering
@@ -151,7 +151,7 @@ def photo_rectify(request, code):
                                               f"{photo.height} photo"})
     with photo.image.open("rb") as f:
         try:
-            out = rectify(Image.open(f), corners, max_pixels=settings.FACAID_MAX_RECTIFIED_PIXELS)
+            out = rectify_file(f, corners, max_pixels=settings.FACAID_MAX_RECTIFIED_PIXELS)
         except ValueError as exc:
             raise ValidationError({"corners": str(exc)}) from None
     buf = io.BytesIO()
