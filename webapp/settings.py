@@ -177,7 +177,7 @@ REST_FRAMEWORK = {
     "DEFAULT_THROTTLE_RATES": {"anon": env_rate("FACAID_API_ANON_RATE", "300/min"),
                                "user": env_rate("FACAID_API_USER_RATE", "1200/min"),
                                # rendering, variations, rectifying, downloads (webapp/facades/throttling.py)
-                               "heavy": env_rate("FACAID_API_HEAVY_RATE", "120/min"),
+                               "heavy": env_rate("FACAID_API_HEAVY_RATE", "240/min"),
                                "signup": env_rate("FACAID_SIGNUP_RATE", "10/hour")},  # accounts/views.signup
     "NUM_PROXIES": FACAID_PROXY_COUNT,
     # JSON with bounded nesting (a RecursionError would be a 500), then forms and uploads

@@ -234,6 +234,20 @@ def _check_size(path: str, i: int, mode: str, value: Any) -> None:
         raise ProcedureError(path, f"sizes[{i}] is too large ({value!r} > {MAX_EXTENT:g})")
 
 
+def _texts(value: Any) -> Iterator[str]:
+    """Every key and string in a JSON value."""
+    stack = [value]
+    while stack:
+        value = stack.pop()
+        if isinstance(value, str):
+            yield value
+        elif isinstance(value, dict):
+            yield from (k for k in value if isinstance(k, str))
+            stack.extend(value.values())
+        elif isinstance(value, list):
+            stack.extend(value)
+
+
 def _check_meta(meta: dict) -> None:
     """Free-form notes, but plain JSON that every database stores and every encoder writes back: finite numbers,
     text without NUL or unpaired surrogates, at most `MAX_META_CHARS` written out."""
@@ -242,7 +256,7 @@ def _check_meta(meta: dict) -> None:
         text.encode("utf-8")
     except (ValueError, TypeError, UnicodeEncodeError, RecursionError) as exc:
         raise ProcedureError("(document)", f"meta must be plain JSON text and finite numbers ({exc})") from None
-    if "\\u0000" in text:
+    if any("\x00" in text for text in _texts(meta)):
         raise ProcedureError("(document)", "meta must not hold NUL characters")
     if len(text) > MAX_META_CHARS:
         raise ProcedureError("(document)", f"meta is too long ({len(text)} characters written out; at most "

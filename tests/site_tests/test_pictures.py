@@ -76,6 +76,9 @@ def test_a_procedure_stored_past_the_size_cap_is_scaled_by_the_migration(alice, 
 
     from facaid.grammar import Procedure as Tree
 
+    deep = generate(4).procedure.to_dict()
+    deep["root"]["sizes"] = [[m, 30_000.0 if m == "abs" else v] for m, v in deep["root"]["sizes"]]
+    too_big = Procedure.objects.create(owner=alice, data=deep)  # an inner size past the cap, the facade not
     data = generate(3).procedure.to_dict()
     factor = 20_000 / data["width"]
     data["width"], data["height"] = 20_000, data["height"] * factor
@@ -90,6 +93,9 @@ def test_a_procedure_stored_past_the_size_cap_is_scaled_by_the_migration(alice, 
     assert max(scaled.width, scaled.height) == 16384
     assert abs(scaled.width - data["width"] * shrink) < 1e-6 and abs(scaled.height - data["height"] * shrink) < 1e-6
     assert as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png").status_code == 200
+    assert deep["root"]["sizes"][0][0] == "abs"
+    Tree.from_dict(Procedure.objects.get(id=too_big.id).data)  # parses now
+    assert Procedure.objects.get(id=too_big.id).accuracy is None
 
 
 def test_pictures_are_cached_by_visibility_and_revalidated_by_digest(alice, as_alice, as_bob, as_charlie):
@@ -112,3 +118,19 @@ def test_gallery_cards_show_thumbnails(alice, as_charlie):
                                     visibility="public")
     page = as_charlie.get("/").content.decode()
     assert f"/api/v1/procedures/{proc.code}/thumbnail.png" in page
+
+
+def test_a_picture_drawn_after_an_edit_is_filed_under_the_tree_it_shows(alice, as_alice):
+    from webapp.facades import access
+
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
+    seen = access.get_procedure_picture_for_user(alice, proc.code)  # digest read, tree not
+    proc.data = generate(4).procedure.to_dict()
+    proc.save()  # an edit commits before the picture is drawn
+    name, tag, png = pictures.stored(seen, "thumbnail.png")
+    assert tag == pictures.digest(proc.data) and name.endswith(f"{tag}-thumbnail.png") and png
+    r = as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png")
+    assert r["ETag"] == f'"{pictures.digest(proc.data)}"'
+    Procedure.objects.filter(id=proc.id).delete()
+    with pytest.raises(LookupError):
+        pictures.stored(seen, "labels.png")

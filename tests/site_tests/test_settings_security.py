@@ -99,7 +99,7 @@ def test_proxy_settings_hsts_and_throttle_rates_come_from_the_environment(monkey
                                                               "signup": "2/day"}
     defaults = load_settings(monkeypatch, tmp_path, DEBUG="1")
     assert defaults["REST_FRAMEWORK"]["DEFAULT_THROTTLE_RATES"] == {"anon": "300/min", "user": "1200/min",
-                                                                     "heavy": "120/min", "signup": "10/hour"}
+                                                                     "heavy": "240/min", "signup": "10/hour"}
     assert defaults["AXES_FAILURE_LIMIT"] == 10 and defaults["AXES_COOLOFF_TIME"].total_seconds() == 15 * 60
     with pytest.raises(ImproperlyConfigured, match="FACAID_API_ANON_RATE must be a rate like 120/min"):
         load_settings(monkeypatch, tmp_path, DEBUG="1", FACAID_API_ANON_RATE="fast")

@@ -194,3 +194,16 @@ def test_the_token_page_is_never_cached_and_takes_a_double_click(alice):
     from rest_framework.authtoken.models import Token
 
     assert Token.objects.filter(user=alice).count() == 1
+
+
+def test_writes_that_draw_pictures_count_as_heavy_and_reads_of_kept_files_do_not(low_rates, alice):
+    """Saving a procedure draws its pictures: 3 saves a minute here; reading it, or its kept labels.png, is free."""
+    as_alice = client_for(alice)
+    tree = generate(1).procedure.to_dict()
+    statuses = [as_alice.post("/api/v1/procedures/", {"data": tree}, format="json").status_code for _ in range(4)]
+    assert statuses == [201, 201, 201, 429]
+    code = as_alice.get("/api/v1/procedures/").json()["results"][0]["code"]
+    reads = [as_alice.get(f"/api/v1/procedures/{code}/download/labels.png").status_code for _ in range(3)]
+    assert reads == [200] * 3  # (the general rate, 8/min here, still counts them)
+    r = as_alice.post(f"/procedures/{code}/fork", follow=True)
+    assert "Too many forks and edits in a row" in r.content.decode()

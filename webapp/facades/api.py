@@ -8,6 +8,7 @@ import io
 import zipfile
 
 from django.conf import settings
+from django.contrib.auth import get_user_model
 from django.core.cache import caches
 from django.core.files.base import ContentFile
 from django.core.files.storage import default_storage
@@ -24,7 +25,7 @@ from rest_framework.decorators import (
     permission_classes,
     throttle_classes,
 )
-from rest_framework.exceptions import NotAuthenticated, Throttled, ValidationError
+from rest_framework.exceptions import APIException, NotAuthenticated, ValidationError
 from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
@@ -206,18 +207,25 @@ def segmentation_detail(request, code):
 
 # --- jobs ---------------------------------------------------------------------------------------------------------
 
+class TooManyJobs(APIException):
+    status_code = 429
+    default_code = "too_many_jobs"
+
+
 def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
                prefix_nodes: int = 0) -> Job:
-    """Queue a reconstruction; `Throttled` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
+    """Queue a reconstruction; `TooManyJobs` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
     running, so that one account cannot fill the workers' queue."""
-    active = Job.objects.filter(owner=user, status__in=(Job.Status.QUEUED, Job.Status.RUNNING)).count()
-    if active >= settings.FACAID_MAX_ACTIVE_JOBS:
-        raise Throttled(wait=10, detail=f"You have {active} reconstructions waiting or running (at most "
-                                        f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
     params = {"k": k, "seed": seed}
     if prefix is not None and prefix_nodes > 0:
         params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id)
-    return jobs.submit(owner=user, segmentation=segmentation, params=params)
+    with transaction.atomic():  # the count and the new row together: two submissions at once cannot both pass
+        get_user_model().objects.select_for_update().filter(pk=user.pk).first()
+        active = Job.objects.filter(owner=user, status__in=(Job.Status.QUEUED, Job.Status.RUNNING)).count()
+        if active >= settings.FACAID_MAX_ACTIVE_JOBS:
+            raise TooManyJobs(f"You have {active} reconstructions waiting or running (at most "
+                              f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
+        return jobs.submit(owner=user, segmentation=segmentation, params=params)
 
 
 @extend_schema(methods=["GET"], responses=JobSerializer(many=True), summary="Your jobs, newest first")
@@ -256,6 +264,7 @@ def job_detail(request, code):
 @extend_schema(methods=["POST"], request=ProcedureWriteSerializer, responses={201: ProcedureSerializer},
                summary="Store a procedure JSON (imported or edited)")
 @api_view(["GET", "POST"])
+@throttle_classes(HEAVY)
 @permission_classes([IsAuthenticated])
 @parser_classes([JSONParser])
 def procedure_list(request):
@@ -279,9 +288,9 @@ def gallery(request):
     change and the counts, one aggregate query, so a procedure made private leaves the listing at once."""
     changed = Procedure.objects.aggregate(at=Max("updated"), n=Count("id"),
                                           public=Count("id", filter=Q(visibility=Visibility.PUBLIC)))
-    pager = Pagination()
+    # the query as sent: the page's links are made from it (the cache of pages holds at most 500 of them)
     where = (changed["at"], changed["n"], changed["public"], request.scheme, request.get_host(),
-             pager.get_limit(request), pager.get_offset(request))  # the page's own parameters, not the raw query
+             request.get_full_path())
     key = "gallery:" + hashlib.sha256(repr(where).encode()).hexdigest()
     pages = caches["pages"]
     page = pages.get(key)
@@ -313,6 +322,7 @@ def _remeasure(proc: Procedure) -> None:
                summary="Edit title, visibility or the procedure itself (re-executed and re-measured)")
 @extend_schema(methods=["DELETE"], responses={204: None}, summary="Delete a procedure")
 @api_view(["GET", "PATCH", "DELETE"])
+@throttle_classes(HEAVY)
 @permission_classes([AllowAny])
 @parser_classes([JSONParser])
 def procedure_detail(request, code):
@@ -345,6 +355,7 @@ def fork_procedure(user, proc: Procedure) -> Procedure:
 @extend_schema(request=None, responses={201: ProcedureSerializer},
                summary="Fork: your own private copy, with a link to its parent")
 @api_view(["POST"])
+@throttle_classes(HEAVY)
 @permission_classes([IsAuthenticated])
 def procedure_fork(request, code):
     fork = fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
@@ -458,20 +469,26 @@ def procedure_download(request, code, name):
 def _picture(request, proc: Procedure, kind: str) -> HttpResponse:
     """A stored picture of the procedure, with its digest as the ETag (a 304 when the client has it); shared
     caches may keep a public procedure's a minute."""
-    try:
-        name, tag, png = pictures.stored(proc, kind)
+    etag = f'"{proc.digest}"'
+    if proc.digest and etag in request.headers.get("If-None-Match", ""):
+        resp = HttpResponse(status=304)
+    else:
+        try:
+            name, tag, png = pictures.stored(proc, kind)
+            if png is None:
+                try:
+                    resp = FileResponse(default_storage.open(name, "rb"), content_type="image/png")
+                except FileNotFoundError:  # an edit's refresh replaced it a moment ago: drawn as it is now
+                    proc.digest = ""
+                    name, tag, png = pictures.stored(proc, kind)
+            if png is not None:
+                resp = HttpResponse(png, content_type="image/png")
+        except ProcedureError as exc:  # stored before a limit it now breaks
+            raise ValidationError({"data": f"this procedure cannot be drawn: {exc}"}) from None
+        except LookupError:
+            raise Http404("no such procedure") from None
         etag = f'"{tag}"'
-        if etag in request.headers.get("If-None-Match", ""):
-            resp = HttpResponse(status=304)
-        elif png is not None:  # just rendered
-            resp = HttpResponse(png, content_type="image/png")
-        else:
-            try:
-                resp = FileResponse(default_storage.open(name, "rb"), content_type="image/png")
-            except FileNotFoundError:  # an edit's refresh replaced it a moment ago: this tree's, drawn again
-                resp = HttpResponse(pictures.render(proc.data, kind), content_type="image/png")
-    except ProcedureError as exc:  # stored before a limit it now breaks
-        raise ValidationError({"data": f"this procedure cannot be drawn: {exc}"}) from None
+
     resp["ETag"] = etag
     resp["Cache-Control"] = "public, max-age=60" if proc.visibility == Visibility.PUBLIC else "private, no-cache"
     return resp

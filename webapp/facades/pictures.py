@@ -66,14 +66,26 @@ def render(data: dict, kind: str) -> bytes:
 
 
 def stored(proc, kind: str) -> tuple[str, str, bytes | None]:
-    """(storage name, digest, the PNG when this call had to render it) of the procedure's picture ``kind``. The
-    tree (``proc.data``, which may be deferred) is read only when the picture has to be rendered."""
-    tag = proc.digest or digest(proc.data)
+    """(storage name, digest, the PNG when this call had to draw it) of the procedure's picture ``kind``. Its
+    tree is read only to draw it, together with the digest it is filed under (an edit may have committed since
+    ``proc`` was read); `LookupError` when the procedure is gone meanwhile. A picture that cannot be kept (a full
+    disk) is logged and still returned."""
+    name = f"{_folder(proc.code)}/{proc.digest}-{kind}"
+    if proc.digest and default_storage.exists(name):
+        return name, proc.digest, None
+    from webapp.facades.models import Procedure
+
+    row = Procedure.objects.filter(id=proc.id).values_list("digest", "data").first()
+    if row is None:
+        raise LookupError(f"procedure {proc.code} is gone")
+    tag, data = row
+    tag = tag or digest(data)
     name = f"{_folder(proc.code)}/{tag}-{kind}"
-    if default_storage.exists(name):
-        return name, tag, None
-    png = render(proc.data, kind)
-    _write(name, png)
+    png = render(data, kind)
+    try:
+        _write(name, png)
+    except OSError:
+        log.exception("could not keep %s", name)
     return name, tag, png
 
 
@@ -84,37 +96,45 @@ def _files(code) -> list[str]:
     return [f"{folder}/{f}" for f in default_storage.listdir(folder)[1]]
 
 
-def refresh(procedure_id: int) -> None:
-    """Give the procedure the pictures of the tree the database holds now and delete the rest (all of them when
-    it is gone). A failure is logged and left to the first request, never raised into the save."""
+def _current(procedure_id: int) -> tuple | None:
     from webapp.facades.models import Procedure
 
-    row = Procedure.objects.filter(id=procedure_id).values_list("code", "data").first()
+    return Procedure.objects.filter(id=procedure_id).values_list("code", "digest", "data").first()
+
+
+def refresh(procedure_id: int) -> None:
+    """Give the procedure the pictures of the tree the database holds now, then delete those of other trees,
+    judged again just before (a later save may have committed meanwhile; its refresh draws its own). A failure is
+    logged and left to the first request, never raised into the save that committed."""
     try:
+        row = _current(procedure_id)
         if row is None:
             return
-        code, data = row
-        tag = digest(data)
-        keep = set()
+        code, tag, data = row
+        tag = tag or digest(data)
         for kind in SIDES:
             name = f"{_folder(code)}/{tag}-{kind}"
             if not default_storage.exists(name):
                 _write(name, render(data, kind))
-            keep.add(name)
+        latest = _current(procedure_id)
+        keep = {tag, latest[1] if latest else tag}
         for name in _files(code):
-            if name not in keep and not name.endswith(".partial"):
+            if name.rsplit("/", 1)[1].split("-", 1)[0] not in keep and not name.endswith(".partial"):
                 default_storage.delete(name)
     except Exception:
         log.exception("could not render the pictures of procedure %s", procedure_id)
 
 
 def remove(code) -> None:
-    for name in _files(code):
-        default_storage.delete(name)
-    path = _local_path(_folder(code))
-    if path is not None:
-        with contextlib.suppress(OSError):  # not empty (a render in flight) or already gone
-            os.rmdir(path)
+    try:
+        for name in _files(code):
+            default_storage.delete(name)
+        path = _local_path(_folder(code))
+        if path is not None:
+            with contextlib.suppress(OSError):  # not empty (a render in flight) or already gone
+                os.rmdir(path)
+    except Exception:
+        log.exception("could not delete the pictures of procedure %s", code)
 
 
 def _saved(sender, instance, update_fields=None, raw=False, **_) -> None:

@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+import math
+
 from django.conf import settings
 from django.contrib import messages
 from django.contrib.auth.decorators import login_required
 from django.core.paginator import Paginator
 from django.shortcuts import redirect, render
 from django.views.decorators.http import require_POST
-from rest_framework.exceptions import Throttled, ValidationError
+from rest_framework.exceptions import ValidationError
 
-from webapp.facades import access, api, jsonbody
+from webapp.facades import access, api, jsonbody, throttling
 from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
 from webapp.facades.models import Job, Photo, Procedure
 
@@ -115,7 +117,7 @@ def photo_reconstruct(request, code):
         return redirect(photo)
     try:
         job = api.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"])
-    except Throttled as exc:
+    except api.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(photo)
     return redirect(job)
@@ -154,7 +156,12 @@ def procedure_visibility(request, code):
 @login_required
 @require_POST
 def procedure_fork(request, code):
-    fork = api.fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
+    proc = access.get_procedure_for_user(request.user, code)
+    allowed, wait = throttling.allow_heavy(request)
+    if not allowed:
+        messages.error(request, f"Too many forks and edits in a row; try again in {math.ceil(wait or 1)} s.")
+        return redirect(proc)
+    fork = api.fork_procedure(request.user, proc)
     messages.success(request, "Forked: this copy is yours to edit.")
     return redirect(fork)
 
@@ -169,7 +176,7 @@ def procedure_rerun(request, code):
         return redirect(proc)
     try:
         job = api.submit_job(request.user, proc.segmentation, prefix=proc, prefix_nodes=form.cleaned_data["nodes"])
-    except Throttled as exc:
+    except api.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(proc)
     return redirect(job)

@@ -71,18 +71,34 @@ function drawTree() {
   document.getElementById("tree").replaceChildren(root);
 }
 
+class Throttled extends Error {
+  constructor(seconds) { super(`busy: trying again in ${seconds} s`); this.seconds = seconds; }
+}
+
 async function render(data) {
   const r = await fetch("/api/v1/render", {method: "POST", credentials: "same-origin",
     headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
+  if (r.status === 429) throw new Throttled(Math.max(1, Number(r.headers.get("Retry-After")) || 1));
   if (!r.ok) { const e = await r.json().catch(() => ({})); throw new Error(JSON.stringify(e)); }
   return URL.createObjectURL(await r.blob());
+}
+
+// rendering is rate-limited per account (the server's "heavy" rate): wait as told and try once more
+async function renderPatiently(data) {
+  try {
+    return await render(data);
+  } catch (err) {
+    if (!(err instanceof Throttled)) throw err;
+    await new Promise((done) => setTimeout(done, err.seconds * 1000));
+    return render(data);
+  }
 }
 
 function scheduleRender() {
   clearTimeout(renderTimer);
   renderTimer = setTimeout(async () => {
     try {
-      const url = await render(proc);
+      const url = await renderPatiently(proc);
       if (renderedUrl) URL.revokeObjectURL(renderedUrl);
       renderedUrl = url;
       document.getElementById("render").src = url;
@@ -92,9 +108,10 @@ function scheduleRender() {
       if (saved) saved.textContent = "unsaved changes";
     } catch (err) {
       const saved = document.getElementById("saved");
-      if (saved) saved.textContent = `not valid: ${err.message}`;
+      if (saved) saved.textContent = err instanceof Throttled ? err.message : `not valid: ${err.message}`;
+      if (err instanceof Throttled) scheduleRender();  // the latest edit, once the server has room
     }
-  }, 150);
+  }, 300);
 }
 
 document.getElementById("save")?.addEventListener("click", async () => {
@@ -138,7 +155,7 @@ document.getElementById("vary").addEventListener("click", async () => {
     const card = document.createElement("div");
     card.className = "card";
     const img = document.createElement("img");
-    img.src = await render(v);
+    img.src = await renderPatiently(v);
     img.alt = v.meta?.variation || "variant";
     const caption = document.createElement("div");
     caption.className = "meta";
