@@ -10,38 +10,27 @@ a job.
 
 from __future__ import annotations
 
-import os
-
 from celery import Celery
 from kombu import Queue
+
+from worker.env import env_int, env_seconds, env_str
 
 GPU_QUEUE = "gpu"
 DEFAULT_QUEUE = "default"
 
 
-def _seconds(name: str, default: int) -> int | None:
-    """A time limit from the environment in whole seconds; 0 turns it off."""
-    raw = os.environ.get(name, "") or str(default)
-    try:
-        value = int(raw)
-    except ValueError:
-        raise ValueError(f"{name} must be a whole number of seconds, got {raw!r}") from None
-    if value < 0:
-        raise ValueError(f"{name} must be 0 (no limit) or more seconds, got {raw!r}")
-    return value or None
-
-
 # A job past the soft limit gets SoftTimeLimitExceeded and ends `failed` with a message; one stuck where that
 # cannot reach it (native code) is killed at the hard limit and failed by the worker's main process. Limits need
 # the prefork pool (`--pool prefork --concurrency 1`): the solo pool ignores them.
-JOB_SOFT_TIME_LIMIT = _seconds("FACAID_JOB_SOFT_TIME_LIMIT", 600)
-JOB_TIME_LIMIT = _seconds("FACAID_JOB_TIME_LIMIT", 660)
+JOB_SOFT_TIME_LIMIT = env_seconds("FACAID_JOB_SOFT_TIME_LIMIT", 600)
+JOB_TIME_LIMIT = env_seconds("FACAID_JOB_TIME_LIMIT", 660)
+RUN_JOB = "facaid.run_job"  # the task's name: the site sends it by name, the worker registers it
 
 app = Celery("facaid")
 app.conf.update(
-    broker_url=os.environ.get("REDIS_URL", "redis://127.0.0.1:6379/0"),
+    broker_url=env_str("REDIS_URL", "redis://127.0.0.1:6379/0"),
     broker_connection_retry_on_startup=True,
-    broker_transport_options={"visibility_timeout": int(os.environ.get("FACAID_VISIBILITY_TIMEOUT", "3600"))},
+    broker_transport_options={"visibility_timeout": env_int("FACAID_VISIBILITY_TIMEOUT", 3600, minimum=1)},
     task_ignore_result=True,
     task_acks_late=True,
     task_reject_on_worker_lost=True,
@@ -51,7 +40,7 @@ app.conf.update(
     task_time_limit=JOB_TIME_LIMIT,
     task_default_queue=DEFAULT_QUEUE,
     task_queues=(Queue(DEFAULT_QUEUE), Queue(GPU_QUEUE)),
-    task_routes={"facaid.run_job": {"queue": GPU_QUEUE}},
+    task_routes={RUN_JOB: {"queue": GPU_QUEUE}},
     task_serializer="json",
     accept_content=["json"],
     worker_hijack_root_logger=False,

@@ -14,6 +14,8 @@ from pathlib import Path
 import pytest
 from django.core.exceptions import ImproperlyConfigured
 
+from worker.env import EnvError
+
 ROOT = Path(__file__).resolve().parents[2]
 SETTINGS = ROOT / "webapp" / "settings.py"
 # what tests/conftest.py sets for the suite, and what a production environment would not have
@@ -101,7 +103,7 @@ def test_proxy_settings_hsts_and_throttle_rates_come_from_the_environment(monkey
     assert defaults["REST_FRAMEWORK"]["DEFAULT_THROTTLE_RATES"] == {"anon": "300/min", "user": "1200/min",
                                                                      "heavy": "240/min", "signup": "10/hour"}
     assert defaults["AXES_FAILURE_LIMIT"] == 10 and defaults["AXES_COOLOFF_TIME"].total_seconds() == 15 * 60
-    with pytest.raises(ImproperlyConfigured, match="FACAID_API_ANON_RATE must be a rate like 120/min"):
+    with pytest.raises(EnvError, match="FACAID_API_ANON_RATE must be a rate like 120/min"):
         load_settings(monkeypatch, tmp_path, DEBUG="1", FACAID_API_ANON_RATE="fast")
 
 

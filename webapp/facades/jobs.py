@@ -13,6 +13,7 @@ from django.utils import timezone
 
 from webapp.env import env_int
 from webapp.facades.models import Job
+from worker.app import RUN_JOB, app
 
 log = logging.getLogger(__name__)
 
@@ -30,13 +31,11 @@ def resend_after() -> timedelta:
 
 
 def send(job_id: int) -> None:
-    """Publish the job's task, then record when: a publish that fails (the broker is down) leaves ``sent`` as
-    it was, so recovery sends the job again at its next round instead of after the resend delay."""
-    from webapp.facades.tasks import run_job
-
-    # None, explicitly: otherwise the sender's configured limits travel in the message and override the
-    # worker's own (FACAID_JOB_*TIME_LIMIT, worker/app.py)
-    run_job.apply_async(args=[job_id], time_limit=None, soft_time_limit=None)
+    """Publish the job's task (by name: this module does not import the tasks, which import it), then record
+    when: a publish that fails (the broker is down) leaves ``sent`` as it was, so recovery sends the job again at
+    its next round instead of after the resend delay."""
+    # no time limits in the message: the worker's own apply (FACAID_JOB_*TIME_LIMIT, worker/app.py)
+    app.send_task(RUN_JOB, args=[job_id], time_limit=None, soft_time_limit=None)
     Job.objects.filter(id=job_id).update(sent=timezone.now())
 
 

@@ -16,7 +16,7 @@ from webapp.env import env_int
 from webapp.facades import jobs
 from webapp.facades.models import Job, Procedure, Visibility
 from worker import compute
-from worker.app import app
+from worker.app import RUN_JOB, app
 
 log = logging.getLogger(__name__)
 
@@ -51,7 +51,7 @@ class JobTask(app.Task):
                 close_old_connections()
 
 
-@app.task(name="facaid.run_job", bind=True, base=JobTask, max_retries=jobs.MAX_ATTEMPTS)
+@app.task(name=RUN_JOB, bind=True, base=JobTask, max_retries=jobs.MAX_ATTEMPTS)
 def run_job(self, job_id: int) -> None:
     if not jobs.claim(job_id):
         return  # done, failed, or another worker has it: a duplicate delivery
