@@ -196,3 +196,21 @@ def test_photo_list_names_each_latest_segmentation_in_one_query(facade_photo, as
         listed = as_alice.get("/api/v1/photos/").json()["results"]
     assert len(listed) == 5 and listed[-1]["segmentation"] == newer["code"]
     assert [p["segmentation"] for p in listed[:4]] == [None] * 4
+
+
+def test_every_registered_download_is_served_as_registered(facade_photo, as_alice, alice, as_charlie):
+    from webapp.facades.downloads import DOWNLOADS
+    from webapp.facades.models import Photo, Procedure
+
+    photo, _ = facade_photo
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="public",
+                                    photo=Photo.objects.get(code=photo["code"]))
+    for name, download in DOWNLOADS.items():
+        r = as_alice.get(f"/api/v1/procedures/{proc.code}/download/{name}")
+        assert r.status_code == 200 and r["Content-Type"] == download.content_type, name
+        assert r["Content-Disposition"] == f'attachment; filename="facaid-{str(proc.code)[:8]}-{name}"'
+        if download.needs_photo:  # the photo is alice's and private: others are told, not served
+            r = as_charlie.get(f"/api/v1/procedures/{proc.code}/download/{name}")
+            assert r.status_code == 400 and "photo" in r.json()["name"]
+    page = as_charlie.get(f"/procedures/{proc.code}").content.decode()
+    assert "download/overlay.png" not in page and "download/mesh.zip" in page

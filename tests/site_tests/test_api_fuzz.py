@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from site_helpers import facade_png, upload
 
 from facaid.generator import generate
-from webapp.facades.api import DOWNLOADS
+from webapp.facades.downloads import DOWNLOADS
 
 EXAMPLES = int(os.environ.get("FACAID_FUZZ_EXAMPLES", "15"))
 WHO = ("anonymous", "alice", "alice", "bob")  # alice owns the world's objects (drawn half the time); bob does not
@@ -93,7 +93,7 @@ def real_parameters(case, world, pick: int) -> None:
         choices = world["codes"][kind]
         params["code"] = choices[pick % len(choices)]
     if "name" in params:
-        params["name"] = DOWNLOADS[pick % len(DOWNLOADS)]
+        params["name"] = list(DOWNLOADS)[pick % len(DOWNLOADS)]
     case.path_parameters = params
 
 

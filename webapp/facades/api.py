@@ -5,18 +5,14 @@ from __future__ import annotations
 
 import hashlib
 import io
-import zipfile
 
 from django.conf import settings
-from django.contrib.auth import get_user_model
 from django.core.cache import caches
 from django.core.files.base import ContentFile
 from django.core.files.storage import default_storage
-from django.db import transaction
 from django.db.models import Count, Max, OuterRef, Q, Subquery
 from django.http import FileResponse, Http404, HttpResponse
 from drf_spectacular.utils import OpenApiParameter, extend_schema
-from PIL import Image
 from rest_framework import status
 from rest_framework.decorators import (
     api_view,
@@ -25,20 +21,17 @@ from rest_framework.decorators import (
     permission_classes,
     throttle_classes,
 )
-from rest_framework.exceptions import APIException, NotAuthenticated, ValidationError
+from rest_framework.exceptions import NotAuthenticated, ValidationError
 from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
-from facaid.cga import MAX_SCALE, checked_scale, procedure_cga
-from facaid.defaults import DEFAULT_K
 from facaid.grammar import to_segmentation
 from facaid.grammar.procedure import ProcedureError
-from facaid.mesh import MeshTooLarge, procedure_mesh
 from facaid.rectify import rectify_file
-from facaid.render import segmentation_svg
 from facaid.variation import vary
-from webapp.facades import access, jobs, pictures, rendering
+from webapp.facades import access, downloads, pictures, rendering, services
+from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.paging import Pagination
@@ -56,10 +49,8 @@ from webapp.facades.serializers import (
     SegmentationSummarySerializer,
     VariationsSerializer,
     parse_procedure,
-    parse_segmentation,
 )
 from webapp.facades.throttling import HEAVY
-from webapp.facades.uploads import UploadError, normalize_photo
 
 GALLERY_CACHE_SECONDS = 60  # how long an unchanged gallery page stays in a process's memory (the most a title edit
 # committed out of order with another change could show late)
@@ -72,17 +63,6 @@ def _page(request, queryset, serializer):
 
 
 # --- photos ----------------------------------------------------------------------------------------------------
-
-def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PRIVATE) -> Photo:
-    try:
-        content, _, _ = normalize_photo(upload)
-    except UploadError as exc:
-        raise ValidationError({"image": str(exc)}) from None
-    photo = Photo(owner=owner, title=title, visibility=visibility)
-    photo.image.save(content.name, content, save=False)
-    photo.save()
-    return photo
-
 
 @extend_schema(methods=["GET"], responses=PhotoSerializer(many=True), summary="Your photos")
 @extend_schema(methods=["POST"], request={"multipart/form-data": PhotoUploadSerializer},
@@ -98,7 +78,7 @@ def photos(request):
         return _page(request, photos, PhotoSerializer)
     form = PhotoUploadSerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    photo = create_photo(request.user, form.validated_data["image"], form.validated_data.get("title", ""),
+    photo = services.create_photo(request.user, form.validated_data["image"], form.validated_data.get("title", ""),
                          form.validated_data["visibility"])
     return Response(PhotoSerializer(photo).data, status=status.HTTP_201_CREATED)
 
@@ -167,18 +147,6 @@ def photo_rectify(request, code):
 
 # --- segmentations ------------------------------------------------------------------------------------------------
 
-def add_segmentation(photo: Photo, data) -> Segmentation:
-    seg = parse_segmentation(data)
-    w, h = (photo.rectified.width, photo.rectified.height) if photo.rectified else (photo.width, photo.height)
-    if (seg.width, seg.height) != (w, h):
-        raise ValidationError({"segmentation": f"the segmentation is {seg.width}x{seg.height} but the "
-                                               f"{'rectified ' if photo.rectified else ''}photo is {w}x{h}"})
-    with transaction.atomic():
-        last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
-        return Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
-                                           rect_count=len(seg.rects))
-
-
 @extend_schema(methods=["GET"], responses=SegmentationSummarySerializer(many=True),
                summary="Versions, newest first (without their rectangles: GET segmentations/<code>/ for those)")
 @extend_schema(methods=["POST"], request={"application/json": dict}, responses={201: SegmentationSerializer},
@@ -194,7 +162,7 @@ def photo_segmentations(request, code):
     if not request.user.is_authenticated:
         raise NotAuthenticated()
     photo = access.get_rw_photo_for_user(request.user, code)
-    seg = add_segmentation(photo, request.data)
+    seg = services.add_segmentation(photo, request.data)
     return Response(SegmentationSerializer(seg).data, status=status.HTTP_201_CREATED)
 
 
@@ -206,27 +174,6 @@ def segmentation_detail(request, code):
 
 
 # --- jobs ---------------------------------------------------------------------------------------------------------
-
-class TooManyJobs(APIException):
-    status_code = 429
-    default_code = "too_many_jobs"
-
-
-def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
-               prefix_nodes: int = 0) -> Job:
-    """Queue a reconstruction; `TooManyJobs` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
-    running, so that one account cannot fill the workers' queue."""
-    params = {"k": k, "seed": seed}
-    if prefix is not None and prefix_nodes > 0:
-        params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id)
-    with transaction.atomic():  # the count and the new row together: two submissions at once cannot both pass
-        get_user_model().objects.select_for_update().filter(pk=user.pk).first()
-        active = Job.objects.filter(owner=user, status__in=(Job.Status.QUEUED, Job.Status.RUNNING)).count()
-        if active >= settings.FACAID_MAX_ACTIVE_JOBS:
-            raise TooManyJobs(f"You have {active} reconstructions waiting or running (at most "
-                              f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
-        return jobs.submit(owner=user, segmentation=segmentation, params=params)
-
 
 @extend_schema(methods=["GET"], responses=JobSerializer(many=True), summary="Your jobs, newest first")
 @extend_schema(methods=["POST"], request=JobCreateSerializer, responses={202: JobSerializer},
@@ -247,7 +194,7 @@ def job_list(request):
         raise ValidationError({"segmentation": "fork the photo's procedure or upload your own photo to "
                                                "reconstruct it"})
     prefix = access.get_procedure_for_user(request.user, v["prefix_procedure"]) if v["prefix_procedure"] else None
-    job = submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"])
+    job = services.submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
 
 
@@ -300,23 +247,6 @@ def gallery(request):
     return Response(page)
 
 
-def _remeasure(proc: Procedure) -> None:
-    """Pixel accuracy of an edited procedure against the segmentation it was made from."""
-    if proc.segmentation_id is None:
-        proc.accuracy = None
-        return
-    from facaid.metrics import procedure_accuracy
-    from facaid.segmentation import Segmentation as SegmentationData
-    from facaid.segmentation import flatten
-
-    target = flatten(SegmentationData.from_dict(proc.segmentation.data))
-    tree = parse_procedure(proc.data)
-    if (round(tree.width), round(tree.height)) == (target.width, target.height):
-        proc.accuracy = procedure_accuracy(tree, target)
-    else:
-        proc.accuracy = None  # resized: no longer comparable
-
-
 @extend_schema(methods=["GET"], responses=ProcedureSerializer, summary="A procedure")
 @extend_schema(methods=["PATCH"], request=ProcedureWriteSerializer, responses=ProcedureSerializer,
                summary="Edit title, visibility or the procedure itself (re-executed and re-measured)")
@@ -338,18 +268,9 @@ def procedure_detail(request, code):
     for key, value in form.validated_data.items():
         setattr(proc, key, value)
     if "data" in form.validated_data:
-        _remeasure(proc)
+        services.remeasure(proc)
     proc.save()
     return Response(ProcedureSerializer(proc, context={"request": request}).data)
-
-
-def fork_procedure(user, proc: Procedure) -> Procedure:
-    """A private copy owned by ``user`` with ``proc`` as its parent; the photo link is kept for its owner only."""
-    title = proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}"
-    mine = proc.photo is not None and proc.photo.owner == user
-    return Procedure.objects.create(
-        owner=user, title=title[:200], data=proc.data, parent=proc, accuracy=proc.accuracy, metrics=proc.metrics,
-        photo=proc.photo if mine else None, segmentation=proc.segmentation if mine else None)
 
 
 @extend_schema(request=None, responses={201: ProcedureSerializer},
@@ -358,7 +279,7 @@ def fork_procedure(user, proc: Procedure) -> Procedure:
 @throttle_classes(HEAVY)
 @permission_classes([IsAuthenticated])
 def procedure_fork(request, code):
-    fork = fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
+    fork = services.fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
     return Response(ProcedureSerializer(fork, context={"request": request}).data, status=status.HTTP_201_CREATED)
 
 
@@ -390,20 +311,6 @@ def render_preview(request):
     return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
 
 
-DOWNLOADS = ("procedure.json", "segmentation.json", "labels.png", "labels.svg", "procedure.cga", "mesh.zip",
-             "overlay.png")
-PHOTO_DOWNLOADS = ("overlay.png",)  # only where the photo is visible to the user
-DOWNLOAD_HELP = {  # what each download is, for the procedure page's buttons
-    "procedure.json": "the procedure: the tree with its sizes, to edit or reconstruct from",
-    "segmentation.json": "the labelled rectangles it draws",
-    "labels.png": "the label map as a picture",
-    "labels.svg": "the label map as vector rectangles, one group per class",
-    "procedure.cga": "CityEngine CGA rules: apply Facade to a facade shape",
-    "mesh.zip": "a 3D relief mesh (OBJ and MTL) for Blender and other 3D tools",
-    "overlay.png": "the label map over the photo",
-}
-
-
 @extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),
                            OpenApiParameter("metres_per_pixel", float,
                                             description="procedure.cga's and mesh.zip's scale (default: a storey "
@@ -416,53 +323,18 @@ DOWNLOAD_HELP = {  # what each download is, for the procedure page's buttons
 @throttle_classes(HEAVY)
 @permission_classes([AllowAny])
 def procedure_download(request, code, name):
-    if name not in DOWNLOADS:
+    download = DOWNLOADS.get(name)
+    if download is None:
         raise Http404(f"no download named {name!r}; there are {', '.join(DOWNLOADS)}")
-    if name == "labels.png":  # kept in storage: served as a file, the tree read only if it must be drawn
+    if download.build is None:  # kept in storage: served as a file, the tree read only if it must be drawn
         proc = access.get_procedure_picture_for_user(request.user, code)
+        resp = _picture(request, proc, name)
     else:
         proc = access.get_procedure_for_user(request.user, code)
-    stem = f"facaid-{str(proc.code)[:8]}"
-    if name == "labels.png":
-        resp = _picture(request, proc, "labels.png")
-        resp["Content-Disposition"] = f'attachment; filename="{stem}-{name}"'
-        return resp
-    tree = parse_procedure(proc.data)
-    if name == "procedure.json":
-        resp = HttpResponse(tree.to_json(indent=2), content_type="application/json")
-    elif name in ("procedure.cga", "mesh.zip"):
-        scale = request.query_params.get("metres_per_pixel")
-        try:
-            scale = checked_scale(tree, None if scale is None else float(scale))
-        except ValueError:
-            raise ValidationError({"metres_per_pixel": "metres_per_pixel must be a number > 0 and at most "
-                                                       f"{MAX_SCALE:g}"}) from None
-        if name == "procedure.cga":
-            resp = HttpResponse(procedure_cga(tree, scale, name=proc.title or stem),
-                                content_type="text/plain; charset=utf-8")
-        else:
-            try:
-                resp = HttpResponse(_mesh_zip(tree, scale), content_type="application/zip")
-            except MeshTooLarge as exc:
-                raise ValidationError({"name": str(exc)}) from None
-    else:
-        seg = to_segmentation(tree)
-        if name == "segmentation.json":
-            resp = HttpResponse(seg.to_json(), content_type="application/json")
-        elif name == "labels.svg":
-            resp = HttpResponse(segmentation_svg(seg), content_type="image/svg+xml")
-        else:
-            if not access.photo_visible_to(request.user, proc.photo):
-                raise ValidationError({"name": "this procedure has no photo you may see to overlay"})
-            try:
-                alpha = float(request.query_params.get("alpha", 0.5))
-            except ValueError:
-                raise ValidationError({"alpha": "alpha must be a number between 0 and 1"}) from None
-            if not 0.0 <= alpha <= 1.0:
-                raise ValidationError({"alpha": "alpha must be a number between 0 and 1"})
-            with proc.photo.working_image().open("rb") as f:
-                resp = HttpResponse(rendering.overlay_png(seg, Image.open(f), alpha), content_type="image/png")
-    resp["Content-Disposition"] = f'attachment; filename="{stem}-{name}"'
+        if download.needs_photo and not access.photo_visible_to(request.user, proc.photo):
+            raise ValidationError({"name": "this procedure has no photo you may see to overlay"})
+        resp = HttpResponse(downloads.build(name, proc, request.query_params), content_type=download.content_type)
+    resp["Content-Disposition"] = f'attachment; filename="{downloads.stem(proc)}-{name}"'
     return resp
 
 
@@ -502,15 +374,6 @@ def procedure_thumbnail(request, code):
     return _picture(request, access.get_procedure_picture_for_user(request.user, code), "thumbnail.png")
 
 
-def _mesh_zip(tree, scale: float | None) -> bytes:
-    obj, mtl = procedure_mesh(tree, scale, mtl_name="facade.mtl")
-    out = io.BytesIO()
-    with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("facade.obj", obj)
-        z.writestr("facade.mtl", mtl)
-    return out.getvalue()
-
-
 @extend_schema(request=RerunSerializer, responses={202: JobSerializer},
                summary="Re-run inference keeping the procedure's first `nodes` nodes (BFS)")
 @api_view(["POST"])
@@ -522,6 +385,6 @@ def procedure_rerun(request, code):
         raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
     form = RerunSerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    job = submit_job(request.user, proc.segmentation, k=form.validated_data["k"], seed=0, prefix=proc,
+    job = services.submit_job(request.user, proc.segmentation, k=form.validated_data["k"], seed=0, prefix=proc,
                      prefix_nodes=form.validated_data["nodes"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)

@@ -1,4 +1,5 @@
-"""The pages. They use the same helpers as the JSON API (`webapp.facades.api`) and the same access rules."""
+"""The pages. They call the same operations as the JSON API (`webapp.facades.services`) under the same access
+rules."""
 
 from __future__ import annotations
 
@@ -12,7 +13,9 @@ from django.shortcuts import redirect, render
 from django.views.decorators.http import require_POST
 from rest_framework.exceptions import ValidationError
 
-from webapp.facades import access, api, jsonbody, throttling
+from facaid.cga import MAX_SCALE
+from webapp.facades import access, jsonbody, services, throttling
+from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
 from webapp.facades.models import Job, Photo, Procedure
 
@@ -49,7 +52,7 @@ def photo_new(request):
     form = PhotoForm(request.POST or None, request.FILES or None)
     if request.method == "POST" and form.is_valid():
         try:
-            photo = api.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
+            photo = services.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
                                      form.cleaned_data["visibility"])
         except ValidationError as exc:
             form.add_error("image", _error_text(exc).removeprefix("image: "))
@@ -93,7 +96,7 @@ def photo_segmentation(request, code):
             return redirect(photo)
         raw = upload.read() if upload else form.cleaned_data["text"]
         try:
-            seg = api.add_segmentation(photo, jsonbody.loads(raw))
+            seg = services.add_segmentation(photo, jsonbody.loads(raw))
         except jsonbody.JSONError as exc:
             messages.error(request, f"The segmentation could not be read: {exc}")
         except ValidationError as exc:
@@ -116,8 +119,8 @@ def photo_reconstruct(request, code):
         messages.error(request, "Check the reconstruction settings.")
         return redirect(photo)
     try:
-        job = api.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"])
-    except api.TooManyJobs as exc:
+        job = services.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"])
+    except services.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(photo)
     return redirect(job)
@@ -142,9 +145,8 @@ def procedure(request, code):
         "proc": proc, "owner": owner, "photo_visible": photo_visible,
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
-        "downloads": [(d, api.DOWNLOAD_HELP[d]) for d in api.DOWNLOADS
-                      if photo_visible or d not in api.PHOTO_DOWNLOADS],
-        "max_scale": api.MAX_SCALE})
+        "downloads": [(name, d.help) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
+        "max_scale": MAX_SCALE})
 
 
 @login_required
@@ -161,7 +163,7 @@ def procedure_fork(request, code):
     if not allowed:
         messages.error(request, f"Too many forks and edits in a row; try again in {math.ceil(wait or 1)} s.")
         return redirect(proc)
-    fork = api.fork_procedure(request.user, proc)
+    fork = services.fork_procedure(request.user, proc)
     messages.success(request, "Forked: this copy is yours to edit.")
     return redirect(fork)
 
@@ -175,8 +177,8 @@ def procedure_rerun(request, code):
         messages.error(request, "Re-running needs the procedure's segmentation and a node count of at least 1.")
         return redirect(proc)
     try:
-        job = api.submit_job(request.user, proc.segmentation, prefix=proc, prefix_nodes=form.cleaned_data["nodes"])
-    except api.TooManyJobs as exc:
+        job = services.submit_job(request.user, proc.segmentation, prefix=proc, prefix_nodes=form.cleaned_data["nodes"])
+    except services.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(proc)
     return redirect(job)
