@@ -12,7 +12,7 @@ from PIL import Image
 
 from facaid.generator import generate
 from webapp.facades import pictures
-from webapp.facades.models import Procedure
+from webapp.facades.models import Procedure, tree_digest
 
 pytestmark = pytest.mark.django_db
 
@@ -26,7 +26,7 @@ def test_pictures_are_kept_from_the_save_and_follow_the_tree(alice, as_alice, dj
     tree = generate(3).procedure
     with django_capture_on_commit_callbacks(execute=True):  # rendered once the save commits
         proc = Procedure.objects.create(owner=alice, data=tree.to_dict())
-    tag = pictures.digest(proc.data)
+    tag = tree_digest(proc.data)
     assert kept(proc) == [f"{tag}-labels.png", f"{tag}-thumbnail.png"]  # rendered by the save itself
     thumb = Image.open(default_storage.open(f"pictures/{proc.code}/{tag}-thumbnail.png"))
     assert max(thumb.size) == 320 and abs(thumb.width / thumb.height - tree.width / tree.height) < 0.02
@@ -34,7 +34,7 @@ def test_pictures_are_kept_from_the_save_and_follow_the_tree(alice, as_alice, dj
     with django_capture_on_commit_callbacks(execute=True):
         r = as_alice.patch(f"/api/v1/procedures/{proc.code}/", {"data": edited}, format="json")
     assert r.status_code == 200
-    new = pictures.digest(Procedure.objects.get(id=proc.id).data)
+    new = tree_digest(Procedure.objects.get(id=proc.id).data)
     assert new != tag and kept(proc) == [f"{new}-labels.png", f"{new}-thumbnail.png"]  # the old ones are gone
     with django_capture_on_commit_callbacks(execute=True):
         as_alice.patch(f"/api/v1/procedures/{proc.code}/", {"title": "renamed"}, format="json")
@@ -59,11 +59,11 @@ def test_a_missing_picture_is_rendered_on_its_first_request(alice, as_alice):
 def test_refresh_keeps_the_pictures_of_the_committed_tree(alice):
     """Two saves' refreshes running late, in either order: the pictures left are those of the tree stored."""
     proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
-    first = pictures.digest(proc.data)
+    first = tree_digest(proc.data)
     pictures.refresh(proc.id)
     proc.data = generate(4).procedure.to_dict()
     proc.save()
-    second = pictures.digest(proc.data)
+    second = tree_digest(proc.data)
     pictures.refresh(proc.id)
     pictures.refresh(proc.id)  # the first save's refresh, late: it reads the stored tree, not its own
     assert kept(proc) == [f"{second}-labels.png", f"{second}-thumbnail.png"] and first != second
@@ -104,7 +104,7 @@ def test_pictures_are_cached_by_visibility_and_revalidated_by_digest(alice, as_a
     assert as_bob.get(f"/api/v1/procedures/{private.code}/thumbnail.png").status_code == 404
     assert as_charlie.get(f"/api/v1/procedures/{private.code}/thumbnail.png").status_code == 404
     r = as_alice.get(f"/api/v1/procedures/{private.code}/thumbnail.png")
-    assert r["Cache-Control"] == "private, no-cache" and r["ETag"] == f'"{pictures.digest(private.data)}"'
+    assert r["Cache-Control"] == "private, no-cache" and r["ETag"] == f'"{tree_digest(private.data)}"'
     r = as_charlie.get(f"/api/v1/procedures/{public.code}/thumbnail.png")
     assert r.status_code == 200 and r["Cache-Control"] == "public, max-age=60"
     again = as_charlie.get(f"/api/v1/procedures/{public.code}/thumbnail.png", HTTP_IF_NONE_MATCH=r["ETag"])
@@ -128,9 +128,9 @@ def test_a_picture_drawn_after_an_edit_is_filed_under_the_tree_it_shows(alice, a
     proc.data = generate(4).procedure.to_dict()
     proc.save()  # an edit commits before the picture is drawn
     name, tag, png = pictures.stored(seen, "thumbnail.png")
-    assert tag == pictures.digest(proc.data) and name.endswith(f"{tag}-thumbnail.png") and png
+    assert tag == tree_digest(proc.data) and name.endswith(f"{tag}-thumbnail.png") and png
     r = as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png")
-    assert r["ETag"] == f'"{pictures.digest(proc.data)}"'
+    assert r["ETag"] == f'"{tree_digest(proc.data)}"'
     Procedure.objects.filter(id=proc.id).delete()
     with pytest.raises(LookupError):
         pictures.stored(seen, "labels.png")

@@ -101,8 +101,6 @@ def get_job_for_user(user, code) -> Job:
         *JOB_WITHOUT), code)
 
 
-
-
 def listed(procedures: QuerySet) -> QuerySet:
     """Procedures as lists show them: with their owner and parent, without the JSON columns."""
     return procedures.select_related("owner", "parent").defer(*LISTED_WITHOUT)

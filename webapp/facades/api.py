@@ -79,7 +79,7 @@ def photos(request):
     form = PhotoUploadSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     photo = services.create_photo(request.user, form.validated_data["image"], form.validated_data.get("title", ""),
-                         form.validated_data["visibility"])
+                                  form.validated_data["visibility"])
     return Response(PhotoSerializer(photo).data, status=status.HTTP_201_CREATED)
 
 
@@ -351,8 +351,7 @@ def _picture(request, proc: Procedure, kind: str) -> HttpResponse:
                 try:
                     resp = FileResponse(default_storage.open(name, "rb"), content_type="image/png")
                 except FileNotFoundError:  # an edit's refresh replaced it a moment ago: drawn as it is now
-                    proc.digest = ""
-                    name, tag, png = pictures.stored(proc, kind)
+                    name, tag, png = pictures.stored(proc, kind, redraw=True)
             if png is not None:
                 resp = HttpResponse(png, content_type="image/png")
         except ProcedureError as exc:  # stored before a limit it now breaks
@@ -386,5 +385,5 @@ def procedure_rerun(request, code):
     form = RerunSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     job = services.submit_job(request.user, proc.segmentation, k=form.validated_data["k"], seed=0, prefix=proc,
-                     prefix_nodes=form.validated_data["nodes"])
+                              prefix_nodes=form.validated_data["nodes"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)

@@ -3,6 +3,8 @@ a UUID ``code``; photos and procedures carry a visibility (private, unlisted, pu
 
 from __future__ import annotations
 
+import hashlib
+import json
 import uuid
 
 from django.conf import settings
@@ -73,6 +75,12 @@ class Segmentation(models.Model):
         return f"{self.photo} v{self.version}"
 
 
+def tree_digest(data: dict) -> str:
+    """16 hex digits naming a procedure JSON (its keys sorted); migration 0003 writes the same out."""
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 class Procedure(models.Model):
     code = models.UUIDField(default=uuid.uuid4, unique=True, editable=False)
     owner = models.ForeignKey(settings.AUTH_USER_MODEL, on_delete=models.CASCADE, related_name="procedures")
@@ -84,7 +92,7 @@ class Procedure(models.Model):
     parent = models.ForeignKey("self", on_delete=models.SET_NULL, null=True, blank=True, related_name="forks")
     accuracy = models.FloatField(null=True, blank=True)  # pixel accuracy against the segmentation
     metrics = models.JSONField(default=dict, blank=True)
-    # names the tree in `data` (facades.pictures.digest): its kept pictures' names and ETags, read without `data`
+    # names the tree in `data` (tree_digest): its kept pictures' names and ETags, read without `data`
     digest = models.CharField(max_length=16, blank=True, editable=False)
     visibility = models.CharField(max_length=10, choices=Visibility.choices, default=Visibility.PRIVATE)
     created = models.DateTimeField(default=timezone.now)
@@ -100,12 +108,12 @@ class Procedure(models.Model):
         return reverse("procedure", args=[self.code])
 
     def save(self, *args, **kwargs) -> None:
-        from webapp.facades.pictures import digest
-
-        if "data" not in self.get_deferred_fields():
-            self.digest = digest(self.data)
-            if kwargs.get("update_fields") is not None and "data" in kwargs["update_fields"]:
-                kwargs["update_fields"] = {*kwargs["update_fields"], "digest"}
+        fields = kwargs.get("update_fields")
+        if fields is None and "data" not in self.get_deferred_fields():
+            self.digest = tree_digest(self.data)
+        elif fields is not None and "data" in fields:
+            self.digest = tree_digest(self.data)
+            kwargs["update_fields"] = {*fields, "digest"}
         super().save(*args, **kwargs)
 
     def lineage(self) -> list[Procedure]:

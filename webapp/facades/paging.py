@@ -3,6 +3,5 @@
 from rest_framework.pagination import LimitOffsetPagination
 
 
-class Pagination(LimitOffsetPagination):
-    default_limit = 24
+class Pagination(LimitOffsetPagination):  # the default limit is REST_FRAMEWORK's PAGE_SIZE
     max_limit = 100  # ?limit= beyond this gives this many (an unbounded one reached the database as an overflow)

@@ -9,8 +9,6 @@ are decided from the tree the database holds once it commits, so saves racing ea
 from __future__ import annotations
 
 import contextlib
-import hashlib
-import json
 import logging
 import os
 import uuid
@@ -20,20 +18,24 @@ from django.core.files.storage import default_storage
 from django.db import transaction
 
 from webapp.facades import rendering
+from webapp.facades.models import Procedure
 
 log = logging.getLogger(__name__)
 
 SIDES = {"labels.png": rendering.MAX_RENDER_SIDE, "thumbnail.png": 320}
 
 
-def digest(data: dict) -> str:
-    """16 hex digits naming a procedure JSON (its keys sorted)."""
-    text = json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
 def _folder(code) -> str:
     return f"pictures/{code}"
+
+
+def _name(code, tag: str, kind: str) -> str:
+    return f"{_folder(code)}/{tag}-{kind}"
+
+
+def _tag(name: str) -> str:
+    """The digest a kept picture's name holds (the inverse of `_name`)."""
+    return name.rsplit("/", 1)[1].split("-", 1)[0]
 
 
 def _local_path(name: str) -> str | None:
@@ -65,22 +67,19 @@ def render(data: dict, kind: str) -> bytes:
     return rendering.label_map_png(to_segmentation(Tree.from_dict(data)), SIDES[kind])
 
 
-def stored(proc, kind: str) -> tuple[str, str, bytes | None]:
-    """(storage name, digest, the PNG when this call had to draw it) of the procedure's picture ``kind``. Its
-    tree is read only to draw it, together with the digest it is filed under (an edit may have committed since
-    ``proc`` was read); `LookupError` when the procedure is gone meanwhile. A picture that cannot be kept (a full
-    disk) is logged and still returned."""
-    name = f"{_folder(proc.code)}/{proc.digest}-{kind}"
-    if proc.digest and default_storage.exists(name):
+def stored(proc, kind: str, redraw: bool = False) -> tuple[str, str, bytes | None]:
+    """(storage name, digest, the PNG when this call had to draw it) of the procedure's picture ``kind``; with
+    ``redraw``, drawn even if kept (the kept file just went). Its tree is read only to draw it, together with the
+    digest it is filed under (an edit may have committed since ``proc`` was read); `LookupError` when the
+    procedure is gone meanwhile. A picture that cannot be kept (a full disk) is logged and still returned."""
+    name = _name(proc.code, proc.digest, kind)
+    if not redraw and proc.digest and default_storage.exists(name):
         return name, proc.digest, None
-    from webapp.facades.models import Procedure
-
     row = Procedure.objects.filter(id=proc.id).values_list("digest", "data").first()
     if row is None:
         raise LookupError(f"procedure {proc.code} is gone")
     tag, data = row
-    tag = tag or digest(data)
-    name = f"{_folder(proc.code)}/{tag}-{kind}"
+    name = _name(proc.code, tag, kind)
     png = render(data, kind)
     try:
         _write(name, png)
@@ -96,30 +95,23 @@ def _files(code) -> list[str]:
     return [f"{folder}/{f}" for f in default_storage.listdir(folder)[1]]
 
 
-def _current(procedure_id: int) -> tuple | None:
-    from webapp.facades.models import Procedure
-
-    return Procedure.objects.filter(id=procedure_id).values_list("code", "digest", "data").first()
-
-
 def refresh(procedure_id: int) -> None:
     """Give the procedure the pictures of the tree the database holds now, then delete those of other trees,
     judged again just before (a later save may have committed meanwhile; its refresh draws its own). A failure is
     logged and left to the first request, never raised into the save that committed."""
+    rows = Procedure.objects.filter(id=procedure_id)
     try:
-        row = _current(procedure_id)
+        row = rows.values_list("code", "digest", "data").first()
         if row is None:
             return
         code, tag, data = row
-        tag = tag or digest(data)
         for kind in SIDES:
-            name = f"{_folder(code)}/{tag}-{kind}"
+            name = _name(code, tag, kind)
             if not default_storage.exists(name):
                 _write(name, render(data, kind))
-        latest = _current(procedure_id)
-        keep = {tag, latest[1] if latest else tag}
+        keep = {tag, rows.values_list("digest", flat=True).first() or tag}
         for name in _files(code):
-            if name.rsplit("/", 1)[1].split("-", 1)[0] not in keep and not name.endswith(".partial"):
+            if _tag(name) not in keep and not name.endswith(".partial"):
                 default_storage.delete(name)
     except Exception:
         log.exception("could not render the pictures of procedure %s", procedure_id)
@@ -153,8 +145,6 @@ def connect() -> None:
     """Keep pictures in step with every save and delete of a procedure, wherever it happens (the site, the
     worker, the admin)."""
     from django.db.models.signals import post_delete, post_save
-
-    from webapp.facades.models import Procedure
 
     post_save.connect(_saved, sender=Procedure, dispatch_uid="facaid-pictures-saved")
     post_delete.connect(_deleted, sender=Procedure, dispatch_uid="facaid-pictures-deleted")

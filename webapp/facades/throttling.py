@@ -4,7 +4,8 @@ the general ones, per account for users and per address for everyone else; reads
 (a procedure's JSON, its `labels.png` file) do not count."""
 
 from rest_framework.permissions import SAFE_METHODS
-from rest_framework.throttling import AnonRateThrottle, UserRateThrottle
+from rest_framework.settings import api_settings
+from rest_framework.throttling import UserRateThrottle
 
 
 class HeavyRateThrottle(UserRateThrottle):
@@ -25,7 +26,7 @@ def _light(request, view) -> bool:
         request.resolver_match.url_name in ("api-procedures", "api-procedure")
 
 
-HEAVY = [AnonRateThrottle, UserRateThrottle, HeavyRateThrottle]
+HEAVY = [*api_settings.DEFAULT_THROTTLE_CLASSES, HeavyRateThrottle]  # the site's throttles, and this one
 
 
 def allow_heavy(request) -> tuple[bool, float | None]:

@@ -53,7 +53,7 @@ def photo_new(request):
     if request.method == "POST" and form.is_valid():
         try:
             photo = services.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
-                                     form.cleaned_data["visibility"])
+                                          form.cleaned_data["visibility"])
         except ValidationError as exc:
             form.add_error("image", _error_text(exc).removeprefix("image: "))
         else:

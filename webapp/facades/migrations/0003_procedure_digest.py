@@ -1,4 +1,4 @@
-"""Each procedure keeps a digest of its tree (webapp.facades.pictures.digest, written out here as it is today),
+"""Each procedure keeps a digest of its tree (webapp.facades.models.tree_digest, written out here as it is today),
 so that its pictures are found and revalidated without reading the tree."""
 
 import hashlib
