@@ -126,7 +126,7 @@ def cmd_train(args: argparse.Namespace) -> None:
     from facaid.train import train
 
     last = train(args.config, out=args.out, resume=args.resume, steps=args.steps, until=args.until,
-                 max_hours=args.max_hours, progress=not args.quiet)
+                 max_hours=args.max_hours, workers=args.workers, progress=not args.quiet)
     print(f"checkpoint: {last}")
 
 
@@ -310,6 +310,8 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--until", type=int, help="stop after this step (resume later with --resume)")
     t.add_argument("--max-hours", type=float, help="override train.max_hours: stop and save after this much "
                                                      "wall time (resume later with --resume)")
+    t.add_argument("--workers", type=int, help="override train.workers: processes generating samples (0: in the "
+                                               "training process; on a GPU machine, about its CPU cores)")
     t.add_argument("--quiet", action="store_true", help="no progress bar")
     t.set_defaults(func=cmd_train)
 

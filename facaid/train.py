@@ -359,7 +359,8 @@ def _initial_model(path: str, model_cfg: FacaidConfig, tok_cfg: TokenizerConfig,
 
 
 def train(config_path: str | Path, out: str | None = None, resume: bool = False, steps: int | None = None,
-          until: int | None = None, max_hours: float | None = None, progress: bool = True) -> Path:
+          until: int | None = None, max_hours: float | None = None, workers: int | None = None,
+          progress: bool = True) -> Path:
     """Train per the config; returns the checkpoint directory (OUT/last).
 
     ``steps`` overrides the schedule's length; ``until`` stops (and saves) after that step without changing
@@ -371,6 +372,10 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
         cfg.steps = steps
     if max_hours is not None:
         cfg.max_hours = max_hours
+    if workers is not None:
+        if workers < 0:
+            raise ValueError(f"workers must be >= 0 (0: samples made in the training process), got {workers}")
+        cfg.workers = workers
     out_dir = Path(cfg.out)
     last = out_dir / "last"
     device = torch.device("cuda" if torch.cuda.is_available() else "cpu")

@@ -402,81 +402,87 @@ def test_config_errors(tmp_path):
             load_config(bad)
 
 
-@pytest.mark.parametrize("name", sorted(path.stem for path in (ROOT / "configs").glob("*.toml")))
-def test_committed_configs_build_the_shipped_architecture(name):
-    """The configs that made the shipped checkpoint (and the CPU recipe) parse and describe its model; those before
-    configs/finetune-deep.toml, which appended two decoder blocks (`facaid.model.deepened`), with fewer blocks."""
-    model_config, tok_config, train_config = load_config(ROOT / "configs" / f"{name}.toml")
+EXPERIMENTS = ROOT / "experiments"
+
+
+def _shipped() -> tuple[dict, TokenizerConfig]:
     shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
+    return shipped, TokenizerConfig(**shipped.pop("tokenizer"))
+
+
+@pytest.mark.parametrize("name", sorted(path.stem for path in (ROOT / "configs").glob("*.toml")))
+def test_user_configs_parse_and_shipped_toml_states_the_shipped_model(name):
+    """configs/ holds what a user runs: each parses into a schedule; shipped.toml is the shipped model and tokenizer
+    exactly, the others share its fixed architecture (width, heads, feed-forward)."""
+    model_config, tok_config, train_config = load_config(ROOT / "configs" / f"{name}.toml")
+    assert train_config.steps > 0 and train_config.lr > train_config.min_lr and not train_config.init
+    shipped, shipped_tok = _shipped()
     for key in FIXED:
         assert getattr(model_config, key) == shipped[key], key
-    assert model_config.decoder_layers <= shipped["decoder_layers"]
-    assert model_config.encoder_layers <= shipped["encoder_layers"]
-    shipped_tok = TokenizerConfig(**shipped["tokenizer"])
-    # the configs before configs/finetune-counts.toml read no peer counts, those before configs/finetune-fine.toml
-    # coarser coordinates and one peer rule (`adapt_to_tokenizer` took each to the next); the rest is the same
-    assert shipped_tok.coord_bins % tok_config.coord_bins == 0
-    assert replace(tok_config, count_features=shipped_tok.count_features, peer_rule=shipped_tok.peer_rule,
-                   coord_bins=shipped_tok.coord_bins, aspect_bins=shipped_tok.aspect_bins) == shipped_tok
-    assert train_config.steps > 0 and train_config.lr > train_config.min_lr
+    if name == "shipped":
+        assert tok_config == shipped_tok
+        for key in GROWN:
+            assert getattr(model_config, key) == shipped[key], key
 
 
-def _runs(directory: Path) -> dict[Path, Path]:
-    """The configs of a directory by the weights their runs leave (``train.out``/last, resolved)."""
-    return {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in directory.glob("*.toml")}
+def _runs() -> dict[Path, Path]:
+    """The experiments' configs by the weights their runs leave (``train.out``/last, resolved)."""
+    return {(ROOT / load_config(p)[2].out / "last").resolve(): p for p in EXPERIMENTS.glob("*/config.toml")}
 
 
-def test_the_shipped_checkpoint_is_the_last_committed_run():
-    """The shipped checkpoint is the model and tokenizer of the committed config that the others lead to: the one
-    whose run no other committed config starts from, and every committed run that starts from another's run
-    trains that run's model, or adds to it what `train.init` may add (decoder blocks, the box bias)."""
-    configs = {p.stem: load_config(p) for p in (ROOT / "configs").glob("*.toml")}
-    runs = {run: path.stem for run, path in _runs(ROOT / "configs").items()}
-    parents = {name: runs[(ROOT / cfg.init).resolve()] for name, (_, _, cfg) in configs.items()
-               if (ROOT / cfg.init).resolve() in runs}
+def test_every_experiment_has_its_config_and_notes():
+    folders = [p for p in EXPERIMENTS.iterdir() if p.is_dir()]
+    assert len(folders) >= 15
+    for folder in folders:
+        assert (folder / "config.toml").is_file() and (folder / "notes.md").is_file(), folder.name
+        date, name = folder.name[:10], folder.name[11:]
+        assert date.count("-") == 2 and name, f"{folder.name}: expected YYYY-MM-DD-name"
+        assert (folder / "notes.md").read_text().startswith(f"# {name} ({date})")
+
+
+def test_the_shipped_checkpoint_is_the_last_link_of_the_experiments_chain():
+    """Following ``train.init`` from run to run, the experiments marked as links of the shipped chain lead to one
+    last run whose model and tokenizer are the shipped checkpoint's; each link trains its parent's model or adds
+    what `train.init` may add (decoder blocks, the box bias). Runs tried and not shipped start from the shipped
+    checkpoint or another experiment's run."""
+    runs = _runs()
+    configs = {path.parent.name: load_config(path) for path in runs.values()}
+    chain = {path.parent.name for path in runs.values()
+             if "in the chain that made the shipped checkpoint" in (path.parent / "notes.md").read_text()}
+    assert len(chain) == 15
+    parents = {}
+    for name, (_, _, cfg) in configs.items():
+        init = (ROOT / cfg.init).resolve()
+        if init in runs:
+            parents[name] = runs[init].parent.name
+        elif name in chain:
+            assert cfg.init == "runs/gpu/last" or not cfg.init, f"{name}: init {cfg.init} is no run of the chain"
+        else:
+            assert init == DEFAULT_CHECKPOINT.resolve(), f"{name}: init {cfg.init} is neither shipped nor a run"
     for name, parent in parents.items():
-        model_config, parent_model = configs[name][0], configs[parent][0]  # the tokenizer may read more (above)
+        model_config, parent_model = configs[name][0], configs[parent][0]  # the tokenizer may read more
         for key in FIXED:
             assert getattr(parent_model, key) == getattr(model_config, key), (name, key)
         for key in GROWN:
             assert getattr(parent_model, key) <= getattr(model_config, key), (name, key)
-    last = [name for name in parents if name not in parents.values()]
+    last = [name for name in chain if name not in {parents[n] for n in chain if n in parents}]
     assert len(last) == 1, last
     model_config, tok_config, _ = configs[last[0]]
-    shipped = json.loads((DEFAULT_CHECKPOINT / "config.json").read_text())
-    assert TokenizerConfig(**shipped.pop("tokenizer")) == tok_config
+    shipped, shipped_tok = _shipped()
+    assert shipped_tok == tok_config
     for key in (*FIXED, *GROWN):
         assert shipped[key] == getattr(model_config, key), key
 
 
-EXPERIMENTS = ROOT / "configs" / "experiments"
-
-
-@pytest.mark.parametrize("name", sorted(path.stem for path in EXPERIMENTS.glob("*.toml")))
-def test_experiment_configs_start_from_a_committed_run(name):
-    """The configs of runs that were tried and not shipped parse, and their init is the shipped checkpoint (whose
-    weights then build the model they train), the run of a committed config, or the last weights of another
-    experiment's run that leads to one of these in turn; each link trains the same model and tokenizer."""
-    from facaid.train import _initial_model
-
-    model_config, tok_config, train_config = load_config(EXPERIMENTS / f"{name}.toml")
-    assert train_config.steps > 0 and train_config.lr > train_config.min_lr
-    experiments, committed = _runs(EXPERIMENTS), _runs(ROOT / "configs")
-    init = (ROOT / train_config.init).resolve()
-    for _ in range(len(experiments)):
-        if init == DEFAULT_CHECKPOINT.resolve() or init in committed:
-            break
-        assert init in experiments, f"{name}: init {init} is neither the shipped checkpoint nor a committed run"
-        parent_model, parent_tok, parent = load_config(experiments[init])
-        assert (parent_model, parent_tok) == (model_config, tok_config), f"{experiments[init].stem} trains another"
-        init = (ROOT / parent.init).resolve()
-    if init in committed:  # its weights are not committed; its config must train the same model
-        assert load_config(committed[init])[:2] == (model_config, tok_config), f"{committed[init].stem} trains another"
-        return
-    assert init == DEFAULT_CHECKPOINT.resolve()
-    model = _initial_model(str(init), model_config, tok_config, "cpu")  # every run of the chain trains this model
-    for key in (*FIXED, *GROWN):
-        assert getattr(model.config, key) == getattr(model_config, key), key
+def test_the_shipped_checkpoint_holds_weights_config_tokenizer_and_a_model_card():
+    """No optimizer state and no logs: --resume state lives in a run's directory, logs in experiments/."""
+    assert {p.name for p in DEFAULT_CHECKPOINT.iterdir()} == {"config.json", "model.safetensors", "tokenizer.json",
+                                                             "README.md"}
+    card = (DEFAULT_CHECKPOINT / "README.md").read_text()
+    header, _, body = card.removeprefix("---\n").partition("\n---\n")
+    assert card.startswith("---\n") and "license:" in header and "pipeline_tag:" in header
+    for section in ("## Training data", "## Figures", "## Limits", "## How it was made"):
+        assert section in body, section
 
 
 def test_learning_rate_schedule():
