@@ -23,7 +23,8 @@ from __future__ import annotations
 import math
 from statistics import median_high
 
-from facaid.grammar.execute import execute_with_boxes, expand, layout, leaf_array, repeat_count
+from facaid.grammar.execute import execute_with_boxes, leaf_array
+from facaid.grammar.layout import expand, layout, repeat_count
 from facaid.grammar.procedure import Node, Procedure
 from facaid.labels import LABEL_ID, hex_colour
 

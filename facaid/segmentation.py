@@ -163,9 +163,24 @@ def _compressed_grid(width: int, height: int, arr: np.ndarray) -> tuple[np.ndarr
     ix0, ix1 = np.searchsorted(xs, arr[:, 1]), np.searchsorted(xs, arr[:, 3])
     iy0, iy1 = np.searchsorted(ys, arr[:, 2]), np.searchsorted(ys, arr[:, 4])
     grid = np.zeros((len(ys) - 1, len(xs) - 1), dtype=np.uint8)
-    for lab, a, b, c, d in zip(arr[:, 0].tolist(), iy0.tolist(), iy1.tolist(), ix0.tolist(), ix1.tolist(),
-                               strict=True):
-        grid[a:b, c:d] = lab
+    rows, cols = iy1 - iy0, ix1 - ix0
+    cells = rows * cols
+    total = int(cells.sum())
+    if total > 4 * grid.size + 4096:  # much overlap: paint rectangle by rectangle
+        for lab, a, b, c, d in zip(arr[:, 0].tolist(), iy0.tolist(), iy1.tolist(), ix0.tolist(), ix1.tolist(),
+                                   strict=True):
+            grid[a:b, c:d] = lab
+        return xs, ys, grid
+    # every covered cell at once: each takes the label of the last rectangle painted over it (the highest
+    # position in paint order), as painting them in turn would
+    owner = np.repeat(np.arange(len(arr)), cells)
+    k = np.arange(total) - np.repeat(np.cumsum(cells) - cells, cells)
+    r = iy0[owner] + k // cols[owner]
+    c = ix0[owner] + k % cols[owner]
+    top = np.full(grid.shape, -1, dtype=np.int64)
+    np.maximum.at(top, (r, c), owner)
+    covered = top >= 0
+    grid[covered] = arr[top[covered], 0]
     return xs, ys, grid
 
 

@@ -29,7 +29,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from facaid.grammar.execute import fill_counts, layout
+from facaid.grammar.execute import fill_counts
+from facaid.grammar.layout import layout
 from facaid.grammar.procedure import (
     GRAMMAR_VERSION,
     MAX_CHILDREN,

@@ -9,7 +9,8 @@ from __future__ import annotations
 import random
 
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.grammar.execute import expand, first_boxes, layout
+from facaid.grammar.execute import first_boxes
+from facaid.grammar.layout import expand, layout
 from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Node, Procedure, ProcedureError, Size, validate
 
 

@@ -147,3 +147,16 @@ def test_stats_compare_generated_with_cmp(cmp_records):
     assert distance(real, real) == 0.0
     table = format_table(generated, real)
     assert "window" in table and "total variation" in table
+
+
+def test_a_dataset_record_is_the_sample_written_out():
+    """`sample_record` writes the rows `generate_rows` returns without building a `Segmentation`: the same JSON as
+    the sample's own, and the procedure `generate_procedure` validates."""
+    from facaid.generator.dataset import sample_record, sample_seed
+
+    for index in range(25):
+        record = sample_record(3, index)
+        sample = generate(sample_seed(3, index))
+        assert record["segmentation"] == sample.segmentation.to_dict()
+        assert record["procedure"] == sample.procedure.to_dict() == generate_procedure(sample.seed).to_dict()
+        assert (record["seed"], record["style"]) == (sample.seed, sample.style)

@@ -6,7 +6,7 @@ import pytest
 import torch
 
 import facaid.grammar as grammar_pkg
-from facaid.grammar import Node, Procedure, ProcedureError, Size, execute, layout, to_segmentation
+from facaid.grammar import Node, Procedure, ProcedureError, Size, execute, layout, to_segmentation, validate
 from facaid.grammar.differentiable import compile_plan, execute_plan, execute_torch
 from facaid.grammar.procedure import MAX_DEPTH, MAX_NODES
 from facaid.labels import LABELS
@@ -215,3 +215,24 @@ def test_with_parameters_validates():
         p.with_parameters(values)
     with pytest.raises(ValueError, match="expected"):
         p.with_parameters(values[:-1])
+
+
+def test_leaf_count_is_the_executed_count_and_stops_past_the_limit():
+    from facaid.generator import generate_procedure
+    from facaid.grammar.execute import execute_with_boxes, first_boxes
+    from facaid.grammar.layout import count_leaves
+    from facaid.grammar.limits import MAX_LEAVES
+
+    for seed in range(60):
+        proc = generate_procedure(seed)
+        leaves, boxes = execute_with_boxes(proc)
+        assert count_leaves(proc.root, proc.width, proc.height) == len(leaves)
+        assert first_boxes(proc) == boxes  # visiting each node once finds the same first boxes
+    cell = Node.leaf("window")
+    row = Node.repeat("x", 256, [(Size("flt", 1.0), cell)])
+    grid = Node.repeat("y", 256, [(Size("flt", 1.0), row)])
+    huge = Procedure(1000, 1000, Node.repeat("x", 2, [(Size("flt", 1.0), grid)]))  # 131,072 leaves
+    assert count_leaves(huge.root, 1000, 1000) == MAX_LEAVES + 1
+    assert count_leaves(grid, 1000, 1000, limit=10**6) == 65_536
+    with pytest.raises(ProcedureError, match=f"expands to more than {MAX_LEAVES} rectangles"):
+        validate(huge)

@@ -17,7 +17,7 @@ repeat that draws the same row (`_plain_row`).
 from __future__ import annotations
 
 from facaid.grammar.execute import first_boxes
-from facaid.grammar.procedure import Node, Procedure, Size, validate
+from facaid.grammar.procedure import Node, Procedure, Size
 
 MIN_GAP = 1 / 128  # of the image side: narrower wall or background is not part of the canonical tree
 IMPLICIT = ("facade", "background")
@@ -25,7 +25,7 @@ SLOT_ROLES = ("floor", "ground")  # roles of a slot in the facade's layout, what
 
 
 def canonical(proc: Procedure) -> Procedure:
-    """The procedure with invisible gaps removed (in place); returns it, validated."""
+    """The procedure with invisible gaps removed (in place); returns it (`generate_procedure` validates it)."""
     boxes = first_boxes(proc)
 
     def invisible(node: Node, axis: str) -> bool:
@@ -54,7 +54,6 @@ def canonical(proc: Procedure) -> Procedure:
         return node
 
     proc.root = visit(proc.root)
-    validate(proc)
     return proc
 
 

@@ -18,8 +18,9 @@ from pathlib import Path
 import orjson
 from tqdm import tqdm
 
-from facaid.generator import STYLE_NAMES, generate
+from facaid.generator import STYLE_NAMES, generate_rows
 from facaid.grammar.procedure import GRAMMAR_VERSION
+from facaid.labels import LABELS
 
 MANIFEST = "manifest.json"
 
@@ -31,13 +32,16 @@ def sample_seed(seed: int, index: int) -> int:
 
 
 def sample_record(seed: int, index: int, style: str | None = None) -> dict:
-    s = generate(sample_seed(seed, index), style)
+    """Sample ``index`` of the dataset as its JSON record (the segmentation as `Segmentation.to_dict` writes it)."""
+    proc, rows = generate_rows(sample_seed(seed, index), style)
     return {
         "id": f"s{seed}-{index:08d}",
-        "seed": s.seed,
-        "style": s.style,
-        "segmentation": s.segmentation.to_dict(),
-        "procedure": s.procedure.to_dict(),
+        "seed": proc.meta["seed"],
+        "style": proc.meta["style"],
+        "segmentation": {"width": round(proc.width), "height": round(proc.height),
+                         "rects": [{"label": LABELS[k], "x0": x0, "y0": y0, "x1": x1, "y1": y1}
+                                   for k, x0, y0, x1, y1 in rows.tolist()]},
+        "procedure": proc.to_dict(),
     }
 
 

@@ -1,6 +1,7 @@
 """The FaçAID split grammar: procedures (derivation trees), their JSON form, and their execution."""
 
-from facaid.grammar.execute import execute, layout, to_segmentation
+from facaid.grammar.execute import execute, to_segmentation
+from facaid.grammar.layout import layout
 from facaid.grammar.procedure import (
     GRAMMAR_VERSION,
     Node,

@@ -10,66 +10,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from facaid.grammar.procedure import MAX_COUNT, MAX_LEAVES, Node, Procedure, ProcedureError, Size
+from facaid.grammar.layout import expand, layout
+from facaid.grammar.procedure import MAX_LEAVES, Node, Procedure, ProcedureError
 from facaid.labels import BACKGROUND, LABEL_ID
 from facaid.segmentation import Segmentation
-
-
-def nominal(size: Size, length: float) -> float:
-    """The length a size asks for before floating sizes share the remainder."""
-    return size.value * length if size.mode == "rel" else size.value
-
-
-def repeat_count(node: Node, length: float) -> int:
-    """How many times a repeat node lays out its pattern in a region of the given length."""
-    if node.count != "fill":
-        return node.count
-    pattern = sum(nominal(s, length) for s in node.sizes)
-    tail = sum(nominal(s, length) for s in node.sizes[: node.tail])
-    return max(1, min(MAX_COUNT, int((length - tail) / pattern + 0.5)))
-
-
-def expand(node: Node, length: float) -> tuple[list[Size], list[Node], list[bool]]:
-    """The plain split a repeat or mirror node stands for: (sizes, children, reflected) along its axis."""
-    if node.rule == "split":
-        return node.sizes, node.children, [False] * len(node.children)
-    if node.rule == "repeat":
-        n = repeat_count(node, length)
-        t = node.tail
-        return (node.sizes * n + node.sizes[:t], node.children * n + node.children[:t],
-                [False] * (len(node.children) * n + t))
-    # mirror
-    back = list(range(len(node.children) - (2 if node.center else 1), -1, -1))
-    return (node.sizes + [node.sizes[i] for i in back], node.children + [node.children[i] for i in back],
-            [False] * len(node.children) + [True] * len(back))
-
-
-def layout(sizes: list[Size], length: float) -> list[float]:
-    """Lengths of the children of a split of the given length (see the rules in `procedure`). A length below 0
-    (a last child laid out where rounding put its start a hair past its end) counts as 0."""
-    length = max(length, 0.0)
-    fixed = 0.0
-    weights = 0.0
-    for s in sizes:
-        if s.mode == "flt":
-            weights += s.value
-        else:
-            fixed += s.value * length if s.mode == "rel" else s.value
-    if weights > 0:
-        scale = length / fixed if fixed > length else 1.0
-        share = max(length - fixed, 0.0) / weights
-    else:
-        scale = length / fixed if fixed > 0 else 0.0
-        share = 0.0
-    out = []
-    for s in sizes:
-        if s.mode == "flt":
-            out.append(s.value * share)
-        elif s.mode == "rel":
-            out.append(s.value * length * scale)
-        else:
-            out.append(s.value * scale)
-    return out
 
 
 @dataclass
@@ -92,6 +36,7 @@ class _Executor:
         self.layouts: dict[tuple[int, float], tuple] = {}  # repeated copies share their layout
         self.fill_counts: dict[int, int] = {}
         self.first_boxes: dict[int, tuple[float, float, float, float]] | None = None  # set to record them
+        self.once = False  # with first_boxes: skip a node seen before, with its subtree (no leaves are output)
         self.offsets: dict[int, int] = {}
         if trace is not None:
             k = 0
@@ -123,6 +68,7 @@ class _Executor:
         trace = self.trace
         pidx = self._param_indices(node, len(sizes)) if trace is not None else None
         n_pattern = len(node.children)
+        out, once, seen = self.out, self.once, self.first_boxes
         pos = hi if flip else lo
         last = len(children) - 1
         for i, child in enumerate(children):
@@ -134,6 +80,13 @@ class _Executor:
                 a, b = pos, (hi if i == last else pos + length)
                 pos = b
             sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)
+            if once:
+                if id(child) not in seen:  # a later copy's subtree's first boxes are known
+                    if child.rule == "leaf":
+                        seen[id(child)] = sub
+                    else:
+                        self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), -1)
+                continue
             child_id = -1
             if trace is not None:
                 child_id = len(trace.depth)
@@ -144,7 +97,10 @@ class _Executor:
                 trace.axis.append(node.axis)
                 trace.flip.append(flip)
             if child.rule == "leaf" and self.first_boxes is None:  # most nodes are leaves: no call
-                self.leaf(child, sub, (where, i % n_pattern), child_id)
+                if trace is None and len(out) < MAX_LEAVES:
+                    out.append((LABEL_ID[child.label], *sub))
+                else:
+                    self.leaf(child, sub, (where, i % n_pattern), child_id)
             else:
                 self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), child_id)
 
@@ -198,8 +154,14 @@ def fill_counts(proc: Procedure) -> dict[int, int]:
 
 
 def first_boxes(proc: Procedure) -> dict[int, tuple[float, float, float, float]]:
-    """The box of the first instance of every node, keyed by ``id(node)``."""
-    return execute_with_boxes(proc)[1]
+    """The box of the first instance of every node, keyed by ``id(node)``. Each node is visited once, where it
+    first occurs depth-first: the later copies of a repeat or mirror are skipped with their subtrees, whose first
+    instances all came before them (the boxes are those `execute_with_boxes` records)."""
+    ex = _Executor(proc, None)
+    ex.first_boxes = {}
+    ex.once = True
+    ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
+    return ex.first_boxes
 
 
 def execute_with_boxes(proc: Procedure) -> tuple[list[tuple[int, float, float, float, float]],
@@ -209,10 +171,6 @@ def execute_with_boxes(proc: Procedure) -> tuple[list[tuple[int, float, float, f
     ex.first_boxes = {}
     ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
     return ex.out, ex.first_boxes
-
-
-def count_leaves(proc: Procedure) -> int:
-    return len(execute(proc))
 
 
 def leaf_array(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None

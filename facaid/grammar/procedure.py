@@ -27,9 +27,18 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
+from facaid.grammar.layout import count_leaves
+from facaid.grammar.limits import (
+    MAX_CHILDREN,
+    MAX_COUNT,
+    MAX_DEPTH,
+    MAX_EXTENT,
+    MAX_LEAVES,
+    MAX_META_CHARS,
+    MAX_NODES,
+)
 from facaid.labels import LABEL_ID, LABELS
 from facaid.numbers import finite
-from facaid.segmentation import MAX_SIDE
 
 FORMAT = "facaid-procedure"
 FORMAT_VERSION = 1
@@ -54,13 +63,11 @@ ROLES = (
     "margin",  # wall or background at the edges
 )
 
-MAX_DEPTH = 32
-MAX_NODES = 8192
-MAX_CHILDREN = 64
-MAX_COUNT = 256
-MAX_LEAVES = 100_000  # rectangles after repeats and mirrors are expanded
-MAX_META_CHARS = 65_536
-MAX_EXTENT = float(MAX_SIDE)  # pixels: a procedure executes to a segmentation, whose sides stop there too
+__all__ = [
+    "AXES", "FORMAT", "FORMAT_VERSION", "GRAMMAR_VERSION", "MAX_CHILDREN", "MAX_COUNT", "MAX_DEPTH", "MAX_EXTENT",
+    "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES", "Node", "Procedure", "ProcedureError",
+    "Size", "parse_procedure", "validate",
+]
 
 
 class ProcedureError(ValueError):
@@ -364,9 +371,5 @@ def validate(proc: Procedure) -> None:
 
 
 def _check_expansion(proc: Procedure) -> None:
-    # Imported here: the executor depends on this module, not the other way round.
-    from facaid.grammar.execute import count_leaves
-
-    n = count_leaves(proc)
-    if n > MAX_LEAVES:
-        raise ProcedureError("root", f"expands to {n} rectangles (at most {MAX_LEAVES})")
+    if count_leaves(proc.root, proc.width, proc.height) > MAX_LEAVES:
+        raise ProcedureError("root", f"expands to more than {MAX_LEAVES} rectangles")

@@ -1,0 +1,111 @@
+"""How a node lays out its children along its axis: the grammar's sizing rules, in plain Python floats.
+
+Shared by the executor (`facaid.grammar.execute`) and by validation (`count_leaves`, which bounds what a
+procedure expands to without executing it). Nodes are `facaid.grammar.procedure.Node` objects, sizes `Size`s
+(``mode``, ``value``); this module reads their attributes and imports neither, so that the procedure module can
+use it.
+"""
+
+from __future__ import annotations
+
+from facaid.grammar.limits import MAX_COUNT, MAX_LEAVES
+
+
+def nominal(size, length: float) -> float:
+    """The length a size asks for before floating sizes share the remainder."""
+    return size.value * length if size.mode == "rel" else size.value
+
+
+def repeat_count(node, length: float) -> int:
+    """How many times a repeat node lays out its pattern in a region of the given length."""
+    if node.count != "fill":
+        return node.count
+    pattern = sum(nominal(s, length) for s in node.sizes)
+    tail = sum(nominal(s, length) for s in node.sizes[: node.tail])
+    return max(1, min(MAX_COUNT, int((length - tail) / pattern + 0.5)))
+
+
+def expand(node, length: float) -> tuple[list, list, list[bool]]:
+    """The plain split a repeat or mirror node stands for: (sizes, children, reflected) along its axis."""
+    if node.rule == "split":
+        return node.sizes, node.children, [False] * len(node.children)
+    if node.rule == "repeat":
+        n = repeat_count(node, length)
+        t = node.tail
+        return (node.sizes * n + node.sizes[:t], node.children * n + node.children[:t],
+                [False] * (len(node.children) * n + t))
+    # mirror
+    back = list(range(len(node.children) - (2 if node.center else 1), -1, -1))
+    return (node.sizes + [node.sizes[i] for i in back], node.children + [node.children[i] for i in back],
+            [False] * len(node.children) + [True] * len(back))
+
+
+def layout(sizes: list, length: float) -> list[float]:
+    """Lengths of the children of a split of the given length (see the rules in `procedure`). A length below 0
+    (a last child laid out where rounding put its start a hair past its end) counts as 0."""
+    length = max(length, 0.0)
+    fixed = 0.0
+    weights = 0.0
+    for s in sizes:
+        if s.mode == "flt":
+            weights += s.value
+        else:
+            fixed += s.value * length if s.mode == "rel" else s.value
+    if weights > 0:
+        scale = length / fixed if fixed > length else 1.0
+        share = max(length - fixed, 0.0) / weights
+    else:
+        scale = length / fixed if fixed > 0 else 0.0
+        share = 0.0
+    out = []
+    for s in sizes:
+        if s.mode == "flt":
+            out.append(s.value * share)
+        elif s.mode == "rel":
+            out.append(s.value * length * scale)
+        else:
+            out.append(s.value * scale)
+    return out
+
+
+class _TooMany(Exception):
+    pass
+
+
+def count_leaves(root, width: float, height: float, limit: int = MAX_LEAVES) -> int:
+    """How many rectangles a tree expands to in a ``width`` x ``height`` image, or ``limit + 1`` as soon as it is
+    more than ``limit``. Counted from the regions' extents without laying out positions: the copies of a repeat
+    (same node, same extent) are counted once, so a tree of a million leaves costs what its distinct nodes do.
+    (The executor places copies at float offsets, so a copy's extent may differ from this one's by a rounding
+    error, which could move a ``"fill"`` count only if its quotient sat exactly on a half: a bound, not a layout.)
+    """
+    memo: dict[tuple[int, float, float], int] = {}
+    total = 0
+
+    def count(node, w: float, h: float) -> int:
+        nonlocal total
+        if node.rule == "leaf":
+            total += 1
+            if total > limit:
+                raise _TooMany
+            return 1
+        key = (id(node), w, h)
+        known = memo.get(key)
+        if known is not None:
+            total += known
+            if total > limit:
+                raise _TooMany
+            return known
+        along_x = node.axis == "x"
+        length = w if along_x else h
+        sizes, children, _ = expand(node, length)
+        n = 0
+        for child, extent in zip(children, layout(sizes, length), strict=True):
+            n += count(child, extent, h) if along_x else count(child, w, extent)
+        memo[key] = n
+        return n
+
+    try:
+        return count(root, float(width), float(height))
+    except _TooMany:
+        return limit + 1
