@@ -6,7 +6,7 @@ Held-out generated facades (dataset seed 1100, not the model's training or valid
 induced procedure's pixel accuracy against its own input before and after sizing, its node count beside the
 generator's true procedure and the exact guillotine decomposition (`facaid.grammar.decompose`), and the time
 to induce and size it. Jittered inputs move every element edge by N(0, sigma x the longer side) pixels, as
-`facaid.evaluation.noise.jitter` does. This is where the defaults of `induce_procedure` were chosen; the CMP
+`facaid.augmentation.jitter` does. This is where the defaults of `induce_procedure` were chosen; the CMP
 facades are never used for that.
 """
 
@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from facaid.evaluation.noise import jitter
+from facaid.augmentation import jitter
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.grammar.decompose import procedure_from_segmentation

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from facaid.grammar.decompose import _chunked, _cut_rects, _least_crossed_cut, _partition
+from facaid.grammar.guillotine import chunked_split, cut_rects, least_crossed_cut, partition
 from facaid.grammar.procedure import MAX_COUNT, Node, Procedure, ProcedureError, Size
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.segmentation import Segmentation
@@ -193,8 +193,8 @@ class _Inducer:
                 if 1 < len(strict[1]) < len(next((o[2] for o in options if o[0] == axis), [])):
                     options.append((axis, *strict))
         if not options:
-            axis, lo_col, hi_col, lo, hi, cut = _least_crossed_cut(rects, box)
-            options.append((axis, *_bands(_cut_rects(rects, [cut], lo_col, hi_col), lo_col, hi_col, 0.0)))
+            axis, lo_col, hi_col, lo, hi, cut = least_crossed_cut(rects, box)
+            options.append((axis, *_bands(cut_rects(rects, [cut], lo_col, hi_col), lo_col, hi_col, 0.0)))
         if depth >= self.lookahead or len(options) == 1:
             return self._split(box, depth, *options[0])
         trees = [self._split(box, depth, *o) for o in options]
@@ -321,7 +321,7 @@ def _node(tree: _Tree) -> Node:
             modes[max(found, key=lambda i: lengths[i])] = "flt"
             break
     items = [(Size(m, v), c) for m, v, c in zip(modes, tree.lengths, children, strict=True)]
-    return _chunked(tree.axis, items, lengths)
+    return chunked_split(tree.axis, items, lengths)
 
 
 def induce_procedure(seg: Segmentation, *, snap: float = 0.01, tolerance: float = 0.15, min_px: float = 2.0,
@@ -332,7 +332,7 @@ def induce_procedure(seg: Segmentation, *, snap: float = 0.01, tolerance: float 
     top ``lookahead`` levels try every way to cut and keep the shortest. Chosen on generated facades, clean
     and jittered (bench/bench_induce.py)."""
     tol = max(1.0, snap * max(seg.width, seg.height))
-    rects = _partition(seg)
+    rects = partition(seg)
     rects = _clean(rects[rects[:, 0] != FACADE], tol)  # the wall is what the elements and background leave
     tree = _Inducer(tol, tolerance, min_px, lookahead).cut(rects, (0, 0, seg.width, seg.height), True)
     proc = Procedure(seg.width, seg.height, _node(tree), {"source": "facaid.induce"})

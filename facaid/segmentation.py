@@ -154,7 +154,7 @@ def rasterize(seg: Segmentation) -> np.ndarray:
     return out
 
 
-def _compressed_grid(width: int, height: int, arr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def compressed_grid(width: int, height: int, arr: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The label map on the grid of all rectangle edges: (xs, ys, grid) with grid[j, i] the label of
     the cell [xs[i], xs[i+1]) x [ys[j], ys[j+1]). ``arr`` holds rows (label, x0, y0, x1, y1)."""
     arr = arr[np.argsort(np.asarray(PRIORITY)[arr[:, 0]], kind="stable")]  # paint order
@@ -184,7 +184,7 @@ def _compressed_grid(width: int, height: int, arr: np.ndarray) -> tuple[np.ndarr
     return xs, ys, grid
 
 
-def _decompose(grid: np.ndarray) -> np.ndarray:
+def decompose_grid(grid: np.ndarray) -> np.ndarray:
     """Canonical rectangle decomposition of the non-zero cells of a label grid.
 
     Each row is cut into maximal runs of one label; a run continues the rectangle above it when that
@@ -234,13 +234,13 @@ def flatten_array(width: int, height: int, arr: np.ndarray, wall: str = "pieces"
         raise ValueError(f"wall must be 'pieces' or 'footprint', got {wall!r}")
     if len(arr) == 0:
         return np.zeros((0, 5), dtype=np.int64)
-    xs, ys, grid = _compressed_grid(width, height, arr)
+    xs, ys, grid = compressed_grid(width, height, arr)
     if wall == "pieces":
-        cells = _decompose(grid)
+        cells = decompose_grid(grid)
     else:
         footprint = np.where(grid != BACKGROUND, FACADE, 0).astype(np.uint8)
         elements = np.where(grid > FACADE, grid, 0).astype(np.uint8)
-        cells = np.concatenate([_decompose(footprint), _decompose(elements)])
+        cells = np.concatenate([decompose_grid(footprint), decompose_grid(elements)])
     out = np.stack([cells[:, 0], xs[cells[:, 1]], ys[cells[:, 2]], xs[cells[:, 3]], ys[cells[:, 4]]], axis=1)
     return out[np.lexsort((out[:, 0], out[:, 1], out[:, 2]))]
 

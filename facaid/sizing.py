@@ -22,6 +22,7 @@ import numpy as np
 import torch
 
 from facaid.grammar.differentiable import compile_plan, execute_plan
+from facaid.grammar.guillotine import partition
 from facaid.grammar.procedure import Procedure, ProcedureError
 from facaid.labels import FACADE, LABELS
 from facaid.metrics import procedure_accuracy, procedure_iou, scaled_label_map
@@ -228,9 +229,7 @@ def _polish(plan, free: torch.Tensor, is_rel: torch.Tensor, labels: torch.Tensor
 def _target_rects(target: Segmentation) -> np.ndarray:
     """Rows (label, x0, y0, x1, y1) of the target's element and background rectangles (facade pieces left
     out: the wall is what the elements leave)."""
-    from facaid.grammar.decompose import _partition
-
-    rows = _partition(target)
+    rows = partition(target)
     return rows[rows[:, 0] != FACADE]
 
 

@@ -23,7 +23,7 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
-from facaid.evaluation.noise import jitter
+from facaid.augmentation import jitter
 from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
 from facaid.grammar.procedure import MODES
@@ -156,7 +156,7 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
                  styles: tuple[float, ...] | None = None):
     """The training example of sample ``index`` of dataset ``seed``: (rows, (ids, local, boxes)), or None when
     the facade is too long for the model. ``noise`` = (share, sigma): that share of the inputs get their edges
-    jittered (`facaid.evaluation.noise.jitter`, sigma uniform in [0, sigma]), seeded by the sample. ``styles``:
+    jittered (`facaid.augmentation.jitter`, sigma uniform in [0, sigma]), seeded by the sample. ``styles``:
     weights of the generator styles (`sample_style`)."""
     s = generate(sample_seed(seed, index), sample_style(seed, index, styles))
     c = tokenizer.config

@@ -2,9 +2,9 @@ import json
 
 import pytest
 
+from facaid.augmentation import changed_fraction, perturb
 from facaid.cli import main
 from facaid.decoding import decode
-from facaid.evaluation.noise import changed_fraction, perturb
 from facaid.evaluation.records import RecordsError
 from facaid.evaluation.synthetic import by_style, evaluate_synthetic, nll, write_report
 from facaid.generator import generate

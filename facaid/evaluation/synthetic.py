@@ -18,9 +18,9 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from facaid.augmentation import perturb
 from facaid.decoding import decode, ranked_candidates
 from facaid.defaults import FLOOR_TOLERANCE, TEMPERATURE
-from facaid.evaluation.noise import perturb
 from facaid.evaluation.records import RecordLog, model_digest
 from facaid.evaluation.ted import tree_edit_distance, tree_size
 from facaid.generator import generate

@@ -12,30 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from facaid.grammar.procedure import MAX_CHILDREN, Node, Procedure, Size
+from facaid.grammar.guillotine import chunked_split, clean_cuts, cut_rects, least_crossed_cut, partition
+from facaid.grammar.procedure import Node, Procedure, Size
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS
-from facaid.segmentation import Segmentation, _compressed_grid, _decompose
-
-
-def _partition(seg: Segmentation) -> np.ndarray:
-    """Canonical rectangles (label, x0, y0, x1, y1) covering the whole image, background included."""
-    arr = seg.to_array()
-    if len(arr) == 0:
-        return np.array([[BACKGROUND, 0, 0, seg.width, seg.height]], dtype=np.int64)
-    xs, ys, grid = _compressed_grid(seg.width, seg.height, arr)
-    cells = _decompose(grid.astype(np.int64) + 1)  # + 1: background is kept as a rectangle too
-    return np.stack([cells[:, 0] - 1, xs[cells[:, 1]], ys[cells[:, 2]], xs[cells[:, 3]], ys[cells[:, 4]]], axis=1)
-
-
-def _cuts(rects: np.ndarray, lo_col: int, hi_col: int, lo: int, hi: int) -> list[int]:
-    """Positions strictly inside (lo, hi) where a line along the other axis crosses no rectangle."""
-    edges = np.unique(np.concatenate([rects[:, lo_col], rects[:, hi_col]]))
-    edges = edges[(edges > lo) & (edges < hi)]
-    if len(edges) == 0:
-        return []
-    starts, stops = rects[:, lo_col], rects[:, hi_col]
-    crossed = ((starts[None, :] < edges[:, None]) & (stops[None, :] > edges[:, None])).any(axis=1)
-    return edges[~crossed].tolist()
+from facaid.segmentation import Segmentation
 
 
 def _sizes(lengths: list[int], labels: list[int | None]) -> list[Size]:
@@ -55,13 +35,13 @@ def _build(rects: np.ndarray, box: tuple[int, int, int, int], prefer_y: bool, de
     axes = ("y", "x") if prefer_y else ("x", "y")
     for axis in axes:
         lo_col, hi_col, lo, hi = (2, 4, y0, y1) if axis == "y" else (1, 3, x0, x1)
-        cuts = _cuts(rects, lo_col, hi_col, lo, hi)
+        cuts = clean_cuts(rects, lo_col, hi_col, lo, hi)
         if cuts:
             break
     else:  # no clean cut: cut once where the fewest rectangles are crossed, cutting those in two
-        axis, lo_col, hi_col, lo, hi, cut = _least_crossed_cut(rects, box)
+        axis, lo_col, hi_col, lo, hi, cut = least_crossed_cut(rects, box)
         cuts = [cut]
-        rects = _cut_rects(rects, cuts, lo_col, hi_col)
+        rects = cut_rects(rects, cuts, lo_col, hi_col)
     bounds = [lo, *cuts, hi]
     items: list[tuple[Size, Node]] = []
     for a, b in zip(bounds[:-1], bounds[1:], strict=True):
@@ -75,49 +55,11 @@ def _build(rects: np.ndarray, box: tuple[int, int, int, int], prefer_y: bool, de
             items.append((Size("abs", float(b - a)), child))
     lengths = [int(size.value) for size, _ in items]
     labels = [LABEL_ID[child.label] if child.rule == "leaf" else None for _, child in items]
-    return _chunked(axis, list(zip(_sizes(lengths, labels), [c for _, c in items], strict=True)), lengths)
-
-
-def _chunked(axis: str, items: list[tuple[Size, Node]], lengths: list[int]) -> Node:
-    """A split, nested in groups when it has more children than a node may hold."""
-    if len(items) <= MAX_CHILDREN:
-        return Node.split(axis, items)
-    step = -(-len(items) // MAX_CHILDREN)  # ceil: at most MAX_CHILDREN groups
-    groups = []
-    for k in range(0, len(items), step):
-        part = items[k : k + step]
-        groups.append((Size("abs", float(sum(lengths[k : k + step]))),
-                       part[0][1] if len(part) == 1 else Node.split(axis, part)))
-    return _chunked(axis, groups, [int(g.value) for g, _ in groups])
-
-
-def _least_crossed_cut(rects: np.ndarray, box: tuple[int, int, int, int]) -> tuple:
-    best = None
-    for axis, lo_col, hi_col, lo, hi in (("y", 2, 4, box[1], box[3]), ("x", 1, 3, box[0], box[2])):
-        edges = np.unique(np.concatenate([rects[:, lo_col], rects[:, hi_col]]))
-        edges = edges[(edges > lo) & (edges < hi)]
-        crossed = ((rects[None, :, lo_col] < edges[:, None]) & (rects[None, :, hi_col] > edges[:, None])).sum(axis=1)
-        for e, c in zip(edges.tolist(), crossed.tolist(), strict=True):
-            key = (c, abs(2 * e - lo - hi) / (hi - lo))
-            if best is None or key < best[0]:
-                best = (key, (axis, lo_col, hi_col, lo, hi, e))
-    return best[1]
-
-
-def _cut_rects(rects: np.ndarray, cuts: list[int], lo_col: int, hi_col: int) -> np.ndarray:
-    """Split every rectangle at the given positions along one axis."""
-    out = []
-    for r in rects.tolist():
-        points = [r[lo_col], *[c for c in cuts if r[lo_col] < c < r[hi_col]], r[hi_col]]
-        for a, b in zip(points[:-1], points[1:], strict=True):
-            piece = list(r)
-            piece[lo_col], piece[hi_col] = a, b
-            out.append(piece)
-    return np.array(out, dtype=np.int64)
+    return chunked_split(axis, list(zip(_sizes(lengths, labels), [c for _, c in items], strict=True)), lengths)
 
 
 def procedure_from_segmentation(seg: Segmentation) -> Procedure:
     """An exact procedure for the flattened segmentation: executing it gives back its label map."""
-    rects = _partition(seg)
+    rects = partition(seg)
     root = _build(rects, (0, 0, seg.width, seg.height), prefer_y=True)
     return Procedure(seg.width, seg.height, root, {"source": "guillotine decomposition"})

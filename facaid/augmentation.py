@@ -1,4 +1,5 @@
-"""Noisy segmentations: element edges jittered until a given share of the pixels changes label."""
+"""Augmentation: segmentations made noisy as people annotate, for training (`jitter`: element edges moved) and
+for evaluation (`perturb`: jittered until a given share of the pixels changes label)."""
 
 from __future__ import annotations
 
