@@ -10,7 +10,7 @@ DEFAULT_K = 16
 MAX_K = 32  # the most candidates a job may ask for
 TEMPERATURE = 0.7  # exact structure 64.5 % at 0.7 against 61.5 % at 1.0 (same facades, best of 16)
 # Decoded floors: neighbouring floors with the same tree whose sizes agree within this fraction are written as one
-# repeat, as the canonical trees write them (`facaid.generator.canonical.merge_repeated_floors`). On 150 facades
+# repeat, as the canonical trees write them (`facaid.grammar.floors.merge_repeated_floors`). On 150 facades
 # of dataset seed 7777, best of 16: TED <= 5 84.7 % at 0.2-0.3 and with no size check, 84.0 % at 0.05-0.1,
 # 82.7 % unmerged. Floors further apart than this stay apart, so a real facade's taller floor keeps its height.
 FLOOR_TOLERANCE = 0.25

@@ -3,10 +3,11 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.generator.canonical import IMPLICIT, MIN_GAP, canonical, merge_floor_runs, merge_repeated_floors, structure
+from facaid.generator.canonical import IMPLICIT, MIN_GAP, canonical
 from facaid.generator.dataset import sample_seed
 from facaid.grammar import Procedure, execute
 from facaid.grammar.execute import first_boxes, leaf_array
+from facaid.grammar.floors import merge_floor_runs, merge_repeated_floors, structure
 from facaid.grammar.procedure import Node, Size
 
 

@@ -35,13 +35,41 @@ def test_random_logits_always_give_a_valid_procedure(seed, max_len):
         scores = torch.from_numpy(rng.normal(0, 3, size=(1, len(TOK.vocab))).astype(np.float32))
         masked = proc(torch.tensor([ids]), scores)
         assert torch.equal(torch.isfinite(masked), torch.from_numpy(proc.mask()))
-        if proc.grammars[0].done:
+        if proc.finished(0):
             break
         ids.append(int(masked.argmax()))
     assert ids[-1] == EOS and len(ids) <= max_len
     result = TOK.decode_procedure(ids, 300, 200)
     validate(result)
     assert len(execute(result)) >= 1
+
+
+def test_the_processor_constrains_hugging_face_generate():
+    """`GrammarLogitsProcessor` is a ``transformers.LogitsProcessor``: inside ``generate`` it makes a small random
+    decoder-only model (GPT-2 shaped, untrained) write valid procedures, greedy and sampled, and without it the
+    same model writes none."""
+    from transformers import GPT2Config, GPT2LMHeadModel, LogitsProcessor, LogitsProcessorList
+
+    torch.manual_seed(0)
+    lm = GPT2LMHeadModel(GPT2Config(vocab_size=len(TOK.vocab), n_positions=200, n_embd=32, n_layer=1, n_head=2,
+                                    bos_token_id=BOS, eos_token_id=EOS, pad_token_id=PAD)).eval()
+    sizes = [(300.0, 200.0), (120.0, 400.0), (640.0, 480.0)]
+    for sample in (False, True):
+        processor = GrammarLogitsProcessor(TOK, sizes, max_len=120)
+        assert isinstance(processor, LogitsProcessor)
+        out = lm.generate(torch.full((3, 1), BOS), logits_processor=LogitsProcessorList([processor]),
+                          max_new_tokens=119, do_sample=sample, top_k=0, eos_token_id=EOS, pad_token_id=PAD,
+                          attention_mask=torch.ones(3, 1, dtype=torch.long))
+        for row, (w, h) in zip(out.tolist(), sizes, strict=True):
+            ids = row[: row.index(EOS) + 1]
+            proc = TOK.decode_procedure(ids, w, h)
+            validate(proc)
+            assert len(execute(proc)) >= 1
+    free = lm.generate(torch.full((3, 1), BOS), max_new_tokens=40, do_sample=False, pad_token_id=PAD,
+                       attention_mask=torch.ones(3, 1, dtype=torch.long))
+    for row in free.tolist():
+        with pytest.raises(ValueError):
+            TOK.decode_procedure(row[: row.index(EOS) + 1] if EOS in row else row, 300.0, 200.0)
 
 
 def test_a_rule_is_offered_only_where_its_smallest_expansion_fits_the_leaf_budget():

@@ -55,7 +55,7 @@ def test_decoded_floors_that_repeat_are_written_as_the_canonical_repeat():
 
 @pytest.mark.skipif(not (DEFAULT_CHECKPOINT / "model.safetensors").is_file(), reason="no shipped checkpoint")
 def test_best_of_k_composes_the_buildings_of_a_wings_facade():
-    from facaid.decoding import _fits, best_of_k, ranked_candidates
+    from facaid.decoding import best_of_k, fits, ranked_candidates
     from facaid.evaluation.ted import tree_edit_distance
 
     model, tokenizer = default_model()
@@ -64,7 +64,7 @@ def test_best_of_k_composes_the_buildings_of_a_wings_facade():
     first, plain = ranked[0], ranked[1]
     assert first.swaps > 0 and first.procedure.meta["composed"] == first.swaps
     validate(first.procedure)
-    assert _fits(tokenizer, first.procedure)
+    assert fits(tokenizer, first.procedure)
     truth = sample.procedure.root
     assert tree_edit_distance(truth, first.procedure.root) < tree_edit_distance(truth, plain.procedure.root)
     assert best_of_k(model, tokenizer, sample.segmentation, 16).ids == first.ids

@@ -12,8 +12,9 @@ from __future__ import annotations
 import random
 from dataclasses import dataclass, replace
 
-from facaid.generator.canonical import canonical, structure
+from facaid.generator.canonical import canonical
 from facaid.generator.styles import Style
+from facaid.grammar.floors import structure
 from facaid.grammar.procedure import Node, Procedure, Size
 
 WALL = "facade"
