@@ -19,7 +19,8 @@ import torch
 
 from facaid.model import FacaidModel, batch_inputs, batch_outputs
 from facaid.tokenizer import Tokenizer
-from facaid.train import SampleStream, load_config
+from facaid.training import load_config
+from facaid.training.samples import SampleStream
 
 
 def main() -> None:

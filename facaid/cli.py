@@ -123,7 +123,7 @@ def cmd_render(args: argparse.Namespace) -> None:
 
 
 def cmd_train(args: argparse.Namespace) -> None:
-    from facaid.train import train
+    from facaid.training import train
 
     last = train(args.config, out=args.out, resume=args.resume, steps=args.steps, until=args.until,
                  max_hours=args.max_hours, workers=args.workers, progress=not args.quiet)

@@ -187,7 +187,7 @@ def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k,
 
 @pytest.fixture(scope="module")
 def biased_model(tiny_model):
-    from facaid.model import with_box_bias
+    from facaid.training.surgery import with_box_bias
 
     model = with_box_bias(tiny_model)
     model.box_scale.data = torch.tensor([3.0, -2.0])

@@ -12,24 +12,22 @@ from facaid.labels import LABELS
 from facaid.model import (
     FacaidConfig,
     FacaidModel,
-    adapt_to_tokenizer,
     batch_inputs,
     batch_outputs,
-    deepened,
-    encoder_deepened,
     load_model,
     save_model,
-    widen_for_counts,
-    with_box_bias,
 )
 from facaid.paths import DEFAULT_CHECKPOINT, ROOT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
-from facaid.train import _ARCHITECTURE, load_config, lr_at, structure_weighted_loss, token_log_probs, train
+from facaid.training import load_config, train
+from facaid.training.config import ARCHITECTURE
+from facaid.training.objective import lr_at, structure_weighted_loss, token_log_probs
+from facaid.training.surgery import adapt_to_tokenizer, deepened, encoder_deepened, widen_for_counts, with_box_bias
 
 # what `train.init` may add to a checkpoint's model (`deepened`, `with_box_bias`), and what it must keep (dropout is a
 # training setting, not compared)
 GROWN = ("decoder_layers", "encoder_layers", "box_bias")
-FIXED = tuple(k for k in _ARCHITECTURE if k not in (*GROWN, "dropout"))
+FIXED = tuple(k for k in ARCHITECTURE if k not in (*GROWN, "dropout"))
 TINY = {"d_model": 16, "encoder_layers": 1, "decoder_layers": 1, "heads": 2, "ffn": 32, "node_boxes": True}
 
 
@@ -272,7 +270,7 @@ def test_added_peer_rules_start_at_zero_and_what_cannot_be_adapted_is_refused():
 
 
 def test_the_shipped_weights_adapted_to_finer_coordinates_keep_their_loss():
-    from facaid.train import SampleStream
+    from facaid.training.samples import SampleStream
 
     model, tok = load_model(DEFAULT_CHECKPOINT)
     c = tok.config
@@ -486,7 +484,7 @@ def test_the_shipped_checkpoint_holds_weights_config_tokenizer_and_a_model_card(
 
 
 def test_learning_rate_schedule():
-    from facaid.train import TrainConfig
+    from facaid.training import TrainConfig
 
     cfg = TrainConfig(lr=1e-3, min_lr=1e-4, warmup=10, steps=110)
     assert lr_at(0, cfg) == pytest.approx(1e-4)
@@ -496,7 +494,7 @@ def test_learning_rate_schedule():
 
 
 def test_sample_processes_give_the_same_examples_in_the_same_order():
-    from facaid.train import SampleStream
+    from facaid.training.samples import SampleStream
 
     tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=160))  # short: some facades are skipped
     one = SampleStream(tok, seed=5, noise=(0.5, 0.006))
@@ -512,7 +510,7 @@ def test_sample_processes_give_the_same_examples_in_the_same_order():
 
 
 def test_noisy_inputs_keep_the_clean_target_and_are_seeded():
-    from facaid.train import make_example
+    from facaid.training.samples import make_example
 
     tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=768))
     for index in range(4):
@@ -531,7 +529,8 @@ def test_style_weights_draw_the_styles_of_the_samples(tmp_path):
     import random
 
     from facaid.generator import STYLE_NAMES, TRAINING_STYLES
-    from facaid.train import TrainConfig, make_example, sample_style
+    from facaid.training import TrainConfig
+    from facaid.training.samples import make_example, sample_style
 
     cfg = TrainConfig(style_weights={"wings": 3.0, "house": 0.0})
     assert (*STYLE_NAMES, "wing") == TRAINING_STYLES

@@ -7,7 +7,8 @@ from facaid import native
 from facaid.decoding import decode
 from facaid.generator import generate
 from facaid.incremental import IncrementalDecoder
-from facaid.model import batch_inputs, batch_outputs, with_box_bias
+from facaid.model import batch_inputs, batch_outputs
+from facaid.training.surgery import with_box_bias
 
 pytestmark = pytest.mark.skipif(native.library() is None, reason="no C compiler to build the native step")
 
