@@ -1,11 +1,12 @@
 """The encoder-decoder transformer: flattened segmentation rows in, procedure tokens out.
 
-Built from Hugging Face parts: an encoder over the rectangle rows (bidirectional BERT, or a causal GPT-2 as in
-the paper: ``FacaidConfig.encoder``) and a GPT-2 decoder with cross-attention. Both take our own embeddings
-(``inputs_embeds``): the five fields of a rectangle are embedded separately and summed (one token per
-rectangle) or laid out as five tokens with a field index; output tokens add the embedding of their local
-index within their node group. `FacaidModel.save_pretrained` writes config.json and model.safetensors; the
-checkpoint also holds the tokenizer and the grammar version.
+An encoder over the rectangle rows (Hugging Face's bidirectional BERT, or a causal GPT-2 as in the paper:
+``FacaidConfig.encoder``) and our own GPT-2 decoder with cross-attention (`facaid.decoder`, written once for
+training and decoding). Both take our own embeddings: the five fields of a rectangle are embedded separately
+and summed (one token per rectangle) or laid out as five tokens with a field index; output tokens add the
+embedding of their local index within their node group and of their node's box. `FacaidModel` is a Hugging Face
+`PreTrainedModel`: `save_pretrained` writes config.json and model.safetensors, `from_pretrained` reads them;
+the checkpoint also holds the tokenizer and the grammar version.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import torch.nn.functional as F
 from torch import nn
 from transformers import BertConfig, BertModel, GPT2Config, GPT2Model, PretrainedConfig, PreTrainedModel
 
+from facaid.decoder import Conv1D, Decoder
 from facaid.grammar.procedure import GRAMMAR_VERSION
 from facaid.tokenizer import PAD, Tokenizer, TokenizerConfig
 
@@ -55,6 +57,8 @@ class FacaidModel(PreTrainedModel):
     config_class = FacaidConfig
     base_model_prefix = "facaid"
     main_input_name = "rects"
+    # the token embedding of the Hugging Face GPT-2 decoder the shipped weights were trained with, never read
+    _keys_to_ignore_on_load_unexpected = [r"^decoder\.wte\.weight$"]
 
     def __init__(self, config: FacaidConfig):
         super().__init__(config)
@@ -85,11 +89,7 @@ class FacaidModel(PreTrainedModel):
             ))
         self.token_embedding = nn.Embedding(len(tok.vocab), d)
         self.local_embedding = nn.Embedding(MAX_LOCAL, d)
-        self.decoder = GPT2Model(GPT2Config(
-            vocab_size=1, n_positions=tc.max_out, n_embd=d, n_layer=config.decoder_layers, n_head=config.heads,
-            n_inner=config.ffn, add_cross_attention=True, resid_pdrop=config.dropout,
-            embd_pdrop=config.dropout, attn_pdrop=config.dropout, bos_token_id=None, eos_token_id=None,
-        ))
+        self.decoder = Decoder(d, config.decoder_layers, config.heads, config.ffn, tc.max_out, config.dropout)
         self.lm_head = nn.Linear(d, len(tok.vocab), bias=False)
         # per head, the cross-attention logit added per unit of a rectangle's share inside the node box; zero at
         # first, so that a model given it (`with_box_bias`) computes what it computed without it
@@ -101,7 +101,10 @@ class FacaidModel(PreTrainedModel):
             nn.init.zeros_(self.box_scale)
 
     def _init_weights(self, module: nn.Module) -> None:
-        if isinstance(module, nn.Linear):
+        if isinstance(module, Conv1D):
+            nn.init.normal_(module.weight, std=0.02)
+            nn.init.zeros_(module.bias)
+        elif isinstance(module, nn.Linear):
             nn.init.normal_(module.weight, std=0.02)
             if module.bias is not None:
                 nn.init.zeros_(module.bias)
@@ -187,23 +190,23 @@ class FacaidModel(PreTrainedModel):
         return bias.masked_fill(~memory_mask[:, None, None, :], masked)
 
     def decode(self, ids: torch.Tensor, local: torch.Tensor, memory: torch.Tensor, memory_mask: torch.Tensor,
-               past=None, use_cache: bool = False, boxes: torch.Tensor | None = None,
-               memory_boxes: torch.Tensor | None = None):
-        """ids, local (B, T) and, with ``config.node_boxes``, boxes (B, T, 4) -> logits (B, T, V) and the cache.
+               boxes: torch.Tensor | None = None, memory_boxes: torch.Tensor | None = None) -> torch.Tensor:
+        """Teacher forcing: ids, local (B, T) and, with ``config.node_boxes``, boxes (B, T, 4) -> logits (B, T, V).
 
         ``boxes`` hold at each position the quantized (x, y, w, h) of the node the next token belongs to
         (`Tokenizer.node_boxes`); they are embedded with the same tables as the input rectangles. With
         ``config.box_bias`` the cross-attention also leans towards the rectangles inside them: pass
-        ``memory_boxes`` (`memory_boxes` of the encoded rectangles)."""
-        x = self.embed_outputs(ids, local, boxes)
-        mask = memory_mask.long()
+        ``memory_boxes`` (`memory_boxes` of the encoded rectangles). Token-by-token decoding runs the same blocks
+        through `facaid.decoder.DecoderState`."""
+        x = self.embed_outputs(ids, local, boxes)  # (B, T, d)
         if self.box_scale is not None:
             if memory_boxes is None:
                 raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
-            mask = self.cross_bias(memory_boxes, memory_mask, boxes).to(x.dtype)
-        out = self.decoder(inputs_embeds=x, encoder_hidden_states=memory,
-                           encoder_attention_mask=mask, cache=past, use_cache=use_cache)
-        return self.lm_head(out.last_hidden_state), out.cache  # (B, T, V)
+            mask = self.cross_bias(memory_boxes, memory_mask, boxes).to(x.dtype)  # (B, H, T, M)
+        else:
+            mask = x.new_zeros(memory_mask.shape).masked_fill(~memory_mask, torch.finfo(x.dtype).min)
+            mask = mask[:, None, None, :]  # (B, 1, 1, M)
+        return self.lm_head(self.decoder(x, memory, mask))  # (B, T, V)
 
     def forward(self, rects: torch.Tensor, rect_mask: torch.Tensor, ids: torch.Tensor, local: torch.Tensor,
                 targets: torch.Tensor | None = None, boxes: torch.Tensor | None = None
@@ -211,7 +214,7 @@ class FacaidModel(PreTrainedModel):
         """Teacher-forced logits (B, T, V) and, given targets (B, T) with -100 for ignored, the mean loss."""
         memory, memory_mask = self.encode(rects, rect_mask)
         memory_boxes = self.memory_boxes(rects) if self.box_scale is not None else None
-        logits, _ = self.decode(ids, local, memory, memory_mask, boxes=boxes, memory_boxes=memory_boxes)
+        logits = self.decode(ids, local, memory, memory_mask, boxes=boxes, memory_boxes=memory_boxes)
         loss = None
         if targets is not None:
             loss = F.cross_entropy(logits.reshape(-1, logits.shape[-1]), targets.reshape(-1), ignore_index=-100)

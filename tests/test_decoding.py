@@ -159,8 +159,10 @@ def test_decode_greedy_sampling_and_prefix(tiny_model):
 
 @pytest.mark.parametrize("k, padded, shared", [(1, False, False), (3, False, False), (2, True, False),
                                                (3, False, True)])
-def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k, padded, shared):
-    from facaid.incremental import IncrementalDecoder
+def test_decoder_state_steps_give_the_teacher_forced_logits(tiny_model, k, padded, shared):
+    """`facaid.decoder`: the blocks stepped with their key/value cache (one token a row, K rows on one memory row
+    or their own) compute what the teacher-forced pass over the whole sequence computes."""
+    from facaid.decoder import DecoderState
     from facaid.model import batch_inputs, batch_outputs
 
     samples = [generate(s) for s in (4, 5)[: 2 if padded else 1]]
@@ -171,17 +173,17 @@ def test_incremental_decoder_gives_the_cached_hugging_face_logits(tiny_model, k,
     with torch.no_grad():
         memory, memory_mask = tiny_model.encode(rects, mask)
         assert bool(memory_mask.all()) != padded
-        full, _ = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
+        full = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
         if shared:  # K rows on one memory row: the K queries of a head attend in one product
-            fast = IncrementalDecoder(tiny_model, memory[:1], memory_mask[:1], max_len=64, rows=k)
+            fast = DecoderState(tiny_model, memory[:1], memory_mask[:1], max_len=64, rows=k)
             assert fast.shared
         else:
-            fast = IncrementalDecoder(tiny_model, memory, memory_mask, max_len=64)
+            fast = DecoderState(tiny_model, memory, memory_mask, max_len=64)
         x = tiny_model.embed_outputs(ids, local, boxes)
         steps = torch.stack([fast.step(x[:, i]) for i in range(x.shape[1])], 1)
     assert torch.allclose(steps, full, atol=1e-5)
     with pytest.raises(ValueError, match="memory has 2 rows"):
-        IncrementalDecoder(tiny_model, torch.zeros(2, 5, memory.shape[-1]), torch.ones(2, 5, dtype=torch.bool),
+        DecoderState(tiny_model, torch.zeros(2, 5, memory.shape[-1]), torch.ones(2, 5, dtype=torch.bool),
                            max_len=8, rows=3)
 
 
@@ -195,8 +197,8 @@ def biased_model(tiny_model):
 
 
 @pytest.mark.parametrize("k, shared, padded", [(1, False, False), (3, True, False), (2, False, True)])
-def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, shared, padded):
-    from facaid.incremental import IncrementalDecoder
+def test_decoder_state_applies_the_box_bias(tiny_model, biased_model, k, shared, padded):
+    from facaid.decoder import DecoderState
     from facaid.model import batch_inputs, batch_outputs
 
     samples = [generate(4), generate(5)] if padded else [generate(4)] * k
@@ -207,11 +209,11 @@ def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, s
         memory, memory_mask = biased_model.encode(rects, mask)
         assert bool(memory_mask.all()) != padded
         memory_boxes = biased_model.memory_boxes(rects)
-        full, _ = biased_model.decode(ids, local, memory, memory_mask, boxes=boxes, memory_boxes=memory_boxes)
-        plain, _ = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
+        full = biased_model.decode(ids, local, memory, memory_mask, boxes=boxes, memory_boxes=memory_boxes)
+        plain = tiny_model.decode(ids, local, memory, memory_mask, boxes=boxes)
         assert not torch.allclose(full, plain, atol=1e-3)  # the same weights but the bias
         rows = 1 if shared else k
-        fast = IncrementalDecoder(biased_model, memory[:rows], memory_mask[:rows], max_len=64, rows=k,
+        fast = DecoderState(biased_model, memory[:rows], memory_mask[:rows], max_len=64, rows=k,
                                   memory_boxes=memory_boxes[:rows])
         x = biased_model.embed_outputs(ids, local, boxes)
         steps = torch.stack([fast.step(x[:, i], boxes[:, i]) for i in range(x.shape[1])], 1)
@@ -219,15 +221,11 @@ def test_incremental_decoder_applies_the_box_bias(tiny_model, biased_model, k, s
         fast.step(x[:, 0])
     assert torch.allclose(steps, full, atol=1e-5)
     with pytest.raises(ValueError, match="pass memory_boxes"):
-        IncrementalDecoder(biased_model, memory, memory_mask, max_len=8)
-    seg = generate(6).segmentation
-    a = decode(biased_model, TOK, seg, k=3, sample=True, seed=2, greedy=1)
-    b = decode(biased_model, TOK, seg, k=3, sample=True, seed=2, greedy=1, incremental=False)
-    assert [c.ids for c in a] == [c.ids for c in b]
+        DecoderState(biased_model, memory, memory_mask, max_len=8)
 
 
-@pytest.mark.parametrize("incremental, sample", [(True, True), (False, True), (True, False)])
-def test_decoded_log_probability_is_the_teacher_forced_one(biased_model, incremental, sample):
+@pytest.mark.parametrize("native, sample", [(True, True), (False, True), (False, False)])
+def test_decoded_log_probability_is_the_teacher_forced_one(biased_model, native, sample):
     """`decode` keeps a node's box, its embedding and its cross-attention bias while the node's tokens last;
     teacher forcing the decoded sequence recomputes all of them at every position and must give the same
     masked log-probability (greedy alone takes each token and its log-probability from one ``max``)."""
@@ -236,14 +234,14 @@ def test_decoded_log_probability_is_the_teacher_forced_one(biased_model, increme
     seg = generate(6).segmentation
     rects, mask = batch_inputs([TOK.encode_segmentation(seg)])
     candidates = decode(biased_model, TOK, seg, k=3 if sample else 1, sample=sample, seed=2, greedy=1,
-                        merge_floors=False, incremental=incremental)
+                        merge_floors=False, native=native)
     for c in candidates:
         inputs = c.ids[:-1]
         local = torch.tensor([TOK.local_indices(inputs, TOK.vocab)]).clamp(max=MAX_LOCAL - 1)
         boxes = torch.as_tensor(TOK.node_boxes(inputs, seg.width, seg.height))[None]
         with torch.no_grad():
             memory, memory_mask = biased_model.encode(rects, mask)
-            logits, _ = biased_model.decode(torch.tensor([inputs]), local, memory, memory_mask, boxes=boxes,
+            logits = biased_model.decode(torch.tensor([inputs]), local, memory, memory_mask, boxes=boxes,
                                             memory_boxes=biased_model.memory_boxes(rects))
         grammar = TokenGrammar(TOK.vocab, seg.width, seg.height, CONFIG.max_out)
         total = 0.0
@@ -255,13 +253,6 @@ def test_decoded_log_probability_is_the_teacher_forced_one(biased_model, increme
         assert total == pytest.approx(c.logprob, abs=1e-4)
     if sample:
         assert len({tuple(c.ids) for c in candidates}) > 1  # the samples differ: more than one path was checked
-
-
-def test_incremental_and_module_decoding_agree(tiny_model):
-    seg = generate(6).segmentation
-    a = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1)
-    b = decode(tiny_model, TOK, seg, k=3, sample=True, seed=2, greedy=1, incremental=False)
-    assert [c.ids for c in a] == [c.ids for c in b]
 
 
 def _candidate(accuracy: float, count_error: int, logprob: float) -> Candidate:

@@ -172,10 +172,10 @@ def test_a_deepened_decoder_keeps_the_logits_until_trained(tmp_path):
     deep.eval()
     with torch.no_grad():
         assert not torch.allclose(deep(rects, mask, ids, local, boxes=boxes)[0], a)
-    # incremental (cached) decoding runs every block
+    # token-by-token decoding runs every block, in torch and in C
     from facaid.decoding import decode
     s = generate(5)
-    fast, slow = (decode(deep, tok, s.segmentation, max_len=80, incremental=flag)[0] for flag in (True, False))
+    fast, slow = (decode(deep, tok, s.segmentation, max_len=80, native=flag)[0] for flag in (True, False))
     assert fast.ids == slow.ids
     save_model(deep, tok, tmp_path / "deep")
     again, _ = load_model(tmp_path / "deep")
@@ -301,16 +301,19 @@ def test_padding_does_not_change_a_sequence():
 
 
 def test_cached_and_uncached_decoding_agree():
+    from facaid.decoder import DecoderState
+
     model, tok = tiny()
     model.eval()
     rects, mask, ids, local, _, boxes = batch(tok, [9])
     with torch.no_grad():
         memory, mmask = model.encode(rects, mask)
-        full, _ = model.decode(ids, local, memory, mmask, boxes=boxes)
-        first, past = model.decode(ids[:, :10], local[:, :10], memory, mmask, use_cache=True, boxes=boxes[:, :10])
-        nxt, _ = model.decode(ids[:, 10:11], local[:, 10:11], memory, mmask, past, use_cache=True,
-                              boxes=boxes[:, 10:11])
-    assert torch.allclose(full[:, 10], nxt[:, 0], atol=1e-5)
+        full = model.decode(ids, local, memory, mmask, boxes=boxes)
+        state = DecoderState(model, memory, mmask, max_len=ids.shape[1])
+        x = model.embed_outputs(ids, local, boxes)
+        steps = [state.step(x[:, i]) for i in range(11)]
+    assert torch.allclose(full[:, 10], steps[10], atol=1e-5)
+    assert torch.allclose(full[:, 0], steps[0], atol=1e-5)
 
 
 def test_save_load_round_trip_and_grammar_check(tmp_path):

@@ -1,12 +1,12 @@
-"""The decoder step in C (`facaid.native`): the same logits as the torch paths, and a clean fallback."""
+"""The decoder step in C (`facaid.native`): the same logits as the torch decoder, and a clean fallback."""
 
 import pytest
 import torch
 
 from facaid import native
+from facaid.decoder import DecoderState
 from facaid.decoding import decode
 from facaid.generator import generate
-from facaid.incremental import IncrementalDecoder
 from facaid.model import batch_inputs, batch_outputs
 from facaid.training.surgery import with_box_bias
 
@@ -23,7 +23,7 @@ def models(tiny):
 
 @pytest.mark.parametrize("kind", ["plain", "biased"])
 @pytest.mark.parametrize(("k", "threads"), [(1, 1), (3, 1), (9, 2), (16, 3)])
-def test_native_step_gives_the_hugging_face_logits(models, kind, k, threads):
+def test_native_step_gives_the_teacher_forced_logits(models, kind, k, threads):
     """Each row its own sequence (other facades' trees), so that rows read from another row's cache or mask
     (the shards' offsets) would show; 9 rows on two threads are shards of 4 and 5, 16 on three 5, 5 and 6."""
     by_kind, tok = models
@@ -35,7 +35,7 @@ def test_native_step_gives_the_hugging_face_logits(models, kind, k, threads):
     with torch.no_grad():
         memory, memory_mask = model.encode(rects, mask)
         memory_boxes = model.memory_boxes(rects) if model.box_scale is not None else None
-        full, _ = model.decode(ids, local, memory.repeat(k, 1, 1), memory_mask.repeat(k, 1), boxes=boxes,
+        full = model.decode(ids, local, memory.repeat(k, 1, 1), memory_mask.repeat(k, 1), boxes=boxes,
                                memory_boxes=None if memory_boxes is None else memory_boxes.repeat(k, 1, 1))
         fast = native.NativeDecoder(model, memory, memory_mask, max_len=64, rows=k, memory_boxes=memory_boxes,
                                     threads=threads)
@@ -57,7 +57,7 @@ def test_native_step_masks_padded_memory(models):
         memory_mask = memory_mask.clone()
         memory_mask[0, -3:] = False
         memory[0, -3:] = 50.0  # would dominate the attention if it were read
-        a = IncrementalDecoder(model, memory, memory_mask, max_len=16)
+        a = DecoderState(model, memory, memory_mask, max_len=16)
         b = native.NativeDecoder(model, memory, memory_mask, max_len=16)
         x = torch.randn(12, 1, memory.shape[-1], generator=torch.Generator().manual_seed(0))
         for step in x:
@@ -85,7 +85,7 @@ def test_shipped_model_logits_match_the_torch_step(shipped):
     with torch.no_grad():
         memory, memory_mask = model.encode(rects, mask)
         memory_boxes = model.memory_boxes(rects)
-        a = IncrementalDecoder(model, memory, memory_mask, max_len=ids.shape[1], memory_boxes=memory_boxes)
+        a = DecoderState(model, memory, memory_mask, max_len=ids.shape[1], memory_boxes=memory_boxes)
         b = native.NativeDecoder(model, memory, memory_mask, max_len=ids.shape[1], memory_boxes=memory_boxes)
         x = model.embed_outputs(ids, local, boxes)
         worst = max(float((a.step(x[:, i], boxes[:, i]) - b.step(x[:, i], boxes[:, i])).abs().max())

@@ -1,16 +1,16 @@
-"""What computes the next token's logits for the decoding loop: one interface over three backends.
+"""What computes the next token's logits for the decoding loop: one interface over two backends.
 
 - the C step (`facaid.native`), where it builds: K rows in shards on torch's threads;
-- `facaid.incremental.IncrementalDecoder`: the same math in torch without the modules' per-call overhead;
-- the Hugging Face modules (`FacaidModel.decode` with its key/value cache): training mode, or asked for.
-All three give the same logits (to about 1e-5 for the C step; tests/test_native.py, tests/test_decoding.py).
+- `facaid.decoder.DecoderState`: the model's own decoder blocks stepped with their key/value cache.
+Both give the logits of the teacher-forced `FacaidModel.decode` (to about 1e-5; tests/test_native.py,
+tests/test_decoding.py).
 """
 
 from __future__ import annotations
 
 import torch
 
-from facaid.incremental import IncrementalDecoder
+from facaid.decoder import DecoderState
 from facaid.model import FacaidModel
 from facaid.native import native_decoder
 
@@ -22,22 +22,14 @@ class Stepper:
     model biases cross-attention by them."""
 
     def __init__(self, model: FacaidModel, memory: torch.Tensor, memory_mask: torch.Tensor,
-                 memory_boxes: torch.Tensor | None, max_len: int, rows: int, *, incremental: bool = True,
-                 native: bool = True):
+                 memory_boxes: torch.Tensor | None, max_len: int, rows: int, *, native: bool = True):
         self.model = model
         self.fast = None
-        if incremental and not model.training:
-            if native:
-                self.fast = native_decoder(model, memory, memory_mask, max_len, rows=rows,
-                                           memory_boxes=memory_boxes, threads=torch.get_num_threads())
-            self.fast = self.fast or IncrementalDecoder(model, memory, memory_mask, max_len, rows=rows,
-                                                        memory_boxes=memory_boxes)
-        else:
-            memory, memory_mask = memory.expand(rows, -1, -1).contiguous(), memory_mask.expand(rows, -1).contiguous()
-            if memory_boxes is not None:
-                memory_boxes = memory_boxes.expand(rows, -1, -1)
-        self.memory, self.memory_mask, self.memory_boxes = memory, memory_mask, memory_boxes
-        self.past = None
+        if native:
+            self.fast = native_decoder(model, memory, memory_mask, max_len, rows=rows, memory_boxes=memory_boxes,
+                                       threads=torch.get_num_threads())
+        self.fast = self.fast or DecoderState(model, memory, memory_mask, max_len, rows=rows,
+                                              memory_boxes=memory_boxes)
         self._boxes: torch.Tensor | None = None  # the boxes whose embedding is kept (the tokens of one node)
         self._box_embedding: torch.Tensor | None = None
         self._row_boxes: torch.Tensor | None = None
@@ -50,10 +42,6 @@ class Stepper:
     def logits(self, ids: torch.Tensor, local: torch.Tensor, boxes: torch.Tensor) -> torch.Tensor:
         """(K, V) logits after the new tokens ``ids`` (K, T) with their local indices (K, T) and node boxes
         (K, T, 4). Pass the same ``boxes`` tensor while the rows stay in their nodes: its embedding is kept."""
-        if self.fast is None:
-            logits, self.past = self.model.decode(ids, local, self.memory, self.memory_mask, self.past,
-                                                  use_cache=True, boxes=boxes, memory_boxes=self.memory_boxes)
-            return logits[:, -1]
         if boxes is not self._boxes:
             self._boxes = boxes
             self._box_embedding = self.model.embed_boxes(boxes) if self.model.node_boxes else None

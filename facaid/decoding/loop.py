@@ -48,7 +48,7 @@ def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> 
 def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: int = 1, sample: bool = False,
            temperature: float = 1.0, seed: int = 0, prefix: list[int] | None = None,
            max_len: int | None = None, constrained: bool = True, greedy: int = 0,
-           incremental: bool = True, merge_floors: bool = True, native: bool = True) -> list[Candidate]:
+           merge_floors: bool = True, native: bool = True) -> list[Candidate]:
     """K candidate procedures for a segmentation (greedy when ``sample`` is False; then K copies are equal).
 
     With ``merge_floors`` (and no ``prefix``), neighbouring floors with the same tree and sizes within
@@ -56,9 +56,9 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     ids are then those of the merged tree, its log-probability that of the decoded sequence.
 
     With ``sample``, the first ``greedy`` rows are still decoded greedily, in the same batch as the samples.
-    ``incremental`` (in eval mode) steps with `IncrementalDecoder`; False runs the Hugging Face modules. With
-    ``native`` the rows step with the C step of `facaid.native` when it is available (the same logits to
-    about 1e-5); K > 1 rows in shards on torch's threads, torch held to one thread meanwhile.
+    The rows step with the model's decoder blocks and their key/value cache (`facaid.decoder.DecoderState`), or
+    with ``native`` with the C step of `facaid.native` when it is available (the same logits to about 1e-5);
+    K > 1 rows in shards on torch's threads, torch held to one thread meanwhile.
 
     ``constrained=False`` decodes without the grammar mask, to measure what nullification buys: a sequence
     that breaks the grammar stops there and comes back with ``procedure=None`` and the error."""
@@ -83,7 +83,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     local = torch.tensor(start_local, device=device).clamp(max=MAX_LOCAL - 1)
     prev_local = [row[-1] for row in start_local]  # each row's newest local index, not clamped
     boxes = torch.as_tensor(tokenizer.node_boxes(start, seg.width, seg.height), device=device).expand(k, -1, -1)
-    stepper = Stepper(model, memory, memory_mask, memory_boxes, max_len, k, incremental=incremental, native=native)
+    stepper = Stepper(model, memory, memory_mask, memory_boxes, max_len, k, native=native)
     vocab = tokenizer.vocab
     last_boxes: list[tuple | None] | None = None  # the rows' node boxes (unquantized) of the newest token
     with torch_threads(1) if stepper.sharded else contextlib.nullcontext():  # torch's workers off the shards' cores

@@ -2,11 +2,11 @@
 
 Greedy decoding takes a few hundred steps of one token, and a step is some 80 torch operations on vectors of
 128: their fixed cost, not the arithmetic, sets the time. `NativeDecoder` does the whole step in one call of a
-small C function (the same arithmetic as `IncrementalDecoder.step`; the tests check the logits to 1e-5). It takes
-K rows of one input: greedy decoding steps one row (0.56x the torch step's time), best of K steps K rows split
-into `threads` shards, each shard one call on its own thread (ctypes lets go of the GIL for the call), while
-torch itself is held to one thread (`torch_threads`), so that its OpenMP workers, which spin for a while after
-each parallel region, do not take the cores the shards run on.
+small C function (the same arithmetic as `facaid.decoder.DecoderState.step`; the tests check the logits to
+1e-5). It takes K rows of one input: greedy decoding steps one row (0.56x the torch step's time), best of K
+steps K rows split into `threads` shards, each shard one call on its own thread (ctypes lets go of the GIL for
+the call), while torch itself is held to one thread (`torch_threads`), so that its OpenMP workers, which spin
+for a while after each parallel region, do not take the cores the shards run on.
 
 The library is compiled once per source and machine into ``$FACAID_CACHE`` (default ``~/.cache/facaid``) with
 ``-O3 -march=native``; without a C compiler, or with ``FACAID_NATIVE=0``, `native_decoder` returns None and
@@ -29,12 +29,12 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from facaid.incremental import IncrementalDecoder
+from facaid.decoder import DecoderState
 from facaid.model import FacaidModel
 
 log = logging.getLogger(__name__)
 
-SOURCE = Path(__file__).with_name("native") / "step.c"
+SOURCE = Path(__file__).with_name("step.c")
 FLAGS = ["-O3", "-march=native", "-ffp-contract=fast", "-shared", "-fPIC", "-std=c99"]
 _library: ctypes.CDLL | None = None
 _tried = False
@@ -135,8 +135,8 @@ def torch_threads(n: int):
         torch.set_num_threads(before)
 
 
-class NativeDecoder(IncrementalDecoder):
-    """`IncrementalDecoder` whose `step` is one call of the C step per shard of rows (``threads`` shards of at
+class NativeDecoder(DecoderState):
+    """`DecoderState` whose `step` is one call of the C step per shard of rows (``threads`` shards of at
     least four rows, run at once). Only for rows that read one memory row (what `decode` builds); the
     cross-attention keys and values, caches and masks are the parent's, read in place."""
 
@@ -161,7 +161,7 @@ class NativeDecoder(IncrementalDecoder):
             arrays = [w.ln_1[0], w.ln_1[1], w.attn_w, w.attn_b, w.attn_proj_w, w.attn_proj_b,
                       w.ln_cross[0], w.ln_cross[1], w.cross_q_w, w.cross_q_b, w.cross_proj_w, w.cross_proj_b,
                       w.ln_2[0], w.ln_2[1], w.fc_w, w.fc_b, w.mlp_proj_w, w.mlp_proj_b]
-            arrays = [_array(a) for a in arrays]
+            arrays = [_array(t) for t in arrays]
             arrays.append(_array(ck[0].transpose(1, 2)))  # (H, dh, M)
             arrays.append(_array(cv[0]))  # (H, M, dh)
             cache = kv.numpy()  # the parent's buffer, read as keys (K, H, dh, L) and values (K, H, L, dh)
@@ -191,7 +191,7 @@ class NativeDecoder(IncrementalDecoder):
             return None, 0, 0
         if self.mask_np[0] is mask:
             return self.mask_np[1:]
-        a = _array(mask[0])  # (H or 1, K or 1, M), additive (`IncrementalDecoder` builds it so)
+        a = _array(mask[0])  # (H or 1, K or 1, M), additive (`DecoderState` builds it so)
         h_stride = 0 if a.shape[0] == 1 else a.shape[1] * self.m
         r_stride = 0 if a.shape[1] == 1 else self.m
         self.mask_np = (mask, a, h_stride, r_stride)
@@ -203,7 +203,7 @@ class NativeDecoder(IncrementalDecoder):
             raise ValueError(f"the decoder holds at most {self.max_len} positions")
         if x.shape != (self.k, self.d) or x.dtype != torch.float32 or x.device.type != "cpu":
             raise ValueError(f"x must be float32 ({self.k}, {self.d}) on the CPU, got {x.dtype} {tuple(x.shape)}")
-        mask, mask_h, mask_r = self._mask_array(self._cross_mask(boxes))
+        mask, mask_h, mask_r = self._mask_array(self.cross_mask(boxes))
         x = x.contiguous()
         out = torch.empty((self.k, self.vocab))
         wpe_t = self.wpe_at + 4 * self.d * self.t
