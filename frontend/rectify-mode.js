@@ -92,3 +92,14 @@ export class RectifyMode {
     return [w, h];
   }
 }
+
+/** The rectification step opened on the original photo (`info`: the photo's API record), drawn with its preview. */
+export async function openRectifyMode(canvas, preview, info) {
+  const original = new Image();
+  original.src = info.image;
+  await original.decode();
+  const mode = new RectifyMode({canvas, preview, image: original, corners: info.corners});
+  mode.draw();
+  mode.renderPreview();
+  return mode;
+}

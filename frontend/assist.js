@@ -1,0 +1,25 @@
+// Helpers that draw for the user, DOM-free: a grid of copies of one rectangle, proposals of look-alikes found in the
+// photo (`match.js`), and the command that adds the proposals the user kept.
+import {AddRects, repeatRects} from "./commands.js";
+import {findSimilar} from "./match.js";
+
+/** Copies of rectangle `id` in `cols` x `rows` with the given gaps (image pixels) between them. */
+export function repeatCommand(seg, id, {cols, rows, gapX, gapY}) {
+  const r = seg.get(id);
+  return repeatRects(seg, id, {cols, rows, dx: r.x1 - r.x0 + gapX, dy: r.y1 - r.y0 + gapY});
+}
+
+/** Places in the photo (`gray`, `match.toGray`) that look like rectangle `id`, as proposals of its class; the
+ * rectangles of that class already drawn are not proposed again. */
+export function similarProposals(gray, seg, id, threshold) {
+  const r = seg.get(id);
+  const same = [...seg.rects.values()].filter((o) => o.label === r.label && o.id !== r.id);
+  return findSimilar(gray, r, {threshold, exclude: same}).map((p) => ({...p, label: r.label}));
+}
+
+/** The command adding the proposals not rejected (`accepted === false`), or null when none is left. */
+export function acceptCommand(proposals) {
+  const keep = proposals.filter((p) => p.accepted !== false);
+  return keep.length ? new AddRects(keep.map(({label, x0, y0, x1, y1}) => ({label, x0, y0, x1, y1})), "find similar")
+    : null;
+}

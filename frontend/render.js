@@ -1,0 +1,68 @@
+// Painting the editor's canvas from its state: the photo, the rectangles in paint order with any gesture's
+// preview, the rectangle being drawn, the selection and its handles, proposals, the marquee, snap guides and the
+// result overlay. Reads a 2D context and the state; owns nothing.
+import {handlePoints, normalize} from "./geometry.js";
+import {cssColor} from "./labels.js";
+import {toGray} from "./match.js";
+
+/** The photo's gray levels at its own size, for `match.findSimilar`. */
+export function grayPixels(photo, width, height) {
+  const g = Object.assign(document.createElement("canvas"), {width, height}).getContext("2d", {willReadFrequently: true});
+  g.drawImage(photo, 0, 0);
+  return toGray(g.getImageData(0, 0, width, height));
+}
+
+export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
+  const sx = (x) => x * view.scale + view.ox;
+  const sy = (y) => y * view.scale + view.oy;
+  const box = (r) => [sx(r.x0), sy(r.y0), (r.x1 - r.x0) * view.scale, (r.y1 - r.y0) * view.scale];
+  const stroke = (r, color, width = 1, dash = []) => {
+    ctx.setLineDash(dash);
+    ctx.strokeStyle = color;
+    ctx.lineWidth = width;
+    ctx.strokeRect(sx(r.x0) + 0.5, sy(r.y0) + 0.5, (r.x1 - r.x0) * view.scale, (r.y1 - r.y0) * view.scale);
+    ctx.setLineDash([]);
+  };
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.fillStyle = "#2a2f36";
+  ctx.fillRect(0, 0, canvas.width, canvas.height);
+  ctx.imageSmoothingEnabled = view.scale < 1;
+  ctx.drawImage(photo, view.ox, view.oy, seg.width * view.scale, seg.height * view.scale);
+  const drag = ui.drag;
+  const preview = drag?.preview || new Map();
+  for (const r0 of seg.paintOrder()) {
+    const r = preview.get(r0.id) || r0;
+    ctx.fillStyle = cssColor(r.label, fill);
+    ctx.fillRect(...box(r));
+    stroke(r, cssColor(r.label), 1);
+  }
+  if (drag?.kind === "draw" && drag.rect) {
+    ctx.fillStyle = cssColor(ui.label, 0.4);
+    ctx.fillRect(...box(drag.rect));
+    stroke(drag.rect, "#fff", 1, [4, 3]);
+  }
+  for (const id of ui.selection) {
+    const r = preview.get(id) || seg.rects.get(id);
+    if (!r) continue;
+    stroke(r, "#fff", 2);
+    if (ui.selection.size === 1) {
+      ctx.fillStyle = "#fff";
+      for (const [hx, hy] of Object.values(handlePoints(r))) ctx.fillRect(sx(hx) - 3, sy(hy) - 3, 7, 7);
+    }
+  }
+  for (const p of ui.proposals) stroke(p, p.accepted === false ? "#888" : "#ffeb3b", 2, [6, 4]);
+  if (drag?.kind === "marquee") stroke(normalize(drag.box), "#9cf", 1, [3, 3]);
+  ctx.strokeStyle = "#ff4fd8";
+  ctx.lineWidth = 1;
+  for (const g of ui.guides) {
+    ctx.beginPath();
+    if (g.axis === "x") { ctx.moveTo(sx(g.at) + 0.5, 0); ctx.lineTo(sx(g.at) + 0.5, canvas.height); }
+    else { ctx.moveTo(0, sy(g.at) + 0.5); ctx.lineTo(canvas.width, sy(g.at) + 0.5); }
+    ctx.stroke();
+  }
+  if (ui.overlay) {
+    ctx.globalAlpha = ui.overlayAlpha;
+    ctx.drawImage(ui.overlay, view.ox, view.oy, seg.width * view.scale, seg.height * view.scale);
+    ctx.globalAlpha = 1;
+  }
+}

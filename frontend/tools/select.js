@@ -1,0 +1,40 @@
+// What a press starts, by tool and by what lies under the pointer: the gesture and the selection it leaves.
+//   - Space or the middle button: pan;
+//   - on a handle of the one selected rectangle: resize it;
+//   - the draw tool: draw;
+//   - the select tool, on a rectangle: select it (Shift toggles it) and move the selection; a press inside the
+//     selection grabs it even where another class paints on top;
+//   - the select tool, on nothing: a marquee (Shift keeps the selection).
+import {contains, handleAt} from "../geometry.js";
+import {HANDLE_PX} from "./context.js";
+import {DrawGesture} from "./draw.js";
+import {MarqueeGesture} from "./marquee.js";
+import {MoveGesture} from "./move.js";
+import {PanGesture} from "./pan.js";
+import {ResizeGesture} from "./resize.js";
+
+/** {gesture, selection}: the gesture to feed the pointer's moves, and the selection from now on. */
+export function press(tool, pointer, ctx, view, {pan = false} = {}) {
+  const selection = new Set(ctx.selection);
+  if (pan) return {gesture: new PanGesture(pointer, view), selection};
+  if (selection.size === 1) {
+    const id = [...selection][0];
+    const handle = handleAt(ctx.seg.get(id), pointer.x, pointer.y, HANDLE_PX / ctx.scale);
+    if (handle) return {gesture: new ResizeGesture(id, handle), selection};
+  }
+  if (tool === "draw") return {gesture: new DrawGesture(pointer), selection};
+  const inside = [...selection].map((id) => ctx.seg.get(id)).find((r) => contains(r, pointer.x, pointer.y));
+  const hit = inside && !pointer.shift ? inside : ctx.seg.topAt(pointer.x, pointer.y);
+  if (!hit) {
+    if (!pointer.shift) selection.clear();
+    return {gesture: new MarqueeGesture(pointer), selection};
+  }
+  if (pointer.shift) {
+    if (selection.has(hit.id)) selection.delete(hit.id);
+    else selection.add(hit.id);
+  } else if (!selection.has(hit.id)) {
+    selection.clear();
+    selection.add(hit.id);
+  }
+  return {gesture: new MoveGesture(pointer, selection), selection};
+}
