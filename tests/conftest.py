@@ -1,9 +1,10 @@
 import json
 import os
-from pathlib import Path
 
 import pytest
 from hypothesis import settings
+
+from facaid.paths import DEFAULT_CMP
 
 # The property tests draw the same cases on every run, so that the suite passes or fails alike here and in CI;
 # HYPOTHESIS_PROFILE=explore draws new ones each run (a case it finds goes into its test as an @example).
@@ -11,7 +12,7 @@ settings.register_profile("repeatable", derandomize=True)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
 
-CMP = Path(__file__).resolve().parents[2] / "shared" / "data" / "cmp" / "annotations.jsonl"
+CMP = DEFAULT_CMP  # FACAID_CMP, or ../shared/data/cmp/annotations.jsonl beside the repository
 
 
 @pytest.fixture(scope="session")

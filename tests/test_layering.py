@@ -1,0 +1,103 @@
+"""The code's shape: dependencies point one way (webapp -> worker -> facaid), no module imports a private name of
+another, and no import cycle, counting imports inside functions (type-checking imports aside)."""
+
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("facaid", "webapp", "worker")
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            if "migrations" in path.parts:
+                continue
+            parts = list(path.relative_to(ROOT).with_suffix("").parts)
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            out[".".join(parts)] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _imports(path: Path) -> list[tuple[str, list[str]]]:
+    """(module, names) of every import in the file, in functions too, except under ``if TYPE_CHECKING``."""
+    tree = ast.parse(path.read_text())
+    skip = {id(n) for node in ast.walk(tree) if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test)
+            for n in ast.walk(node)}
+    found = []
+    for node in ast.walk(tree):
+        if id(node) in skip:
+            continue
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            found.append((node.module, [a.name for a in node.names]))
+        elif isinstance(node, ast.Import):
+            found += [(a.name, []) for a in node.names]
+    return found
+
+
+def _graph() -> dict[str, set[str]]:
+    graph = {}
+    for name, path in MODULES.items():
+        edges = set()
+        for module, names in _imports(path):
+            for n in names or [None]:
+                target = f"{module}.{n}" if n and f"{module}.{n}" in MODULES else module
+                if target in MODULES and target != name:
+                    edges.add(target)
+        graph[name] = edges
+    return graph
+
+
+def test_dependencies_point_one_way():
+    layer = {"facaid": 0, "worker": 1, "webapp": 2}
+    for name, path in MODULES.items():
+        for module, _ in _imports(path):
+            top = module.split(".")[0]
+            if top in layer:
+                assert layer[top] <= layer[name.split(".")[0]], f"{name} imports {module}"
+            if name.startswith("facaid"):
+                assert top not in ("django", "rest_framework", "celery"), f"{name} imports {module}"
+
+
+def test_no_module_imports_a_private_name_of_another():
+    bad = [(name, module, n) for name, path in MODULES.items() for module, names in _imports(path)
+           if module.split(".")[0] in PACKAGES for n in names if n.startswith("_") and not n.startswith("__")]
+    assert not bad
+
+
+def test_no_import_cycles():
+    graph = _graph()
+    index, low, stack, on, cycles, counter = {}, {}, [], set(), [], [0]
+
+    def visit(v):  # Tarjan's strongly connected components
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                cycles.append(sorted(component))
+
+    for v in graph:
+        if v not in index:
+            visit(v)
+    assert not cycles
+    assert len(graph) > 60  # the walk found the code
