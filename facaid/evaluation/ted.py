@@ -48,7 +48,7 @@ def tree_edit_distance(a: Node, b: Node) -> int:
     """Fewest node insertions, deletions and relabellings that turn tree ``a`` into tree ``b``.
 
     Zhang & Shasha's dynamic programme over the keyroot pairs; equal trees return at once (most pairs in an
-    evaluation are), and labels are compared as small integers. ``tests/test_ted.py`` checks it against the
+    evaluation are), and labels are compared as small integers. ``tests/evaluation/test_ted.py`` checks it against the
     recursive definition of the forest distance."""
     la, ma = _postorder(a)
     lb, mb = _postorder(b)

@@ -8,7 +8,8 @@
    steps of one token, torch's fixed cost per operation (a few microseconds, about 16 operations a block)
    outweighs this arithmetic; one call does it all.
 
-   Built and loaded by facaid/native.py; checked against the torch paths to 1e-5 by tests/test_native.py. */
+   Built and loaded by facaid/native/__init__.py; checked against the torch decoder to 1e-5 by
+   tests/model/test_native.py. */
 
 #include <math.h>
 #include <stddef.h>

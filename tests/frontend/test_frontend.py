@@ -9,7 +9,7 @@ import pytest
 
 from facaid.labels import LABELS, PAINT_ORDER, PALETTE
 
-FRONTEND = Path(__file__).resolve().parents[1] / "frontend"
+FRONTEND = Path(__file__).resolve().parents[2] / "frontend"
 pytestmark = pytest.mark.skipif(shutil.which("node") is None, reason="needs node")
 
 
