@@ -88,25 +88,28 @@ class Block(nn.Module):
     """One decoder block. Its arithmetic is `block_forward`'s, on `weights`; the submodules hold the parameters under
     GPT-2's names."""
 
-    def __init__(self, d: int, heads: int, ffn: int, dropout: float):
+    def __init__(self, d: int, heads: int, ffn: int, dropout: float, cross: bool = True):
         super().__init__()
         if d % heads:
             raise ValueError(f"d_model {d} is not divisible by {heads} heads")
         self.d, self.heads, self.dropout = d, heads, dropout
         self.ln_1 = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
         self.attn = SelfAttention(d)
-        self.ln_cross_attn = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
-        self.crossattention = CrossAttention(d)
+        if cross:  # without: a block of the causal encoder (`facaid.encoder.CausalEncoder`)
+            self.ln_cross_attn = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
+            self.crossattention = CrossAttention(d)
         self.ln_2 = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
         self.mlp = MLP(d, ffn)
 
     def weights(self) -> BlockWeights:
-        a, c, m = self.attn, self.crossattention, self.mlp
+        a, m = self.attn, self.mlp
+        c = getattr(self, "crossattention", None)
+        cross = (None,) * 7 if c is None else ((self.ln_cross_attn.weight, self.ln_cross_attn.bias), c.q_attn.weight,
+                                               c.q_attn.bias, c.c_attn.weight, c.c_attn.bias, c.c_proj.weight,
+                                               c.c_proj.bias)
         return BlockWeights((self.ln_1.weight, self.ln_1.bias), a.c_attn.weight, a.c_attn.bias, a.c_proj.weight,
-                            a.c_proj.bias, (self.ln_cross_attn.weight, self.ln_cross_attn.bias), c.q_attn.weight,
-                            c.q_attn.bias, c.c_attn.weight, c.c_attn.bias, c.c_proj.weight, c.c_proj.bias,
-                            (self.ln_2.weight, self.ln_2.bias), m.c_fc.weight, m.c_fc.bias, m.c_proj.weight,
-                            m.c_proj.bias)
+                            a.c_proj.bias, *cross, (self.ln_2.weight, self.ln_2.bias), m.c_fc.weight, m.c_fc.bias,
+                            m.c_proj.weight, m.c_proj.bias)
 
     def forward(self, x: torch.Tensor, memory: torch.Tensor, cross_mask: torch.Tensor | None = None) -> torch.Tensor:
         """Teacher forcing: x (B, T, d), memory (B, M, d) -> (B, T, d) (see `block_forward`)."""
@@ -134,13 +137,13 @@ def block_forward(w: BlockWeights, x: torch.Tensor, rows: int, cross_k: torch.Te
                   dropout: float = 0.0) -> torch.Tensor:
     """One block on the residual stream x (B T, d) of ``rows`` = B rows -> (B T, d).
 
-    ``cross_k``, ``cross_v`` (B or 1, H, M, dh): `cross_kv` of the memory; one memory row is shared by B > 1 rows
-    when T is 1. ``cross_mask``: additive, broadcast to the attention's (B, H, T, M) (or (1, H, B, M) when
-    shared). Without ``cache`` the self-attention is causal over the T positions; with it (one token a row, T = 1,
-    at position ``t``) the new keys and values go into the cache ``(kv, keys, values)`` (``kv`` (2, B, H, L, dh),
-    the others its halves) and the query reads positions 0..t. ``dropout`` on the residual branches and the
-    self-attention (training only). The stream stays two-dimensional: a step is a few hundred small operations,
-    and every view costs."""
+    ``cross_k``, ``cross_v`` (B or 1, H, M, dh): `cross_kv` of the memory (None: no cross-attention); one memory
+    row is shared by B > 1 rows when T is 1. ``cross_mask``: additive, broadcast to the attention's (B, H, T, M)
+    (or (1, H, B, M) when shared). Without ``cache`` the self-attention is causal over the T positions; with it
+    (one token a row, T = 1, at position ``t``) the new keys and values go into the cache ``(kv, keys, values)``
+    (``kv`` (2, B, H, L, dh), the others its halves) and the query reads positions 0..t. ``dropout`` on the
+    residual branches and the self-attention (training only). The stream stays two-dimensional: a step is a few
+    hundred small operations, and every view costs."""
     d = x.shape[1]
     n, dh = x.shape[0] // rows, d // heads
     qkv = torch.addmm(w.attn_b, _ln(x, w.ln_1), w.attn_w)  # (B T, 3d)
@@ -156,6 +159,8 @@ def block_forward(w: BlockWeights, x: torch.Tensor, rows: int, cross_k: torch.Te
         o = o.reshape(rows, d)  # (B, H, 1, dh) -> (B, d)
     o = torch.addmm(w.attn_proj_b, o, w.attn_proj_w)
     x = x + (F.dropout(o, dropout) if dropout else o)
+    if cross_k is None:  # a block without cross-attention (the causal encoder's)
+        return _mlp(w, x, dropout)
     q = torch.addmm(w.cross_q_b, _ln(x, w.ln_cross), w.cross_q_w)  # (B T, d)
     if cross_k.shape[0] == 1 and rows > 1 and n == 1:  # (1, H, B, dh): the B rows are B queries on one memory
         o = F.scaled_dot_product_attention(q.view(rows, heads, dh).transpose(0, 1)[None], cross_k, cross_v,
@@ -169,7 +174,10 @@ def block_forward(w: BlockWeights, x: torch.Tensor, rows: int, cross_k: torch.Te
                                            attn_mask=cross_mask)  # (B, H, T, dh)
         o = o.transpose(1, 2).reshape(rows * n, d)
     o = torch.addmm(w.cross_proj_b, o, w.cross_proj_w)
-    x = x + (F.dropout(o, dropout) if dropout else o)
+    return _mlp(w, x + (F.dropout(o, dropout) if dropout else o), dropout)
+
+
+def _mlp(w: BlockWeights, x: torch.Tensor, dropout: float) -> torch.Tensor:
     hidden = F.gelu(torch.addmm(w.fc_b, _ln(x, w.ln_2), w.fc_w), approximate="tanh")  # (B T, ffn)
     o = torch.addmm(w.mlp_proj_b, hidden, w.mlp_proj_w)
     return x + (F.dropout(o, dropout) if dropout else o)

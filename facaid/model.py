@@ -1,12 +1,12 @@
 """The encoder-decoder transformer: flattened segmentation rows in, procedure tokens out.
 
-An encoder over the rectangle rows (Hugging Face's bidirectional BERT, or a causal GPT-2 as in the paper:
-``FacaidConfig.encoder``) and our own GPT-2 decoder with cross-attention (`facaid.decoder`, written once for
-training and decoding). Both take our own embeddings: the five fields of a rectangle are embedded separately
-and summed (one token per rectangle) or laid out as five tokens with a field index; output tokens add the
-embedding of their local index within their node group and of their node's box. `FacaidModel` is a Hugging Face
-`PreTrainedModel`: `save_pretrained` writes config.json and model.safetensors, `from_pretrained` reads them;
-the checkpoint also holds the tokenizer and the grammar version.
+An encoder over the rectangle rows (`facaid.encoder`: bidirectional, BERT-style, or causal as in the paper:
+``FacaidConfig.encoder``) and a GPT-2-style decoder with cross-attention (`facaid.decoder`, written once for
+training and decoding), both in plain torch. They take our own embeddings: the five fields of a rectangle are
+embedded separately and summed (one token per rectangle) or laid out as five tokens with a field index; output
+tokens add the embedding of their local index within their node group and of their node's box. `FacaidModel` is
+a Hugging Face `PreTrainedModel`: `save_pretrained` writes config.json and model.safetensors, `from_pretrained`
+reads them; the checkpoint also holds the tokenizer and the grammar version.
 """
 
 from __future__ import annotations
@@ -16,9 +16,10 @@ from pathlib import Path
 import torch
 import torch.nn.functional as F
 from torch import nn
-from transformers import BertConfig, BertModel, GPT2Config, GPT2Model, PretrainedConfig, PreTrainedModel
+from transformers import PretrainedConfig, PreTrainedModel
 
 from facaid.decoder import Conv1D, Decoder
+from facaid.encoder import BidirectionalEncoder, CausalEncoder
 from facaid.grammar.procedure import GRAMMAR_VERSION
 from facaid.tokenizer import PAD, Tokenizer, TokenizerConfig
 
@@ -57,8 +58,10 @@ class FacaidModel(PreTrainedModel):
     config_class = FacaidConfig
     base_model_prefix = "facaid"
     main_input_name = "rects"
-    # the token embedding of the Hugging Face GPT-2 decoder the shipped weights were trained with, never read
-    _keys_to_ignore_on_load_unexpected = [r"^decoder\.wte\.weight$"]
+    # the token embeddings of the Hugging Face modules the shipped weights were trained with, never read (our own
+    # embeddings go in as ``inputs_embeds``)
+    _keys_to_ignore_on_load_unexpected = [r"^decoder\.wte\.weight$", r"^encoder\.wte\.weight$",
+                                          r"^encoder\.embeddings\.word_embeddings\.weight$"]
 
     def __init__(self, config: FacaidConfig):
         super().__init__(config)
@@ -74,19 +77,8 @@ class FacaidModel(PreTrainedModel):
         self.count_fields = nn.ModuleList(nn.Embedding(n, d) for n in sizes[5:])
         self.field_index = nn.Embedding(5, d)
         max_input = (tc.max_rects + 1) * tc.rect_tokens
-        if config.encoder == "bidirectional":
-            self.encoder = BertModel(BertConfig(
-                vocab_size=1, hidden_size=d, num_hidden_layers=config.encoder_layers,
-                num_attention_heads=config.heads, intermediate_size=config.ffn,
-                max_position_embeddings=max_input, type_vocab_size=1,
-                hidden_dropout_prob=config.dropout, attention_probs_dropout_prob=config.dropout,
-            ), add_pooling_layer=False)
-        else:  # a causal GPT-2 encoder, as in the paper
-            self.encoder = GPT2Model(GPT2Config(
-                vocab_size=1, n_positions=max_input, n_embd=d, n_layer=config.encoder_layers, n_head=config.heads,
-                n_inner=config.ffn, resid_pdrop=config.dropout, embd_pdrop=config.dropout,
-                attn_pdrop=config.dropout, bos_token_id=None, eos_token_id=None,
-            ))
+        kind = BidirectionalEncoder if config.encoder == "bidirectional" else CausalEncoder  # causal: the paper's
+        self.encoder = kind(d, config.encoder_layers, config.heads, config.ffn, max_input, config.dropout)
         self.token_embedding = nn.Embedding(len(tok.vocab), d)
         self.local_embedding = nn.Embedding(MAX_LOCAL, d)
         self.decoder = Decoder(d, config.decoder_layers, config.heads, config.ffn, tc.max_out, config.dropout)
@@ -129,7 +121,7 @@ class FacaidModel(PreTrainedModel):
             x = torch.stack(embs, 2) + self.field_index.weight  # (B, N, 5, d)
             x = x.reshape(b, n * 5, -1)  # (B, 5N, d)
             mask = rect_mask.repeat_interleave(5, dim=1)  # (B, 5N)
-        h = self.encoder(inputs_embeds=x, attention_mask=mask.long()).last_hidden_state  # (B, M, d)
+        h = self.encoder(x, mask)  # (B, M, d)
         return h, mask
 
     def embed_outputs(self, ids: torch.Tensor, local: torch.Tensor, boxes: torch.Tensor | None = None,

@@ -67,7 +67,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     if temperature <= 0:
         raise ValueError(f"temperature must be positive, got {temperature}")
     device = next(model.parameters()).device
-    max_len = max_len or tokenizer.config.max_out
+    max_len = min(max_len or tokenizer.config.max_out, model.decoder.max_len)  # no longer than its positions
     rows = tokenizer.encode_segmentation(seg)
     rects, mask = batch_inputs([rows], device)
     memory, memory_mask = model.encode(rects, mask)  # one row: the K candidates read the same input
