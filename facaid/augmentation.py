@@ -58,3 +58,46 @@ def perturb(seg: Segmentation, level: float, seed: int = 0, iterations: int = 12
         else:
             hi = sigma
     return best
+
+
+ANNOTATOR_EDGE = 0.01  # every edge moves by up to this share of the image's side (uniform), as people annotate
+ANNOTATOR_DROP = 0.10  # share of the elements left out
+ANNOTATOR_SPURIOUS = 2  # boxes added over existing elements
+
+
+def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDGE, drop: float = ANNOTATOR_DROP,
+                    spurious: int = ANNOTATOR_SPURIOUS) -> Segmentation:
+    """A segmentation annotated the way people annotate (`facaid evaluate-real --perturb SEED`), seeded: each
+    element's four edges moved independently by up to ``edge`` of the image's width (x) or height (y), uniformly;
+    ``drop`` of the elements left out (rounded, at least one when there are ten or more); ``spurious`` boxes added,
+    each over an element left in, of a class drawn among the elements and about the size of the element it covers.
+    Facade (wall) rectangles keep their place: they are the building's outline, not an element. The result holds
+    the input's layers as rectangles, not flattened."""
+    if not (0 <= edge <= 0.5 and 0 <= drop < 1 and spurious >= 0):
+        raise ValueError(f"edge must be in [0, 0.5], drop in [0, 1), spurious >= 0; got {edge}, {drop}, {spurious}")
+    rng = np.random.default_rng([int(seed), 20421])
+    walls = [r for r in seg.rects if r.label == FACADE]
+    elements = [r for r in seg.rects if r.label != FACADE]
+    n_drop = int(round(drop * len(elements)))
+    keep = sorted(rng.permutation(len(elements))[n_drop:].tolist()) if elements else []
+    kept = [elements[i] for i in keep]
+    w, h = seg.width, seg.height
+
+    def moved(r: Rect) -> Rect | None:
+        d = rng.uniform(-edge, edge, size=4) * (w, h, w, h)
+        x0, y0 = max(0, round(r.x0 + d[0])), max(0, round(r.y0 + d[1]))
+        x1, y1 = min(w, round(r.x1 + d[2])), min(h, round(r.y1 + d[3]))
+        return Rect(r.label, x0, y0, x1, y1) if x0 < x1 and y0 < y1 else None
+
+    out = walls + [m for m in map(moved, kept) if m is not None]
+    labels = [r.label for r in elements]
+    for _ in range(spurious if kept else 0):
+        under = kept[rng.integers(len(kept))]
+        cw, ch = (under.x1 - under.x0) * rng.uniform(0.5, 1.5), (under.y1 - under.y0) * rng.uniform(0.5, 1.5)
+        cx = (under.x0 + under.x1) / 2 + rng.uniform(-0.5, 0.5) * (under.x1 - under.x0)
+        cy = (under.y0 + under.y1) / 2 + rng.uniform(-0.5, 0.5) * (under.y1 - under.y0)
+        box = Rect(int(labels[rng.integers(len(labels))]), max(0, round(cx - cw / 2)), max(0, round(cy - ch / 2)),
+                   min(w, round(cx + cw / 2)), min(h, round(cy + ch / 2)))
+        if box.x0 < box.x1 and box.y0 < box.y1:
+            out.append(box)
+    return Segmentation(w, h, tuple(out))

@@ -111,3 +111,24 @@ def procedure_accuracy(proc: Procedure, target: Segmentation) -> float:
 
 def procedure_iou(proc: Procedure, target: Segmentation) -> dict[str, float]:
     return class_iou(rasterize(to_segmentation(proc)), rasterize(target))
+
+
+def element_rectangles(seg: Segmentation) -> int:
+    """The elements of an annotation: its rectangles of a class other than wall and background."""
+    return sum(1 for r in seg.rects if r.label not in (BACKGROUND, FACADE))
+
+
+def element_leaves(proc: Procedure) -> int:
+    """The element leaves a person writes and edits: leaf nodes of the tree (not their copies under repeats and
+    mirrors) of a class other than wall and background."""
+    return sum(1 for _, node in proc.root.walk() if node.rule == "leaf" and node.label not in ("background", "facade"))
+
+
+def compression(proc: Procedure, seg: Segmentation) -> float:
+    """Element rectangles of the input per element leaf of the procedure: how much the procedure says with repeats
+    and mirrors (a flat list of the input's rectangles is about 1; a repeat of 8 windows counts one leaf). 1 when
+    both are empty, infinity for elements and no element leaf."""
+    n, leaves = element_rectangles(seg), element_leaves(proc)
+    if leaves == 0:
+        return 1.0 if n == 0 else float("inf")
+    return n / leaves

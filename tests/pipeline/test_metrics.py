@@ -36,3 +36,25 @@ def test_element_counts_are_the_same_for_any_cover_of_the_picture(seed):
     assert expected.sum() > 0
     assert np.array_equal(element_counts(pieces), expected)
     assert np.array_equal(element_counts(flatten(pieces, wall="footprint")), expected)
+
+
+def test_compression_counts_the_input_elements_per_element_leaf_of_the_tree():
+    from facaid.grammar import Node, Procedure, Size
+    from facaid.labels import FACADE
+    from facaid.metrics import compression, element_leaves, element_rectangles
+    from facaid.segmentation import Rect, Segmentation
+
+    windows = Segmentation(600, 100, (Rect(FACADE, 0, 0, 600, 100),
+                                      *(Rect(2, 20 + 100 * i, 20, 80 + 100 * i, 80) for i in range(6))))
+    tile = Node.split("x", [(Size("abs", 20), Node.leaf("facade")), (Size("flt", 60), Node.leaf("window")),
+                            (Size("abs", 20), Node.leaf("facade"))])
+    row = Node.split("y", [(Size("abs", 20), Node.leaf("facade")), (Size("flt", 60), Node.repeat("x", 6, [
+        (Size("flt", 100), tile)])), (Size("abs", 20), Node.leaf("facade"))])
+    flat = Node.split("x", [(Size("abs", 100), Node.leaf("window")) for _ in range(6)])
+    assert element_rectangles(windows) == 6  # the wall rectangle is not an element
+    assert element_leaves(Procedure(600, 100, row)) == 1  # one window leaf, repeated: its copies do not count
+    assert compression(Procedure(600, 100, row), windows) == 6.0
+    assert compression(Procedure(600, 100, flat), windows) == 1.0  # a flat list
+    wall = Procedure(600, 100, Node.leaf("facade"))
+    assert compression(wall, windows) == float("inf")
+    assert compression(wall, Segmentation(600, 100, (Rect(FACADE, 0, 0, 600, 100),))) == 1.0

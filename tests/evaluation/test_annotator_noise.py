@@ -1,0 +1,70 @@
+"""Annotations as people make them (`facaid.augmentation.annotator_noise`), and what `evaluate-real` reports of
+them."""
+
+import json
+
+import pytest
+
+from facaid.augmentation import annotator_noise
+from facaid.generator import generate
+from facaid.labels import FACADE
+from facaid.segmentation import Rect, Segmentation
+
+
+def _grid(cols: int = 6, rows: int = 5) -> Segmentation:
+    rects = [Rect(FACADE, 0, 0, 600, 500)]
+    rects += [Rect(2, 20 + 100 * i, 20 + 100 * j, 80 + 100 * i, 80 + 100 * j) for j in range(rows) for i in range(cols)]
+    return Segmentation(600, 500, tuple(rects))
+
+
+def test_the_noise_is_seeded_moves_edges_within_a_percent_drops_a_tenth_and_adds_two_boxes():
+    seg = _grid()
+    a, b, other = annotator_noise(seg, 7), annotator_noise(seg, 7), annotator_noise(seg, 8)
+    assert a == b and a != other
+    walls = [r for r in a.rects if r.label == FACADE]
+    assert walls == [seg.rects[0]]  # the building's outline stays
+    elements = [r for r in a.rects if r.label != FACADE]
+    assert len(elements) == 30 - 3 + 2  # a tenth of the 30 windows left out, two spurious boxes added
+    kept, spurious = elements[:27], elements[27:]
+    originals = seg.rects[1:]
+    for r in kept:  # each kept window is one of the originals with every edge moved by at most 1 % (+ rounding)
+        near = [o for o in originals if abs(o.x0 - r.x0) <= 6.5 and abs(o.y0 - r.y0) <= 5.5
+                and abs(o.x1 - r.x1) <= 6.5 and abs(o.y1 - r.y1) <= 5.5]
+        assert len(near) == 1
+    assert any((r.x0, r.y0, r.x1, r.y1) != (o.x0, o.y0, o.x1, o.y1) for r, o in zip(kept, originals, strict=False))
+    for box in spurious:  # each over a window left in
+        assert any(box.x0 < r.x1 and r.x0 < box.x1 and box.y0 < r.y1 and r.y0 < box.y1 for r in kept)
+
+
+def test_the_noise_keeps_a_valid_segmentation_and_refuses_bad_settings():
+    for seed in range(20):
+        seg = generate(seed).segmentation
+        noisy = annotator_noise(seg, seed)
+        assert Segmentation.from_dict(noisy.to_dict()) == noisy  # every box inside the image, at least 1 px
+    empty = Segmentation(10, 10, ())
+    assert annotator_noise(empty, 1) == empty
+    for bad in ({"edge": -0.1}, {"drop": 1.0}, {"spurious": -1}):
+        with pytest.raises(ValueError, match="edge must be in"):
+            annotator_noise(_grid(), 1, **bad)
+
+
+def test_evaluate_real_reports_compression_source_and_the_gain_over_a_perturbed_input(tmp_path):
+    from facaid.evaluation.real import evaluate_real, format_summary
+    from facaid.pipeline import default_model
+
+    data = tmp_path / "annotations.jsonl"
+    data.write_text("".join(json.dumps({"id": f"g{s}", **generate(s, "tenement").segmentation.to_dict()}) + "\n"
+                            for s in (3, 4)))
+    model, tokenizer = default_model()
+    clean = evaluate_real(model, tokenizer, data, k=2, progress=False)
+    noisy = evaluate_real(model, tokenizer, data, k=2, progress=False, perturb=1)
+    for result in (clean, noisy):
+        assert result["halves"]["test"] == {"facades": 0} and result["halves"]["dev"]["facades"] == 2
+        for f in result["per_facade"]:
+            assert f["half"] == "dev" and f["compression"] > 0 and f["source"] in ("model", "induced")
+    assert "input_accuracy" not in clean["per_facade"][0]
+    group = noisy["summary"]
+    assert 0 < group["input_accuracy_mean"] < 1
+    assert group["gain_over_input"] == pytest.approx(group["accuracy_mean"] - group["input_accuracy_mean"])
+    text = format_summary(noisy)
+    assert "perturbed as people annotate (seed 1)" in text and "compression median" in text
