@@ -231,13 +231,16 @@ def cmd_evaluate_real(args: argparse.Namespace) -> None:
 
     if not Path(args.data).is_file():
         raise CliError(f"annotations not found at {args.data} (pass --data PATH)")
+    gallery = args.gallery or None  # --gallery "": none
+    if gallery and Path(gallery).suffix.lower() != ".png":  # refused now, not after the whole run
+        raise CliError(f"--gallery must name a .png file (or be empty for none), got {gallery!r}")
     model, tokenizer = load_model(args.checkpoint)
-    result = evaluate_real(model, tokenizer, args.data, k=args.k, limit=args.limit, gallery=args.gallery,
+    result = evaluate_real(model, tokenizer, args.data, k=args.k, limit=args.limit, gallery=gallery,
                            progress=not args.quiet, induce=not args.no_induce, perturb=args.perturb)
     result["checkpoint"] = str(args.checkpoint)
     print(format_summary(result))
-    if args.gallery:
-        print(f"gallery (input | reconstruction): {args.gallery}")
+    if gallery:
+        print(f"gallery (input | reconstruction): {gallery}")
     _write_json(args.json, result)
 
 
@@ -406,7 +409,8 @@ def build_parser() -> argparse.ArgumentParser:
     r2.add_argument("--perturb", type=int, metavar="SEED",
                     help="annotate each input as people do first (edges moved up to 1 %% of the side, 10 %% of the "
                          "elements left out, 2 spurious boxes), seeded; compare with the clean annotation")
-    r2.add_argument("--gallery", default="out/evaluate-real/gallery.png", help="gallery PNG of the first 20")
+    r2.add_argument("--gallery", default="out/evaluate-real/gallery.png",
+                    help='gallery PNG of the first 20 ("" for none)')
     r2.add_argument("--json", help="write the figures to this JSON file")
     r2.add_argument("--quiet", action="store_true", help="no progress bar")
     r2.set_defaults(func=cmd_evaluate_real)

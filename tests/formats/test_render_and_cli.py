@@ -161,3 +161,15 @@ def test_demo_and_console_script(tmp_path):
     assert "newmtl window" in (tmp_path / "haussmann.mtl").read_text()
     done = subprocess.run([sys.executable, "-m", "facaid.cli", "--help"], capture_output=True, text=True)
     assert done.returncode == 0 and "generate" in done.stdout
+
+
+def test_cli_evaluate_real_refuses_a_gallery_it_cannot_write_before_the_run(tmp_path, capsys):
+    data = tmp_path / "annotations.jsonl"
+    data.write_text(json.dumps({"id": "g1", **generate(1, "house").segmentation.to_dict()}) + "\n")
+    assert main(["evaluate-real", "--data", str(data), "--gallery", str(tmp_path / "g.jpg"), "--quiet"]) == 2
+    assert "--gallery must name a .png file" in capsys.readouterr().err
+    out = tmp_path / "r.json"
+    assert main(["evaluate-real", "--data", str(data), "--gallery", "", "--k", "1", "--quiet", "--perturb", "3",
+                 "--json", str(out)]) == 0
+    result = json.loads(out.read_text())
+    assert result["perturb"] == 3 and result["facades"] == 1 and "input_accuracy" in result["per_facade"][0]
