@@ -1,5 +1,7 @@
 import json
 
+import pytest
+
 import facaid
 from facaid.cli import main
 from facaid.generator import generate
@@ -105,3 +107,27 @@ def test_worker_reports_loading_then_the_pipeline_s_stages(tiny, tmp_path):
     assert heard[2] == (0.6, "sizing") and heard[-1] == (1.0, "done")
     assert [f for f, _ in heard] == sorted(f for f, _ in heard)
     Procedure.from_dict(out["procedure"])
+
+
+def test_bad_real_input_gets_a_procedure_or_a_clear_error():
+    """Issue 42's bad inputs: an empty annotation, one without a facade rectangle, boxes all over each other, and
+    20,000 rectangles: a procedure that reproduces the input, or an error that names the limit."""
+    import random
+
+    from facaid.grammar import validate
+    from facaid.segmentation import Rect, Segmentation
+
+    cases = [Segmentation(400, 300, ()),
+             Segmentation(400, 300, tuple(Rect(2, 20 + 60 * i, 40, 60 + 60 * i, 100) for i in range(5))),
+             Segmentation(400, 300, tuple(Rect(2 + i % 9, 0, 0, 400, 300) for i in range(30)))]
+    for seg in cases:
+        result = reconstruct(seg, k=2)
+        validate(result.procedure)
+        assert result.accuracy > 0.99
+    rng = random.Random(1)
+    many = []
+    for i in range(20_000):
+        x, y = rng.randrange(0, 1990), rng.randrange(0, 1990)
+        many.append(Rect(2 + i % 10, x, y, x + rng.randrange(1, 10), y + rng.randrange(1, 10)))
+    with pytest.raises(ValueError, match=r"too many rectangles for the model: \d+ after flattening \(at most 640\)"):
+        reconstruct(Segmentation(2000, 2000, tuple(many)), k=2)
