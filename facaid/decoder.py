@@ -27,6 +27,12 @@ from torch import nn
 LAYER_NORM_EPS = 1e-5  # GPT-2's
 
 
+def padding_mask(mask: torch.Tensor, dtype: torch.dtype) -> torch.Tensor:
+    """mask (B, N) bool, True where a position is real -> additive (B, 1, 1, N): the smallest float at padding."""
+    return torch.zeros(mask.shape, dtype=dtype, device=mask.device).masked_fill(
+        ~mask, torch.finfo(dtype).min)[:, None, None, :]
+
+
 class Conv1D(nn.Module):
     """GPT-2's linear layer: ``x @ weight + bias`` with weight (in, out)."""
 
@@ -111,11 +117,14 @@ class Block(nn.Module):
                             a.c_proj.bias, *cross, (self.ln_2.weight, self.ln_2.bias), m.c_fc.weight, m.c_fc.bias,
                             m.c_proj.weight, m.c_proj.bias)
 
-    def forward(self, x: torch.Tensor, memory: torch.Tensor, cross_mask: torch.Tensor | None = None) -> torch.Tensor:
-        """Teacher forcing: x (B, T, d), memory (B, M, d) -> (B, T, d) (see `block_forward`)."""
+    def forward(self, x: torch.Tensor, memory: torch.Tensor | None, cross_mask: torch.Tensor | None = None
+                ) -> torch.Tensor:
+        """Teacher forcing: x (B, T, d), memory (B, M, d) or None without cross-attention -> (B, T, d) (see
+        `block_forward`)."""
         w = self.weights()
         b, n, d = x.shape
-        out = block_forward(w, x.reshape(b * n, d), b, *cross_kv(w, memory, self.heads), cross_mask, self.heads,
+        cross = (None, None) if memory is None else cross_kv(w, memory, self.heads)
+        out = block_forward(w, x.reshape(b * n, d), b, *cross, cross_mask, self.heads,
                             dropout=self.dropout if self.training else 0.0)
         return out.view(b, n, d)
 
@@ -186,17 +195,18 @@ def _mlp(w: BlockWeights, x: torch.Tensor, dropout: float) -> torch.Tensor:
 class Decoder(nn.Module):
     """Learned positions, the blocks, a final layer norm: embedded tokens (B, T, d) -> hidden states (B, T, d)."""
 
-    def __init__(self, d: int, layers: int, heads: int, ffn: int, max_len: int, dropout: float = 0.0):
+    def __init__(self, d: int, layers: int, heads: int, ffn: int, max_len: int, dropout: float = 0.0,
+                 cross: bool = True):
         super().__init__()
         self.d, self.heads, self.max_len, self.dropout = d, heads, max_len, dropout
         self.wpe = nn.Embedding(max_len, d)
-        self.h = nn.ModuleList(Block(d, heads, ffn, dropout) for _ in range(layers))
+        self.h = nn.ModuleList(Block(d, heads, ffn, dropout, cross) for _ in range(layers))
         self.ln_f = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
 
-    def forward(self, x: torch.Tensor, memory: torch.Tensor, cross_mask: torch.Tensor | None = None
+    def forward(self, x: torch.Tensor, memory: torch.Tensor | None, cross_mask: torch.Tensor | None = None
                 ) -> torch.Tensor:
-        """Teacher forcing: x (B, T, d) embedded tokens, memory (B, M, d), cross_mask additive (B, 1 or H, T or 1,
-        M) -> (B, T, d)."""
+        """Teacher forcing: x (B, T, d) embedded tokens, memory (B, M, d) (None for blocks without
+        cross-attention), cross_mask additive (B, 1 or H, T or 1, M) -> (B, T, d)."""
         if x.shape[1] > self.max_len:
             raise ValueError(f"the decoder holds at most {self.max_len} positions, got {x.shape[1]}")
         x = x + self.wpe.weight[: x.shape[1]]
@@ -228,8 +238,7 @@ class DecoderState:
         self.max_len = min(max_len, dec.max_len)
         self.mask = None  # (B, 1, 1, M) additive: the smallest float where a memory position is padding
         if not bool(memory_mask.all()):
-            self.mask = memory.new_zeros(memory_mask.shape).masked_fill(
-                ~memory_mask, torch.finfo(memory.dtype).min)[:, None, None, :]
+            self.mask = padding_mask(memory_mask, memory.dtype)
         self.box_scale = model.box_scale
         if self.box_scale is not None:
             if memory_boxes is None:

@@ -15,15 +15,9 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from facaid.decoder import LAYER_NORM_EPS, Block, block_forward
+from facaid.decoder import Decoder, padding_mask
 
 BERT_LAYER_NORM_EPS = 1e-12  # BERT's
-
-
-def padding_mask(mask: torch.Tensor, dtype: torch.dtype) -> torch.Tensor:
-    """mask (B, N) bool, True where a position is real -> additive (B, 1, 1, N): the smallest float at padding."""
-    return torch.zeros(mask.shape, dtype=dtype, device=mask.device).masked_fill(
-        ~mask, torch.finfo(dtype).min)[:, None, None, :]
 
 
 class BertEmbeddings(nn.Module):
@@ -115,24 +109,13 @@ class BidirectionalEncoder(nn.Module):
         return x
 
 
-class CausalEncoder(nn.Module):
-    """GPT-2-style, as in the paper: each position reads itself and those before it (padding comes last, so no
-    real position reads it)."""
+class CausalEncoder(Decoder):
+    """GPT-2-style, as in the paper: the decoder's blocks without cross-attention, each position reading itself and
+    those before it (padding comes last, so no real position reads it)."""
 
     def __init__(self, d: int, layers: int, heads: int, ffn: int, max_len: int, dropout: float = 0.0):
-        super().__init__()
-        self.d, self.heads, self.dropout = d, heads, dropout
-        self.wpe = nn.Embedding(max_len, d)
-        self.h = nn.ModuleList(Block(d, heads, ffn, dropout, cross=False) for _ in range(layers))
-        self.ln_f = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
+        super().__init__(d, layers, heads, ffn, max_len, dropout, cross=False)
 
     def forward(self, x: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
         """x (B, N, d) embedded rows, mask (B, N) bool (unused: see the class) -> (B, N, d)."""
-        b, n, d = x.shape
-        x = x + self.wpe.weight[:n]
-        drop = self.dropout if self.training else 0.0
-        x = F.dropout(x, drop) if drop else x
-        h = x.reshape(b * n, d)
-        for block in self.h:
-            h = block_forward(block.weights(), h, b, None, None, None, self.heads, dropout=drop)
-        return torch.layer_norm(h, (d,), self.ln_f.weight, self.ln_f.bias, LAYER_NORM_EPS).view(b, n, d)
+        return super().forward(x, None)

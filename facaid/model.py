@@ -18,7 +18,7 @@ import torch.nn.functional as F
 from torch import nn
 from transformers import PretrainedConfig, PreTrainedModel
 
-from facaid.decoder import Conv1D, Decoder
+from facaid.decoder import Conv1D, Decoder, padding_mask
 from facaid.encoder import BidirectionalEncoder, CausalEncoder
 from facaid.grammar.procedure import GRAMMAR_VERSION
 from facaid.tokenizer import PAD, Tokenizer, TokenizerConfig
@@ -196,8 +196,7 @@ class FacaidModel(PreTrainedModel):
                 raise ValueError("this model biases cross-attention by the node box: pass memory_boxes")
             mask = self.cross_bias(memory_boxes, memory_mask, boxes).to(x.dtype)  # (B, H, T, M)
         else:
-            mask = x.new_zeros(memory_mask.shape).masked_fill(~memory_mask, torch.finfo(x.dtype).min)
-            mask = mask[:, None, None, :]  # (B, 1, 1, M)
+            mask = padding_mask(memory_mask, x.dtype)  # (B, 1, 1, M)
         return self.lm_head(self.decoder(x, memory, mask))  # (B, T, V)
 
     def forward(self, rects: torch.Tensor, rect_mask: torch.Tensor, ids: torch.Tensor, local: torch.Tensor,

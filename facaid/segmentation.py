@@ -38,6 +38,11 @@ class Rect(NamedTuple):
         return (self.x1 - self.x0) * (self.y1 - self.y0)
 
 
+def rect_dicts(rows) -> list[dict[str, Any]]:
+    """The contract's rectangles from (label id, x0, y0, x1, y1) rows: `Rect`s, or int rows as lists."""
+    return [{"label": LABELS[k], "x0": x0, "y0": y0, "x1": x1, "y1": y1} for k, x0, y0, x1, y1 in rows]
+
+
 @dataclass(frozen=True)
 class Segmentation:
     width: int
@@ -45,13 +50,7 @@ class Segmentation:
     rects: tuple[Rect, ...]
 
     def to_dict(self) -> dict[str, Any]:
-        return {
-            "width": self.width,
-            "height": self.height,
-            "rects": [
-                {"label": LABELS[r.label], "x0": r.x0, "y0": r.y0, "x1": r.x1, "y1": r.y1} for r in self.rects
-            ],
-        }
+        return {"width": self.width, "height": self.height, "rects": rect_dicts(self.rects)}
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), separators=(",", ":"))

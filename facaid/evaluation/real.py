@@ -68,8 +68,9 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
         flat = flatten(seg)
         target = rasterize(flat)
         given = seg if perturb is None else annotator_noise(seg, perturb * 100_003 + i)
+        given_flat = flat if perturb is None else flatten(given)
         t0 = time.perf_counter()
-        result = reconstruct(flatten(given), model=model, tokenizer=tokenizer, k=k, induce=induce)
+        result = reconstruct(given_flat, model=model, tokenizer=tokenizer, k=k, induce=induce)
         times.append(time.perf_counter() - t0)
         pred = rasterize(to_segmentation(result.procedure))
         trivial = all_wall(target)
@@ -87,7 +88,7 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
                   "seconds": times[-1], "source": result.source, "shortcut": result.shortcut, "nodes": nodes[-1],
                   "compression": compression(result.procedure, given)}
         if perturb is not None:  # the perturbed input's own accuracy against the clean annotation
-            record["input_accuracy"] = pixel_accuracy(rasterize(flatten(given)), target)
+            record["input_accuracy"] = pixel_accuracy(rasterize(given_flat), target)
         per_facade.append(record)
         if gallery is not None and i < gallery_count:
             pictures.append(side_by_side([colorize(target), colorize(pred)], height=200, gap=4))

@@ -20,7 +20,7 @@ from tqdm import tqdm
 
 from facaid.generator import STYLE_NAMES, generate_rows
 from facaid.grammar.procedure import GRAMMAR_VERSION
-from facaid.labels import LABELS
+from facaid.segmentation import rect_dicts
 
 MANIFEST = "manifest.json"
 
@@ -38,9 +38,7 @@ def sample_record(seed: int, index: int, style: str | None = None) -> dict:
         "id": f"s{seed}-{index:08d}",
         "seed": proc.meta["seed"],
         "style": proc.meta["style"],
-        "segmentation": {"width": round(proc.width), "height": round(proc.height),
-                         "rects": [{"label": LABELS[k], "x0": x0, "y0": y0, "x1": x1, "y1": y1}
-                                   for k, x0, y0, x1, y1 in rows.tolist()]},
+        "segmentation": {"width": round(proc.width), "height": round(proc.height), "rects": rect_dicts(rows.tolist())},
         "procedure": proc.to_dict(),
     }
 
