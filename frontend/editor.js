@@ -231,13 +231,14 @@ async function saveNow() {
 }
 
 async function submitNow() {
-  $("#job").hidden = false;
   try {
-    const {code, job} = await submit(api, photoCode, seg, history, {saved: root.dataset.segmentation, progress: (j) => {
-      $("#job-status").textContent = `${j.status}${j.status === "running" && j.stage ? ` (${j.stage})` : ""}`;
-      $("#job-progress").value = j.progress;
-    }});
-    root.dataset.segmentation = code;
+    const job = await submit(api, photoCode, seg, history, {saved: root.dataset.segmentation,
+      onSaved: (code) => { root.dataset.segmentation = code; },
+      progress: (j) => {
+        $("#job").hidden = false;
+        $("#job-status").textContent = `${j.status}${j.status === "running" && j.stage ? ` (${j.stage})` : ""}`;
+        $("#job-progress").value = j.progress;
+      }});
     if (job.status === "failed") return status(`The reconstruction failed: ${job.message}`, "error");
     ui.overlay = new Image();
     ui.overlay.src = `/api/v1/procedures/${job.result}/download/labels.png`;

@@ -52,12 +52,14 @@ export async function save(api, photoCode, seg, history) {
   return body;
 }
 
-/** Save if needed, submit a reconstruction of `k` candidates and follow it; `progress(job)` after each poll.
- * Resolves with the finished job. `saved`: the code of the saved version the editor shows, if unchanged. */
-export async function submit(api, photoCode, seg, history, {saved, k = 4, progress}) {
+/** Save if needed (`onSaved(code)` once the version is stored), submit a reconstruction of `k` candidates and
+ * follow it, `progress(job)` after each poll; resolves with the finished job. `saved`: the code of the saved
+ * version the editor shows, if unchanged. */
+export async function submit(api, photoCode, seg, history, {saved, k = 4, onSaved, progress}) {
   const code = history.dirty || !saved ? (await save(api, photoCode, seg, history)).code : saved;
+  onSaved(code);
   const job = await api("/api/v1/jobs/", {method: "POST", body: JSON.stringify({segmentation: code, k})});
-  return {code, job: await followJob(api, job.code, progress)};
+  return followJob(api, job.code, progress);
 }
 
 /** The rectangles of a segmentation JSON file for an image of the given size; throws a message otherwise. */
