@@ -1,7 +1,7 @@
 FROM python:3.11-slim
 WORKDIR /app
 ENV PYTHONUNBUFFERED=1 PIP_NO_CACHE_DIR=1
-# a C compiler builds the decoder's native step on first use (facaid/native.py); without one decoding uses torch
+# a C compiler builds the native code on first use (facaid/native/); without one decoding uses torch
 RUN apt-get update && apt-get install -y --no-install-recommends gcc libc6-dev && rm -rf /var/lib/apt/lists/*
 COPY pyproject.toml README.md ./
 COPY facaid facaid

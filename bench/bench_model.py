@@ -26,7 +26,7 @@ from facaid.defaults import TEMPERATURE
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model
-from facaid.native import library as native_library
+from facaid.native.step import library as native_library
 from facaid.paths import DEFAULT_CHECKPOINT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 

@@ -13,8 +13,11 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 import numpy as np
+import orjson
 
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
+from facaid.native.rects import flatten_rows
+from facaid.native.rects import rects_json as native_rects_json
 from facaid.numbers import finite
 
 MAX_SIDE = 16384  # pixels, either side
@@ -41,6 +44,12 @@ class Rect(NamedTuple):
 def rect_dicts(rows) -> list[dict[str, Any]]:
     """The contract's rectangles from (label id, x0, y0, x1, y1) rows: `Rect`s, or int rows as lists."""
     return [{"label": LABELS[k], "x0": x0, "y0": y0, "x1": x1, "y1": y1} for k, x0, y0, x1, y1 in rows]
+
+
+def rects_json(rows: np.ndarray) -> bytes:
+    """The JSON of `rect_dicts` for int rows, as compact as orjson writes it (in C where the library builds)."""
+    text = native_rects_json(rows)
+    return orjson.dumps(rect_dicts(rows.tolist())) if text is None else text
 
 
 @dataclass(frozen=True)
@@ -228,9 +237,19 @@ def flatten(seg: Segmentation, *, wall: str = "pieces") -> Segmentation:
 
 
 def flatten_array(width: int, height: int, arr: np.ndarray, wall: str = "pieces") -> np.ndarray:
-    """`flatten` on int rows (label, x0, y0, x1, y1); returns rows in the same form."""
+    """`flatten` on int rows (label, x0, y0, x1, y1); returns rows in the same form. Computed in C
+    (`facaid.native.grid`) where the library builds, else by `flatten_array_numpy`, the reference."""
     if wall not in ("pieces", "footprint"):
         raise ValueError(f"wall must be 'pieces' or 'footprint', got {wall!r}")
+    if len(arr) == 0:
+        return np.zeros((0, 5), dtype=np.int64)
+    rows = flatten_rows(width, height, arr, wall)
+    return flatten_array_numpy(width, height, arr, wall) if rows is None else rows
+
+
+def flatten_array_numpy(width: int, height: int, arr: np.ndarray, wall: str = "pieces") -> np.ndarray:
+    """`flatten_array` in numpy: the label map on the grid of all edges (`compressed_grid`), cut into
+    rectangles (`decompose_grid`)."""
     if len(arr) == 0:
         return np.zeros((0, 5), dtype=np.int64)
     xs, ys, grid = compressed_grid(width, height, arr)

@@ -12,7 +12,7 @@ import torch
 
 from facaid.decoder import DecoderState
 from facaid.model import FacaidModel
-from facaid.native import native_decoder
+from facaid.native.step import native_decoder
 
 
 class Stepper:

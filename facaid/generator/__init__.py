@@ -15,9 +15,9 @@ import numpy as np
 
 from facaid.generator.heuristics import build_procedure
 from facaid.generator.styles import PRESETS, STYLE_NAMES, Style, sample_style
-from facaid.grammar.execute import execute, leaf_array
+from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure, validate
-from facaid.segmentation import Segmentation, flatten_array
+from facaid.segmentation import Segmentation
 
 __all__ = ["PRESETS", "STYLE_NAMES", "TRAINING_STYLES", "Sample", "Style", "generate", "generate_procedure",
            "generate_rows", "sample_style"]
@@ -76,5 +76,4 @@ def generate_rows(seed: int, style: str | None = None) -> tuple[Procedure, np.nd
     """The procedure and its flat segmentation as int rows (label, x0, y0, x1, y1) (`flatten_array`), without
     the `Segmentation` objects a dataset file does not need."""
     proc = _build(seed, style)
-    w, h = round(proc.width), round(proc.height)
-    return proc, flatten_array(w, h, leaf_array(proc, execute(proc)))
+    return proc, flat_rows(proc)

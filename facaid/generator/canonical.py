@@ -36,7 +36,7 @@ def canonical(proc: Procedure) -> Procedure:
         return extent < (MIN_GAP * side if node.label in IMPLICIT else 1.0)
 
     def visit(node: Node) -> Node:
-        node.children = [visit(child) for child in node.children]
+        node.children = [child if child.rule == "leaf" else visit(child) for child in node.children]
         if node.rule not in ("split", "mirror") or len(node.children) < 2:
             return node
         keep = [i for i, child in enumerate(node.children) if not invisible(child, node.axis)]

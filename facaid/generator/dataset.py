@@ -20,7 +20,7 @@ from tqdm import tqdm
 
 from facaid.generator import STYLE_NAMES, generate_rows
 from facaid.grammar.procedure import GRAMMAR_VERSION
-from facaid.segmentation import rect_dicts
+from facaid.segmentation import rect_dicts, rects_json
 
 MANIFEST = "manifest.json"
 
@@ -33,12 +33,22 @@ def sample_seed(seed: int, index: int) -> int:
 
 def sample_record(seed: int, index: int, style: str | None = None) -> dict:
     """Sample ``index`` of the dataset as its JSON record (the segmentation as `Segmentation.to_dict` writes it)."""
+    return _record(seed, index, style, lambda rows: rect_dicts(rows.tolist()))
+
+
+def sample_line(seed: int, index: int, style: str | None = None) -> bytes:
+    """`sample_record` as the JSON line a shard holds (without the newline), the rectangles written in one call
+    (`rects_json`): what orjson writes for the record."""
+    return orjson.dumps(_record(seed, index, style, lambda rows: orjson.Fragment(rects_json(rows))))
+
+
+def _record(seed: int, index: int, style: str | None, rects) -> dict:
     proc, rows = generate_rows(sample_seed(seed, index), style)
     return {
         "id": f"s{seed}-{index:08d}",
         "seed": proc.meta["seed"],
         "style": proc.meta["style"],
-        "segmentation": {"width": round(proc.width), "height": round(proc.height), "rects": rect_dicts(rows.tolist())},
+        "segmentation": {"width": round(proc.width), "height": round(proc.height), "rects": rects(rows)},
         "procedure": proc.to_dict(),
     }
 
@@ -49,8 +59,7 @@ def _write_shard(job: tuple[str, int, int, int, int, str | None]) -> tuple[str, 
     tmp = path.with_suffix(".tmp")
     with gzip.open(tmp, "wb", compresslevel=1) as f:
         for i in range(start, stop):
-            f.write(orjson.dumps(sample_record(seed, i, style)))
-            f.write(b"\n")
+            f.write(sample_line(seed, i, style) + b"\n")
     os.replace(tmp, path)
     return str(path), stop - start
 

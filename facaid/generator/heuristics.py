@@ -415,9 +415,11 @@ class Builder:
 
 
 def _scaled(node: Node, scale: float) -> Node:
+    """The tree with its sizes in pixels (to 0.1 px), in place."""
     node.sizes = [s if s.mode == "rel" else Size(s.mode, round(s.value * scale, 1)) for s in node.sizes]
     for child in node.children:
-        _scaled(child, scale)
+        if child.children:  # a leaf has no sizes
+            _scaled(child, scale)
     return node
 
 

@@ -11,9 +11,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from facaid.grammar.layout import expand, layout
+from facaid.grammar.limits import MAX_COUNT
 from facaid.grammar.procedure import MAX_LEAVES, Node, Procedure, ProcedureError
 from facaid.labels import BACKGROUND, LABEL_ID
-from facaid.segmentation import Segmentation
+from facaid.native.rects import executed_rows
+from facaid.segmentation import Segmentation, flatten_array
 
 
 @dataclass
@@ -36,7 +38,6 @@ class _Executor:
         self.layouts: dict[tuple[int, float], tuple] = {}  # repeated copies share their layout
         self.fill_counts: dict[int, int] = {}
         self.first_boxes: dict[int, tuple[float, float, float, float]] | None = None  # set to record them
-        self.once = False  # with first_boxes: skip a node seen before, with its subtree (no leaves are output)
         self.offsets: dict[int, int] = {}
         if trace is not None:
             k = 0
@@ -68,7 +69,7 @@ class _Executor:
         trace = self.trace
         pidx = self._param_indices(node, len(sizes)) if trace is not None else None
         n_pattern = len(node.children)
-        out, once, seen = self.out, self.once, self.first_boxes
+        out = self.out
         pos = hi if flip else lo
         last = len(children) - 1
         for i, child in enumerate(children):
@@ -80,13 +81,6 @@ class _Executor:
                 a, b = pos, (hi if i == last else pos + length)
                 pos = b
             sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)
-            if once:
-                if id(child) not in seen:  # a later copy's subtree's first boxes are known
-                    if child.rule == "leaf":
-                        seen[id(child)] = sub
-                    else:
-                        self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), -1)
-                continue
             child_id = -1
             if trace is not None:
                 child_id = len(trace.depth)
@@ -156,12 +150,42 @@ def fill_counts(proc: Procedure) -> dict[int, int]:
 def first_boxes(proc: Procedure) -> dict[int, tuple[float, float, float, float]]:
     """The box of the first instance of every node, keyed by ``id(node)``. Each node is visited once, where it
     first occurs depth-first: the later copies of a repeat or mirror are skipped with their subtrees, whose first
-    instances all came before them (the boxes are those `execute_with_boxes` records)."""
-    ex = _Executor(proc, None)
-    ex.first_boxes = {}
-    ex.once = True
-    ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
-    return ex.first_boxes
+    instances all came before them (the boxes are those `execute_with_boxes` records, placed by the executor's
+    arithmetic, which a test checks)."""
+    seen: dict[int, tuple[float, float, float, float]] = {}
+
+    def visit(node: Node, box: tuple[float, float, float, float], flip_x: bool, flip_y: bool) -> None:
+        seen[id(node)] = box
+        x0, y0, x1, y1 = box
+        along_x = node.axis == "x"
+        lo, hi = (x0, x1) if along_x else (y0, y1)
+        sizes, children, reflected = expand(node, hi - lo)
+        lengths = layout(sizes, hi - lo)
+        flip = flip_x if along_x else flip_y
+        pos = hi if flip else lo
+        last = len(children) - 1
+        for i, child in enumerate(children):
+            if flip:
+                a, b = (lo if i == last else pos - lengths[i]), pos
+                pos = a
+            else:
+                a, b = pos, (hi if i == last else pos + lengths[i])
+                pos = b
+            if id(child) in seen:
+                continue
+            sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)
+            if child.rule == "leaf":
+                seen[id(child)] = sub
+            elif reflected[i]:
+                visit(child, sub, flip_x != along_x, flip_y == along_x)
+            else:
+                visit(child, sub, flip_x, flip_y)
+
+    box = (0.0, 0.0, float(proc.width), float(proc.height))
+    if proc.root.rule == "leaf":
+        return {id(proc.root): box}
+    visit(proc.root, box, False, False)
+    return seen
 
 
 def execute_with_boxes(proc: Procedure) -> tuple[list[tuple[int, float, float, float, float]],
@@ -189,6 +213,14 @@ def leaf_array(proc: Procedure, leaves: list[tuple[int, float, float, float, flo
     np.clip(box, 0, [w, h, w, h], out=box)
     keep = (box[:, 0] < box[:, 2]) & (box[:, 1] < box[:, 3])
     return np.concatenate([arr[keep, :1].astype(np.int64), box[keep]], axis=1)
+
+
+def flat_rows(proc: Procedure) -> np.ndarray:
+    """The executed procedure flattened: ``flatten_array(w, h, leaf_array(proc))``, the rows of `to_segmentation`.
+    In one call of C (`facaid.native.rects`) where the library builds; else, or when the C declines the tree, in
+    Python, which also raises `ProcedureError` for a tree that expands to too much."""
+    rows = executed_rows(proc.root, (proc.width, proc.height), MAX_COUNT, MAX_LEAVES)
+    return flatten_array(round(proc.width), round(proc.height), leaf_array(proc)) if rows is None else rows
 
 
 def to_segmentation(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None

@@ -31,11 +31,21 @@ def merge_floor_runs(split: Node, tolerance: float | None = None) -> None:
     sizes also agree within that fraction (`merge_repeated_floors`)."""
     items = list(zip(split.sizes, split.children, strict=True))
     merged: list[tuple[Size, Node]] = []
+    known: dict[int, tuple] = {}  # structure by id(node): a run is compared with both its neighbours
+
+    def shape(pattern: list[tuple[Size, Node]]) -> tuple:
+        out = []
+        for s, n in pattern:
+            if id(n) not in known:
+                known[id(n)] = structure(n)
+            out.append((s.mode, known[id(n)]))
+        return tuple(out)
+
     for size, node in items:
         if merged:
             prev = _floor_run(*merged[-1])
             cur = _floor_run(size, node)
-            if (prev and cur and _pattern_structure(prev[1]) == _pattern_structure(cur[1])
+            if (prev and cur and shape(prev[1]) == shape(cur[1])
                     and (tolerance is None or _alike(prev[1], cur[1], tolerance))):
                 repeat = Node.repeat(split.axis, prev[0] + cur[0], prev[1], role="floors")
                 merged[-1] = (Size("flt", merged[-1][0].value + size.value), repeat)
@@ -84,10 +94,6 @@ def _alike(a: list[tuple[Size, Node]], b: list[tuple[Size, Node]], tolerance: fl
     if len(a) == 1 and len(b) == 1:  # one floor each: its own sizes (its slot's share is the run's length)
         return same(a[0][1], b[0][1])
     return all(close(s, t) and same(m, n) for (s, m), (t, n) in zip(a, b, strict=True))
-
-
-def _pattern_structure(pattern: list[tuple[Size, Node]]) -> tuple:
-    return tuple((s.mode, structure(n)) for s, n in pattern)
 
 
 def structure(node: Node) -> tuple:

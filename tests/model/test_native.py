@@ -1,13 +1,14 @@
-"""The decoder step in C (`facaid.native`): the same logits as the torch decoder, and a clean fallback."""
+"""The decoder step in C (`facaid.native.step`): the same logits as the torch decoder, and a clean fallback."""
 
 import pytest
 import torch
 
-from facaid import native
+import facaid.native
 from facaid.decoder import DecoderState
 from facaid.decoding import decode
 from facaid.generator import generate
 from facaid.model import batch_inputs, batch_outputs
+from facaid.native import step as native
 from facaid.training.surgery import with_box_bias
 
 pytestmark = pytest.mark.skipif(native.library() is None, reason="no C compiler to build the native step")
@@ -148,12 +149,12 @@ def test_without_the_library_decoding_keeps_torch(models, monkeypatch):
 
 def test_build_is_cached_and_reports_a_failing_compiler(tmp_path, monkeypatch):
     monkeypatch.setenv("FACAID_CACHE", str(tmp_path))
-    path = native.build()
+    path = facaid.native.build("step")
     assert path.parent == tmp_path / "native" and path.is_file()
-    assert native.build() == path  # built once per source, flags and machine
+    assert facaid.native.build("step") == path  # built once per source, flags and machine
     path.unlink()
     with pytest.raises(RuntimeError, match="failed"):
-        native.build(compiler="false")  # exits 1, as a broken compiler would
+        facaid.native.build("step", compiler="false")  # exits 1, as a broken compiler would
     assert not list((tmp_path / "native").iterdir())  # nothing half-written is left
 
 
