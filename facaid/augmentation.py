@@ -63,18 +63,27 @@ def perturb(seg: Segmentation, level: float, seed: int = 0, iterations: int = 12
 ANNOTATOR_EDGE = 0.01  # every edge moves by up to this share of the image's side (uniform), as people annotate
 ANNOTATOR_DROP = 0.10  # share of the elements left out
 ANNOTATOR_SPURIOUS = 2  # boxes added over existing elements
+# Calibrated on the CMP dev half (facades 1-189; `facaid.generator.stats.irregularity`): uniform edge noise of these
+# shares of the width and height gives generated facades the spread of window edges along rows (0.0017 of the
+# height) and columns (0.0043 of the width) that people's annotations have (experiments/2026-12-03-annotation-
+# calibration). The evaluation's ANNOTATOR_EDGE (1 %) is three times noisier along rows than CMP's annotators.
+CMP_EDGE_X = 0.006
+CMP_EDGE_Y = 0.003
 
 
 def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDGE, drop: float = ANNOTATOR_DROP,
-                    spurious: int = ANNOTATOR_SPURIOUS) -> Segmentation:
+                    spurious: int = ANNOTATOR_SPURIOUS, edge_y: float | None = None) -> Segmentation:
     """A segmentation annotated the way people annotate (`facaid evaluate-real --perturb SEED`), seeded: each
-    element's four edges moved independently by up to ``edge`` of the image's width (x) or height (y), uniformly;
+    element's four edges moved independently by up to ``edge`` of the image's width (x) or height (y; ``edge_y``
+    when given), uniformly;
     ``drop`` of the elements left out (rounded, at least one when there are ten or more); ``spurious`` boxes added,
     each over an element left in, of a class drawn among the elements and about the size of the element it covers.
     Facade (wall) rectangles keep their place: they are the building's outline, not an element. The result holds
     the input's layers as rectangles, not flattened."""
-    if not (0 <= edge <= 0.5 and 0 <= drop < 1 and spurious >= 0):
-        raise ValueError(f"edge must be in [0, 0.5], drop in [0, 1), spurious >= 0; got {edge}, {drop}, {spurious}")
+    edge_y = edge if edge_y is None else edge_y
+    if not (0 <= edge <= 0.5 and 0 <= edge_y <= 0.5 and 0 <= drop < 1 and spurious >= 0):
+        raise ValueError(f"edges must be in [0, 0.5], drop in [0, 1), spurious >= 0; got {edge}, {edge_y}, {drop}, "
+                         f"{spurious}")
     rng = np.random.default_rng([int(seed), 20421])
     walls = [r for r in seg.rects if r.label == FACADE]
     elements = [r for r in seg.rects if r.label != FACADE]
@@ -84,7 +93,7 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
     w, h = seg.width, seg.height
 
     def moved(r: Rect) -> Rect | None:
-        d = rng.uniform(-edge, edge, size=4) * (w, h, w, h)
+        d = rng.uniform(-1.0, 1.0, size=4) * (edge * w, edge_y * h, edge * w, edge_y * h)
         x0, y0 = max(0, round(r.x0 + d[0])), max(0, round(r.y0 + d[1]))
         x1, y1 = min(w, round(r.x1 + d[2])), min(h, round(r.y1 + d[3]))
         return Rect(r.label, x0, y0, x1, y1) if x0 < x1 and y0 < y1 else None

@@ -71,9 +71,10 @@ def cmd_generate(args: argparse.Namespace) -> None:
 def _generate_stats(args: argparse.Namespace) -> None:
     from tqdm import tqdm
 
+    from facaid.augmentation import CMP_EDGE_X, CMP_EDGE_Y, annotator_noise
     from facaid.generator import generate
     from facaid.generator.dataset import sample_seed
-    from facaid.generator.stats import class_stats, distance, format_table, load_cmp
+    from facaid.generator.stats import class_stats, distance, format_table, irregularity, load_cmp
 
     cmp_path = Path(args.cmp)
     if not cmp_path.is_file():
@@ -81,11 +82,20 @@ def _generate_stats(args: argparse.Namespace) -> None:
     segs = [generate(sample_seed(args.seed, i), args.style).segmentation
             for i in tqdm(range(args.count), desc="generate", disable=args.quiet)]
     generated = class_stats(segs)
-    real = class_stats(load_cmp(cmp_path))
+    cmp_segs = load_cmp(cmp_path)
+    real = class_stats(cmp_segs)
     print(f"{args.count} generated facades (seed {args.seed}) vs {real.facades} CMP facades")
     print(format_table(generated, real))
+    annotated = [annotator_noise(seg, i, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=0.0, spurious=0)
+                 for i, seg in enumerate(segs)]
+    spread = {"generated": irregularity(segs), "generated, annotated as on CMP": irregularity(annotated),
+              "CMP": irregularity(cmp_segs)}
+    print("windows off the grid (median over rows and columns of >= 3 windows; spreads as a share of the side):")
+    for name, figures in spread.items():
+        print(f"  {name:<31} row tops {figures['row_top']:.4f}  column lefts {figures['column_left']:.4f}  "
+              f"heights cv {figures['row_height_cv']:.3f}  widths cv {figures['column_width_cv']:.3f}")
     _write_json(args.json, {"generated": generated.to_dict(), "cmp": real.to_dict(),
-                            "area_distance": distance(generated, real)})
+                            "area_distance": distance(generated, real), "irregularity": spread})
 
 
 def cmd_render(args: argparse.Namespace) -> None:

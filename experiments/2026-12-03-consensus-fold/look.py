@@ -1,16 +1,30 @@
-import sys, statistics, time
+"""Lookahead 2 or 3 with a consensus fold, every 6th dev facade (needs consensus-fold.patch applied).
+
+    .venv/bin/python experiments/2026-12-03-consensus-fold/look.py LOOKAHEAD CONSENSUS|none
+"""
+
+import statistics
+import sys
+import time
+
 import numpy as np
+
 from facaid.evaluation.real import load_records
-from facaid.paths import DEFAULT_CMP
+from facaid.grammar.execute import to_segmentation
 from facaid.induce import induce_procedure
 from facaid.metrics import compression, pixel_accuracy
-from facaid.grammar.execute import to_segmentation
+from facaid.paths import DEFAULT_CMP
 from facaid.segmentation import flatten, rasterize
-la = int(sys.argv[1]); cons = None if sys.argv[2] == "none" else float(sys.argv[2])
-recs = load_records(DEFAULT_CMP, 189)[::6]
-acc, comp, ts = [], [], []
-for rid, seg in recs:
-    flat = flatten(seg); t=time.perf_counter()
-    p = induce_procedure(flat, lookahead=la, consensus=cons); ts.append(time.perf_counter()-t)
-    acc.append(pixel_accuracy(rasterize(to_segmentation(p)), rasterize(flat))); comp.append(compression(p, seg))
-print(la, cons, f"acc {np.mean(acc):.4f} comp {statistics.median(comp):.3f} t {statistics.median(ts):.2f}s")
+
+lookahead = int(sys.argv[1])
+consensus = None if sys.argv[2] == "none" else float(sys.argv[2])
+acc, comp, seconds = [], [], []
+for _, seg in load_records(DEFAULT_CMP, 189)[::6]:
+    flat = flatten(seg)
+    t0 = time.perf_counter()
+    proc = induce_procedure(flat, lookahead=lookahead, consensus=consensus)
+    seconds.append(time.perf_counter() - t0)
+    acc.append(pixel_accuracy(rasterize(to_segmentation(proc)), rasterize(flat)))
+    comp.append(compression(proc, seg))
+print(lookahead, consensus, f"acc {np.mean(acc):.4f} comp {statistics.median(comp):.3f} "
+      f"t {statistics.median(seconds):.2f}s")

@@ -78,3 +78,54 @@ def format_table(generated: ClassStats, real: ClassStats) -> str:
     lines.append(f"{'elements':<11} {generated.rects_total:>10.1f} {real.rects_total:>10.1f}")
     lines.append(f"area distribution distance (total variation): {distance(generated, real):.3f}")
     return "\n".join(lines)
+
+
+# --- irregularity: how far the rows and columns of windows are from a grid ------------------------------------
+
+WINDOW = LABELS.index("window")
+
+
+def _lines(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
+    """Indices of intervals [lo, hi) grouped into lines: sorted by centre, an interval joins the line before it
+    when it overlaps that line's median interval by at least half its own length."""
+    order = np.argsort((lo + hi) / 2, kind="stable")
+    lines: list[list[int]] = []
+    for i in order.tolist():
+        if lines:
+            members = lines[-1]
+            a, b = np.median(lo[members]), np.median(hi[members])
+            if min(b, hi[i]) - max(a, lo[i]) >= 0.5 * (hi[i] - lo[i]):
+                members.append(i)
+                continue
+        lines.append([i])
+    return [np.array(m) for m in lines]
+
+
+def irregularity(segs: list[Segmentation], min_members: int = 3) -> dict[str, float]:
+    """How regular the windows' rows and columns are, as medians over every row (column) of at least
+    ``min_members`` windows of every facade: the spread of their top (left) edges and of their bottom (right) edges
+    as a share of the image's height (width), and their heights' (widths') coefficient of variation. Windows are
+    the window rectangles of the flattened footprint form (pieces where a blind or sill cuts one), measured the
+    same way on generated facades and CMP annotations. A generated facade's rows are exact (0); people's are not.
+    """
+    spreads: dict[str, list[float]] = {"row_top": [], "row_bottom": [], "row_height_cv": [],
+                                       "column_left": [], "column_right": [], "column_width_cv": []}
+    for seg in segs:
+        rows = flatten(seg, wall="footprint").to_array()
+        win = rows[rows[:, 0] == WINDOW].astype(float)
+        if len(win) < min_members:
+            continue
+        for lo_col, hi_col, side, names in ((2, 4, seg.height, ("row_top", "row_bottom", "row_height_cv")),
+                                            (1, 3, seg.width, ("column_left", "column_right", "column_width_cv"))):
+            lo, hi = win[:, lo_col], win[:, hi_col]
+            for members in _lines(lo, hi):
+                if len(members) < min_members:
+                    continue
+                extent = hi[members] - lo[members]
+                spreads[names[0]].append(float(np.std(lo[members]) / side))
+                spreads[names[1]].append(float(np.std(hi[members]) / side))
+                spreads[names[2]].append(float(np.std(extent) / np.mean(extent)))
+    out = {name: float(np.median(v)) if v else 0.0 for name, v in spreads.items()}
+    out["rows"] = float(len(spreads["row_top"]))
+    out["columns"] = float(len(spreads["column_left"]))
+    return out

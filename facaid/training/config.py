@@ -39,6 +39,8 @@ class TrainConfig:
     workers: int = 0  # processes generating samples; 0: in the training process (results are identical)
     noise: float = 0.0  # share of examples whose input edges are jittered (the target stays the clean procedure)
     noise_sigma: float = 0.006  # the jitter's standard deviation is uniform in [0, this] x the long side
+    annotate: float = 0.0  # share of examples whose input is annotated as people annotate: edges moved as on CMP,
+    # some elements left out, spurious boxes added (`facaid.training.samples.make_example`); the target stays clean
     init: str = ""  # a checkpoint directory whose weights start the run (fine-tuning); fresh optimizer and schedule
     count_lr_scale: float = 1.0  # the peer counts' embeddings learn at this multiple of the learning rate (a
     # model widened for them starts them at zero while the rest is trained already)
@@ -67,6 +69,10 @@ class TrainConfig:
             value = getattr(self, name)
             if not nonnegative(value):
                 raise ValueError(f"{name} must be a finite number >= 0 (0 freezes those parameters), got {value!r}")
+        for name in ("noise", "annotate"):
+            value = getattr(self, name)
+            if not (nonnegative(value) and value <= 1):
+                raise ValueError(f"{name} must be a share between 0 and 1, got {value!r}")
         if not nonnegative(self.structure_weight) or self.structure_weight == 0:
             raise ValueError(f"structure_weight must be a finite number > 0 (1: the plain NLL), got "
                              f"{self.structure_weight!r}")

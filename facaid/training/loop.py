@@ -105,7 +105,7 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     # clean inputs, in this process (a second or two): the loss stays comparable across runs
     val = SampleStream(tokenizer, cfg.val_seed).take(cfg.val_count)
     stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"], workers=cfg.workers,
-                          noise=(cfg.noise, cfg.noise_sigma), styles=cfg.styles)
+                          noise=(cfg.noise, cfg.noise_sigma), styles=cfg.styles, annotate=cfg.annotate)
     stream.skipped = state["skipped"]
     batches = PooledBatches(stream, cfg.batch_size, cfg.pool_batches, cfg.seed, state["batches"])
     stop = min(cfg.steps, until) if until is not None else cfg.steps

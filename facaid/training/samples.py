@@ -1,4 +1,5 @@
-"""Training samples: freshly generated facades, tokenized, optionally jittered, in length-sorted batches.
+"""Training samples: freshly generated facades, tokenized, optionally jittered or annotated as people annotate, in
+length-sorted batches.
 
 Every sample is generated from its own seed (`facaid.generator.dataset.sample_seed`), so a run never sees the same
 facade twice, the validation facades (another dataset seed) are held out, and samples made in worker processes
@@ -13,7 +14,7 @@ import random
 import numpy as np
 import torch
 
-from facaid.augmentation import jitter
+from facaid.augmentation import ANNOTATOR_DROP, ANNOTATOR_SPURIOUS, CMP_EDGE_X, CMP_EDGE_Y, annotator_noise, jitter
 from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
 from facaid.tokenizer import Tokenizer, TokenizerConfig
@@ -21,9 +22,10 @@ from facaid.tokenizer import Tokenizer, TokenizerConfig
 _worker: dict = {}
 
 
-def _init_worker(tok_config: dict, noise: tuple[float, float], styles: tuple[float, ...] | None) -> None:
+def _init_worker(tok_config: dict, noise: tuple[float, float], styles: tuple[float, ...] | None,
+                 annotate: float) -> None:
     torch.set_num_threads(1)
-    _worker.update(tokenizer=Tokenizer(TokenizerConfig(**tok_config)), noise=noise, styles=styles)
+    _worker.update(tokenizer=Tokenizer(TokenizerConfig(**tok_config)), noise=noise, styles=styles, annotate=annotate)
 
 
 def sample_style(seed: int, index: int, styles: tuple[float, ...] | None) -> str | None:
@@ -35,11 +37,13 @@ def sample_style(seed: int, index: int, styles: tuple[float, ...] | None) -> str
 
 
 def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float, float] = (0.0, 0.0),
-                 styles: tuple[float, ...] | None = None):
+                 styles: tuple[float, ...] | None = None, annotate: float = 0.0):
     """The training example of sample ``index`` of dataset ``seed``: (rows, (ids, local, boxes)), or None when
     the facade is too long for the model. ``noise`` = (share, sigma): that share of the inputs get their edges
-    jittered (`facaid.augmentation.jitter`, sigma uniform in [0, sigma]), seeded by the sample. ``styles``:
-    weights of the generator styles (`sample_style`)."""
+    jittered (`facaid.augmentation.jitter`, sigma uniform in [0, sigma]), seeded by the sample. ``annotate``: that
+    share of the inputs are annotated as people annotate (`annotator_noise` with the edge spread calibrated on CMP,
+    up to `ANNOTATOR_DROP` of the elements left out and up to `ANNOTATOR_SPURIOUS` boxes added); the target stays
+    the clean procedure either way. ``styles``: weights of the generator styles (`sample_style`)."""
     s = generate(sample_seed(seed, index), sample_style(seed, index, styles))
     c = tokenizer.config
     target = tokenizer.encode_target(s.procedure)
@@ -51,6 +55,12 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
         rng = np.random.default_rng([seed, index, 1])
         if rng.random() < share:
             seg = jitter(seg, rng.uniform(0.0, sigma), rng)
+    if annotate > 0:
+        rng = np.random.default_rng([seed, index, 2])
+        if rng.random() < annotate:
+            drop, spurious = rng.uniform(0.0, ANNOTATOR_DROP), int(rng.integers(ANNOTATOR_SPURIOUS + 1))
+            seg = annotator_noise(seg, int(rng.integers(2**31)), edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=drop,
+                                  spurious=spurious)
     try:
         rows = tokenizer.encode_segmentation(seg)
     except ValueError:  # too many rectangles
@@ -59,7 +69,8 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
 
 
 def _worker_example(args: tuple[int, int]):
-    return make_example(_worker["tokenizer"], *args, noise=_worker["noise"], styles=_worker["styles"])
+    return make_example(_worker["tokenizer"], *args, noise=_worker["noise"], styles=_worker["styles"],
+                        annotate=_worker["annotate"])
 
 
 class SampleStream:
@@ -69,8 +80,10 @@ class SampleStream:
     order, as in one process."""
 
     def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0, workers: int = 0,
-                 noise: tuple[float, float] = (0.0, 0.0), styles: tuple[float, ...] | None = None):
+                 noise: tuple[float, float] = (0.0, 0.0), styles: tuple[float, ...] | None = None,
+                 annotate: float = 0.0):
         self.tokenizer = tokenizer
+        self.annotate = annotate
         self.styles = styles
         self.seed = seed
         self.index = start
@@ -81,10 +94,10 @@ class SampleStream:
         if workers > 0:
             ctx = multiprocessing.get_context("spawn")  # no fork after CUDA or torch threads have started
             self.pool = ctx.Pool(workers, initializer=_init_worker,
-                                 initargs=(tokenizer.config.to_dict(), noise, styles))
+                                 initargs=(tokenizer.config.to_dict(), noise, styles, annotate))
 
     def example(self, index: int):
-        return make_example(self.tokenizer, self.seed, index, self.noise, self.styles)
+        return make_example(self.tokenizer, self.seed, index, self.noise, self.styles, self.annotate)
 
     def __next__(self):
         while True:

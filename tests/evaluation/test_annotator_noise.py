@@ -43,9 +43,16 @@ def test_the_noise_keeps_a_valid_segmentation_and_refuses_bad_settings():
         assert Segmentation.from_dict(noisy.to_dict()) == noisy  # every box inside the image, at least 1 px
     empty = Segmentation(10, 10, ())
     assert annotator_noise(empty, 1) == empty
-    for bad in ({"edge": -0.1}, {"drop": 1.0}, {"spurious": -1}):
-        with pytest.raises(ValueError, match="edge must be in"):
+    for bad in ({"edge": -0.1}, {"edge_y": 0.6}, {"drop": 1.0}, {"spurious": -1}):
+        with pytest.raises(ValueError, match="edges must be in"):
             annotator_noise(_grid(), 1, **bad)
+    # edge_y moves only the y edges when edge is 0, and by no more than it
+    grid = _grid()
+    moved = annotator_noise(grid, 3, edge=0.0, edge_y=0.02, drop=0.0, spurious=0)
+    pairs = list(zip(grid.rects, moved.rects, strict=True))
+    assert all((a.x0, a.x1) == (b.x0, b.x1) for a, b in pairs)
+    assert any((a.y0, a.y1) != (b.y0, b.y1) for a, b in pairs)
+    assert all(abs(a.y0 - b.y0) <= 0.02 * grid.height + 0.5 for a, b in pairs)
 
 
 def test_evaluate_real_reports_compression_source_and_the_gain_over_a_perturbed_input(tmp_path):

@@ -150,6 +150,9 @@ def test_cli_stats(tmp_path, capsys, cmp_records):
     figures = json.loads(report.read_text())
     assert figures["generated"]["facades"] == 20
     assert set(figures["generated"]["classes"]) == set(LABELS)
+    assert "windows off the grid" in out
+    assert figures["irregularity"]["generated"]["row_top"] == 0.0
+    assert figures["irregularity"]["generated, annotated as on CMP"]["row_top"] > 0.0
 
 
 def test_demo_and_console_script(tmp_path):

@@ -91,8 +91,8 @@ def test_sample_processes_give_the_same_examples_in_the_same_order():
     from facaid.training.samples import SampleStream
 
     tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=160))  # short: some facades are skipped
-    one = SampleStream(tok, seed=5, noise=(0.5, 0.006))
-    many = SampleStream(tok, seed=5, workers=2, noise=(0.5, 0.006))
+    one = SampleStream(tok, seed=5, noise=(0.5, 0.006), annotate=0.5)
+    many = SampleStream(tok, seed=5, workers=2, noise=(0.5, 0.006), annotate=0.5)
     try:
         for n in (7, 13):
             a, b = one.take(n), many.take(n)
@@ -117,6 +117,34 @@ def test_noisy_inputs_keep_the_clean_target_and_are_seeded():
         assert repr(noisy[1]) == repr(clean[1])  # the target: the clean procedure
         assert repr(noisy[0]) != repr(clean[0])  # the input: edges moved
         assert repr(make_example(tok, 3, index, noise=(0.0, 0.006))) == repr(clean)
+
+
+def test_inputs_annotated_as_people_do_keep_the_clean_target():
+    """``annotate``: the input's edges moved as on CMP, elements left out, boxes added; seeded by the sample; the
+    target is the clean procedure; a share of 0 leaves the example as it was."""
+    from facaid.training.samples import make_example
+
+    tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=768))
+    changed = 0
+    for index in range(6):
+        clean = make_example(tok, 4, index)
+        if clean is None:
+            continue
+        annotated = make_example(tok, 4, index, annotate=1.0)
+        assert repr(annotated) == repr(make_example(tok, 4, index, annotate=1.0))
+        assert repr(annotated[1]) == repr(clean[1])
+        changed += repr(annotated[0]) != repr(clean[0])
+        assert repr(make_example(tok, 4, index, annotate=0.0)) == repr(clean)
+    assert changed >= 4
+
+
+@pytest.mark.parametrize("field", ["noise", "annotate"])
+def test_shares_of_noisy_inputs_must_be_shares(field):
+    from facaid.training.config import TrainConfig
+
+    for bad in (-0.1, 1.5, float("nan")):
+        with pytest.raises(ValueError, match=f"{field} must be a share between 0 and 1"):
+            TrainConfig(**{field: bad})
 
 
 def test_style_weights_draw_the_styles_of_the_samples(tmp_path):
