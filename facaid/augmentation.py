@@ -75,9 +75,9 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
                     spurious: int = ANNOTATOR_SPURIOUS, edge_y: float | None = None) -> Segmentation:
     """A segmentation annotated the way people annotate (`facaid evaluate-real --perturb SEED`), seeded: each
     element's four edges moved independently by up to ``edge`` of the image's width (x) or height (y; ``edge_y``
-    when given), uniformly;
-    ``drop`` of the elements left out (rounded, at least one when there are ten or more); ``spurious`` boxes added,
-    each over an element left in, of a class drawn among the elements and about the size of the element it covers.
+    when given), uniformly; ``drop`` of the elements left out (rounded, at least one when there are ten or more);
+    ``spurious`` boxes added, each over an element left in, of a class drawn among the elements and about the size
+    of the element it covers.
     Facade (wall) rectangles keep their place: they are the building's outline, not an element. The result holds
     the input's layers as rectangles, not flattened."""
     edge_y = edge if edge_y is None else edge_y

@@ -238,7 +238,7 @@ def flatten(seg: Segmentation, *, wall: str = "pieces") -> Segmentation:
 
 def flatten_array(width: int, height: int, arr: np.ndarray, wall: str = "pieces") -> np.ndarray:
     """`flatten` on int rows (label, x0, y0, x1, y1); returns rows in the same form. Computed in C
-    (`facaid.native.grid`) where the library builds, else by `flatten_array_numpy`, the reference."""
+    (`facaid.native.rects`) where the library builds, else by `flatten_array_numpy`, the reference."""
     if wall not in ("pieces", "footprint"):
         raise ValueError(f"wall must be 'pieces' or 'footprint', got {wall!r}")
     if len(arr) == 0:

@@ -31,6 +31,27 @@ class Trace:
     leaves: list[int] = field(default_factory=list)  # instance indices of the leaves, depth-first
 
 
+def spans(lo: float, hi: float, lengths: list[float], flip: bool) -> list[tuple[float, float]]:
+    """Where children of these lengths lie in [lo, hi) along their parent's axis, as (start, end) in child order:
+    from ``lo`` up, or from ``hi`` down when ``flip`` (inside a reflection); the last child ends exactly at the far
+    end, so that rounding never leaves a gap."""
+    out = []
+    last = len(lengths) - 1
+    if flip:
+        pos = hi
+        for i, length in enumerate(lengths):
+            a = lo if i == last else pos - length
+            out.append((a, pos))
+            pos = a
+    else:
+        pos = lo
+        for i, length in enumerate(lengths):
+            b = hi if i == last else pos + length
+            out.append((pos, b))
+            pos = b
+    return out
+
+
 class _Executor:
     def __init__(self, proc: Procedure, trace: Trace | None):
         self.out: list[tuple[int, float, float, float, float]] = []
@@ -70,16 +91,7 @@ class _Executor:
         pidx = self._param_indices(node, len(sizes)) if trace is not None else None
         n_pattern = len(node.children)
         out = self.out
-        pos = hi if flip else lo
-        last = len(children) - 1
-        for i, child in enumerate(children):
-            length = lengths[i]
-            if flip:
-                a, b = (lo if i == last else pos - length), pos
-                pos = a
-            else:
-                a, b = pos, (hi if i == last else pos + length)
-                pos = b
+        for i, (child, (a, b)) in enumerate(zip(children, spans(lo, hi, lengths, flip), strict=True)):
             sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)
             child_id = -1
             if trace is not None:
@@ -150,8 +162,7 @@ def fill_counts(proc: Procedure) -> dict[int, int]:
 def first_boxes(proc: Procedure) -> dict[int, tuple[float, float, float, float]]:
     """The box of the first instance of every node, keyed by ``id(node)``. Each node is visited once, where it
     first occurs depth-first: the later copies of a repeat or mirror are skipped with their subtrees, whose first
-    instances all came before them (the boxes are those `execute_with_boxes` records, placed by the executor's
-    arithmetic, which a test checks)."""
+    instances all came before them (the boxes are those `execute_with_boxes` records, placed by the same `spans`)."""
     seen: dict[int, tuple[float, float, float, float]] = {}
 
     def visit(node: Node, box: tuple[float, float, float, float], flip_x: bool, flip_y: bool) -> None:
@@ -161,16 +172,8 @@ def first_boxes(proc: Procedure) -> dict[int, tuple[float, float, float, float]]
         lo, hi = (x0, x1) if along_x else (y0, y1)
         sizes, children, reflected = expand(node, hi - lo)
         lengths = layout(sizes, hi - lo)
-        flip = flip_x if along_x else flip_y
-        pos = hi if flip else lo
-        last = len(children) - 1
-        for i, child in enumerate(children):
-            if flip:
-                a, b = (lo if i == last else pos - lengths[i]), pos
-                pos = a
-            else:
-                a, b = pos, (hi if i == last else pos + lengths[i])
-                pos = b
+        for i, (child, (a, b)) in enumerate(zip(children, spans(lo, hi, lengths, flip_x if along_x else flip_y),
+                                                strict=True)):
             if id(child) in seen:
                 continue
             sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)

@@ -1,11 +1,11 @@
 /* Executing procedures and flattening labelled rectangles in C: the same rows as the Python reference,
  * `facaid.segmentation.flatten_array` and `facaid.grammar.execute.execute` followed by `leaf_array`.
  *
- * Flattening. Paint the rectangles in paint order onto the grid of all their edges (the last painter of a cell wins), cut each
- * grid row into maximal runs of one label, continue a run into the rectangle above it when that rectangle has
- * the same columns and label, and sort the rectangles by (y0, x0, label). ``mode`` 0 keeps every non-background
- * label ("pieces"); mode 1 writes two layers, the footprint (every non-background cell as facade) and the
- * elements (labels above facade) ("footprint").
+ * Flattening. Paint the rectangles in paint order onto the grid of all their edges (the last painter of a cell
+ * wins), cut each grid row into maximal runs of one label, continue a run into the rectangle above it when that
+ * rectangle has the same columns and label, and sort the rectangles by (y0, x0, label). ``mode`` 0 keeps every
+ * non-background label ("pieces"); mode 1 writes two layers, the footprint (every non-background cell as facade)
+ * and the elements (labels above facade) ("footprint").
  *
  * The caller passes room for ``cap`` rows; when more are needed nothing is written and the count is returned, so
  * that the caller can call again with room enough.
@@ -181,6 +181,12 @@ static double nominal(const Exec *e, int64_t k, double length) {
     return e->modes[k - 1] == REL ? e->values[k - 1] * length : e->values[k - 1];
 }
 
+/* the node index of expanded child i of node nd (first child at first, nk children): a repeat's copies cycle
+ * through the pattern; a mirror's children after the first nk run back from index back (nk - 2 when centred) */
+static int64_t child_of(const int64_t *nd, int64_t first, int64_t nk, int64_t back, int64_t i) {
+    return nd[0] == MIRROR && i >= nk ? first + back - (i - nk) : first + i % nk;
+}
+
 static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, int flip_x, int flip_y) {
     if (e->error) return;
     const int64_t *nd = e->nodes + 8 * k;
@@ -220,10 +226,9 @@ static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, 
     }
     /* `layout` */
     double length = span > 0.0 ? span : 0.0, fixed = 0.0, weights = 0.0, scale, share;
-    int64_t back = nk - (nd[4] ? 2 : 1); /* a mirror's children after the first nk: back, back - 1, ... 0 */
+    int64_t back = nk - (nd[4] ? 2 : 1);
     for (int64_t i = 0; i < n; i++) {
-        int64_t c = nd[0] == MIRROR && i >= nk ? first + back - (i - nk) : first + i % nk;
-        int64_t m = e->modes[c - 1];
+        int64_t c = child_of(nd, first, nk, back, i), m = e->modes[c - 1];
         double v = e->values[c - 1];
         if (m == FLT) weights += v;
         else fixed += m == REL ? v * length : v;
@@ -239,7 +244,7 @@ static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, 
     double pos = flip ? hi : lo;
     for (int64_t i = 0; i < n; i++) {
         int reflected = nd[0] == MIRROR && i >= nk;
-        int64_t c = reflected ? first + back - (i - nk) : first + i % nk, m = e->modes[c - 1];
+        int64_t c = child_of(nd, first, nk, back, i), m = e->modes[c - 1];
         double v = e->values[c - 1], size, a, b;
         size = m == FLT ? v * share : m == REL ? v * length * scale : v * scale;
         if (flip) { a = i == n - 1 ? lo : pos - size; b = pos; pos = a; }
@@ -252,10 +257,10 @@ static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, 
     }
 }
 
-/* Execute the tree on [0, extent_x) x [0, extent_y) (the procedure's size), round the leaves' edges to whole pixels (half to even), clip them
- * to the width x height image, drop background and empty ones and flatten the rest (mode as in `facaid_flatten`). Returns the
- * row count as `facaid_flatten` does, or -3 for more than max_leaves leaves, -4 for a "fill" repeat whose pattern
- * has no length (the Python executor then reports either). */
+/* Execute the tree on [0, extent_x) x [0, extent_y) (the procedure's size), round the leaves' edges to whole
+ * pixels (half to even), clip them to the width x height image, drop background and empty ones and flatten the rest
+ * (mode as in `facaid_flatten`). Returns the row count as `facaid_flatten` does, or -3 for more than max_leaves
+ * leaves, -4 for a "fill" repeat whose pattern has no length (the Python executor then reports either). */
 int64_t facaid_execute(const int64_t *nodes, const int64_t *modes, const double *values, double extent_x,
                        double extent_y, int64_t width, int64_t height, int64_t max_count, int64_t max_leaves,
                        const int64_t *priority, int mode, int64_t *result, int64_t cap) {

@@ -53,11 +53,11 @@ def flatten_rows(width: int, height: int, arr: np.ndarray, wall: str = "pieces")
                                                      _MODES[wall], out.ctypes.data, cap), 2 * len(rows) + 16)
 
 
-def _call(fn, cap: int) -> np.ndarray | None:
-    """Call ``fn(out, cap)`` with room for ``cap`` rows, again with more if it needs more; None when it declines
-    its input (a negative code other than -1, which means memory ran out)."""
+def _call(fn, cap: int, row: tuple[int, ...] = (5,), dtype=np.int64) -> np.ndarray | None:
+    """Call ``fn(out, cap)`` with room for ``cap`` rows of shape ``row``, again with more if it needs more; None when
+    it declines its input (a negative code other than -1, which means memory ran out)."""
     while True:
-        out = np.empty((cap, 5), dtype=np.int64)
+        out = np.empty((cap, *row), dtype=dtype)
         n = fn(out, cap)
         if n == -1:
             raise MemoryError("the native rectangles library ran out of memory")
@@ -102,10 +102,7 @@ def executed_rows(root, extent: tuple[float, float], max_count: int, max_leaves:
     width, height = round(extent[0]), round(extent[1])
     return _call(lambda out, cap: lib.facaid_execute(
         tree.ctypes.data, modes.ctypes.data, values.ctypes.data, float(extent[0]), float(extent[1]), width, height,
-        max_count, max_leaves,
-        _PRIORITY.ctypes.data, _MODES[wall], out.ctypes.data, cap), max(1024, 8 * len(queue)))
-
-
+        max_count, max_leaves, _PRIORITY.ctypes.data, _MODES[wall], out.ctypes.data, cap), max(1024, 8 * len(queue)))
 
 
 def rects_json(rows: np.ndarray) -> bytes | None:
@@ -115,12 +112,6 @@ def rects_json(rows: np.ndarray) -> bytes | None:
     if lib is None:
         return None
     rows = np.ascontiguousarray(rows, dtype=np.int64)
-    cap = 160 * len(rows) + 2
-    while True:
-        out = np.empty(cap, dtype=np.uint8)
-        n = lib.facaid_rects_json(rows.ctypes.data, len(rows), _NAMES, out.ctypes.data, cap)
-        if n == -2:
-            return None
-        if n <= cap:
-            return out[:n].tobytes()
-        cap = n
+    text = _call(lambda out, cap: lib.facaid_rects_json(rows.ctypes.data, len(rows), _NAMES, out.ctypes.data, cap),
+                 160 * len(rows) + 2, row=(), dtype=np.uint8)
+    return None if text is None else text.tobytes()
