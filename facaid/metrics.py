@@ -132,3 +132,26 @@ def compression(proc: Procedure, seg: Segmentation) -> float:
     if leaves == 0:
         return 1.0 if n == 0 else float("inf")
     return n / leaves
+
+
+def _grow(mask: np.ndarray, r: int, axis: int) -> np.ndarray:
+    """``mask`` grown by ``r`` pixels both ways along ``axis`` (a running box sum)."""
+    pad = [(r + 1, r) if a == axis else (0, 0) for a in range(2)]
+    c = np.cumsum(np.pad(mask.astype(np.int32), pad), axis=axis)
+    n = mask.shape[axis]
+    return (np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)) > 0
+
+
+def unexplained(pred: np.ndarray, given: np.ndarray, edge: float = 0.01) -> float:
+    """The share of the image where the label map ``pred`` disagrees with ``given`` farther than ``edge`` x the
+    image's width (along x) or height (along y) from every edge of ``given``: disagreement that edges moved by an
+    annotator's hand cannot explain — whole elements missing, added or misplaced."""
+    h, w = given.shape
+    border = np.zeros(given.shape, dtype=bool)
+    across, down = given[:, 1:] != given[:, :-1], given[1:, :] != given[:-1, :]
+    border[:, 1:] |= across
+    border[:, :-1] |= across
+    border[1:, :] |= down
+    border[:-1, :] |= down
+    band = _grow(_grow(border, max(1, round(edge * w)), 1), max(1, round(edge * h)), 0)
+    return float(((pred != given) & ~band).mean())

@@ -4,7 +4,8 @@ Each record is read as layered rectangles (clipped to the image; degenerate boxe
 they are), flattened by the paint order, reconstructed (the model's structures and, where they fit badly, the
 induced one; ``induce=False`` for the model alone), and compared at full resolution with its own label map.
 The trivial baseline paints everything inside the building footprint as wall. Each facade's record gives the
-structure that won (``source``) and the compression (`facaid.metrics.compression`); the figures come for all the
+structure that won (``source``; ``denoised`` where the model's was kept over a closer-fitting induced one,
+`facaid.pipeline.reads_through_noise`) and the compression (`facaid.metrics.compression`); the figures come for all the
 facades and for the dev half (the first 189 records) and the test half (the rest) apart. With ``perturb`` each
 input is first annotated as a person would (`facaid.augmentation.annotator_noise`, seeded by ``perturb`` and the
 facade's position) and both the reconstruction and the perturbed input itself are compared with the clean
@@ -85,8 +86,8 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
             base_union[c] += (t | b).sum()
         nodes.append(sum(1 for _ in result.procedure.nodes()))
         record = {"id": rid, "half": "dev" if i < DEV_FACADES else "test", "accuracy": acc[-1], "baseline": base[-1],
-                  "seconds": times[-1], "source": result.source, "shortcut": result.shortcut, "nodes": nodes[-1],
-                  "compression": compression(result.procedure, given)}
+                  "seconds": times[-1], "source": result.source, "shortcut": result.shortcut,
+                  "denoised": result.denoised, "nodes": nodes[-1], "compression": compression(result.procedure, given)}
         if perturb is not None:  # the perturbed input's own accuracy against the clean annotation
             record["input_accuracy"] = pixel_accuracy(rasterize(given_flat), target)
         per_facade.append(record)
@@ -129,6 +130,7 @@ def _summary(facades: list[dict]) -> dict:
            "accuracy_mean": float(np.mean([f["accuracy"] for f in facades])),
            "compression_median": float(np.median([f["compression"] for f in facades])),
            "model_share": float(np.mean([f["source"].startswith("model") for f in facades])),
+           "denoised_share": float(np.mean([f.get("denoised", False) for f in facades])),
            "seconds_median": float(np.median([f["seconds"] for f in facades]))}
     if "input_accuracy" in facades[0]:
         out["input_accuracy_mean"] = float(np.mean([f["input_accuracy"] for f in facades]))
@@ -169,7 +171,9 @@ def format_summary(result: dict) -> str:
             continue
         line = (f"{name}: {group['facades']} facades, accuracy {100 * group['accuracy_mean']:.2f} %, compression "
                 f"median {group['compression_median']:.2f}, the model's structure for "
-                f"{100 * group['model_share']:.1f} %")
+                f"{100 * group['model_share']:.1f} %"
+                + (f" (kept over the induced copy of the input's noise for {100 * group['denoised_share']:.1f} %)"
+                   if group.get("denoised_share") else ""))
         if "input_accuracy_mean" in group:
             line += (f"; the perturbed input itself {100 * group['input_accuracy_mean']:.2f} % against the clean "
                      f"annotation (gain {100 * group['gain_over_input']:+.2f} points)")

@@ -58,3 +58,47 @@ def test_compression_counts_the_input_elements_per_element_leaf_of_the_tree():
     wall = Procedure(600, 100, Node.leaf("facade"))
     assert compression(wall, windows) == float("inf")
     assert compression(wall, Segmentation(600, 100, (Rect(FACADE, 0, 0, 600, 100),))) == 1.0
+
+
+def test_unexplained_counts_disagreement_away_from_the_inputs_edges():
+    from facaid.metrics import unexplained
+
+    given = np.zeros((300, 400), np.uint8)  # 1 %: 4 px along x, 3 px along y
+    given[60:120, 100:160] = LABEL_ID["window"]
+    moved = given.copy()
+    moved[57:122, 97:163] = LABEL_ID["window"]  # every edge off by 2-3 px
+    assert unexplained(moved, given) == 0.0
+    assert unexplained(given, given) == 0.0
+    added = given.copy()
+    added[180:240, 250:310] = LABEL_ID["window"]  # a whole window the input lacks
+    assert unexplained(added, given) == pytest.approx(3600 / 120_000)
+    far = given.copy()
+    far[60:120, 100:160] = 0
+    far[60:120, 200:260] = LABEL_ID["window"]  # the window drawn 100 px off: its core is unexplained
+    assert unexplained(far, given) > 0.02
+    assert unexplained(moved, given, edge=0.001) > 0  # a narrower band explains less
+
+
+def test_reads_through_noise_keeps_a_compact_structure_that_restores_a_missed_window():
+    from facaid.grammar.procedure import Node, Procedure, Size
+    from facaid.induce import induce_procedure
+    from facaid.pipeline import reads_through_noise
+
+    tile = Node.split("x", [(Size("abs", 20), Node.leaf("facade")), (Size("abs", 40), Node.leaf("window")),
+                            (Size("abs", 20), Node.leaf("facade"))])
+    floor = Node.split("y", [(Size("abs", 20), Node.leaf("facade")), (Size("abs", 50), Node.repeat("x", 6, [
+        (Size("abs", 80), tile)])), (Size("abs", 20), Node.leaf("facade"))])
+    regular = Procedure(480, 450, Node.repeat("y", 5, [(Size("abs", 90), floor)]))
+    clean = to_segmentation(regular)
+    windows = [r for r in clean.rects if r.label == LABEL_ID["window"]]
+    walls = [r for r in clean.rects if r.label != LABEL_ID["window"]]
+    jittered = [Rect(r.label, r.x0 + (i % 3) - 1, r.y0 + (i % 2), r.x1 - (i % 2), r.y1 + (i % 3) - 1)
+                for i, r in enumerate(windows)]
+    drawn = Segmentation(480, 450, tuple(walls + jittered[:7] + jittered[8:]))  # one window missed
+    induced = induce_procedure(flatten(drawn))
+    assert reads_through_noise(regular, induced, flatten(drawn))  # 30 windows in 3 leaves; one window unexplained
+    wrong = Procedure(480, 450, Node.repeat("y", 5, [(Size("abs", 90), Node.split("y", [
+        (Size("abs", 20), Node.leaf("facade")), (Size("abs", 50), Node.leaf("window")),
+        (Size("abs", 20), Node.leaf("facade"))]))]))
+    assert not reads_through_noise(wrong, induced, flatten(drawn))  # compact, but bands where windows are not
+    assert not reads_through_noise(induced, induced, flatten(drawn))  # no more compact than the induced one
