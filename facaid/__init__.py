@@ -12,4 +12,8 @@ def __getattr__(name):
         from facaid.pipeline import reconstruct
 
         return reconstruct
+    if name == "complete":
+        from facaid.completion import complete
+
+        return complete
     raise AttributeError(f"module 'facaid' has no attribute {name!r}")

@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from facaid.defaults import DEFAULT_K
+from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
 from facaid.generator import STYLE_NAMES
 from facaid.paths import DEFAULT_CHECKPOINT, DEFAULT_CMP
 
@@ -188,6 +188,24 @@ def cmd_reconstruct(args: argparse.Namespace) -> None:
         render_segmentation(to_segmentation(result.procedure), outline=True).save(args.png)
         print(f"wrote {args.png}")
     _write_json(args.json, result.to_dict())
+
+
+def cmd_complete(args: argparse.Namespace) -> None:
+    from facaid.completion import complete
+    from facaid.segmentation import Segmentation
+
+    seg = Segmentation.from_dict(_read_json(args.input), clip=args.clip)
+    if args.photo and not Path(args.photo).is_file():
+        raise CliError(f"photo not found at {args.photo}")
+    if not 0 <= args.min_score <= 1:
+        raise CliError(f"--min-score must be in [0, 1], got {args.min_score}")
+    proposals = complete(seg, args.photo, min_score=args.min_score)
+    counts: dict[str, int] = {}
+    for p in proposals:
+        counts[p["label"]] = counts.get(p["label"], 0) + 1
+    print(f"{len(proposals)} proposal{'s' if len(proposals) != 1 else ''} for {len(seg.rects)} drawn rectangles"
+          + (": " + ", ".join(f"{n} {label}" for label, n in sorted(counts.items())) if counts else ""))
+    _write_json(args.json, {"proposals": proposals})
 
 
 def cmd_vary(args: argparse.Namespace) -> None:
@@ -378,6 +396,17 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory (default: shipped)")
     c.add_argument("--json", help="write the figures (accuracy, IoU, timings) to this JSON file")
     c.set_defaults(func=cmd_reconstruct)
+
+    cp = sub.add_parser("complete", help="propose the elements not drawn yet in a partial segmentation",
+                        description="Read the rows, columns and companions of the elements drawn so far and propose "
+                                    "the missing ones, each with a score, none repeating a drawn one.")
+    cp.add_argument("input", help="segmentation JSON drawn so far")
+    cp.add_argument("--photo", help="the rectified photo (accepted; the photo check is not implemented yet)")
+    cp.add_argument("--min-score", type=float, default=DEFAULT_MIN_SCORE,
+                    help=f"leave out proposals scored lower (default {DEFAULT_MIN_SCORE})")
+    cp.add_argument("--clip", action="store_true", help="clip rectangles reaching outside the image")
+    cp.add_argument("--json", help="write the proposals to this JSON file ({\"proposals\": [...]})")
+    cp.set_defaults(func=cmd_complete)
 
     v = sub.add_parser("vary", help="variations of a procedure",
                        description="Write N variants of a procedure: floor and tile counts changed, the facade "

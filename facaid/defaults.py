@@ -14,3 +14,7 @@ TEMPERATURE = 0.7  # exact structure 64.5 % at 0.7 against 61.5 % at 1.0 (same f
 # of dataset seed 7777, best of 16: TED <= 5 84.7 % at 0.2-0.3 and with no size check, 84.0 % at 0.05-0.1,
 # 82.7 % unmerged. Floors further apart than this stay apart, so a real facade's taller floor keeps its height.
 FLOOR_TOLERANCE = 0.25
+
+# completion (facaid.completion): proposals scored lower are not returned; chosen on the CMP dev half with
+# bench/bench_assist.py (a simulated annotator)
+DEFAULT_MIN_SCORE = 0.85

@@ -266,3 +266,20 @@ def flatten_array_numpy(width: int, height: int, arr: np.ndarray, wall: str = "p
 def class_areas(label_map: np.ndarray) -> np.ndarray:
     """Pixel count of each of the 12 labels in a label map."""
     return np.bincount(label_map.ravel(), minlength=len(LABELS))[: len(LABELS)]
+
+
+def aligned_lines(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
+    """Indices of intervals [lo, hi) grouped into lines (rows of windows by their vertical extents, columns by
+    their horizontal ones): sorted by centre, an interval joins the line before it
+    when it overlaps that line's median interval by at least half its own length."""
+    order = np.argsort((lo + hi) / 2, kind="stable")
+    lines: list[list[int]] = []
+    for i in order.tolist():
+        if lines:
+            members = lines[-1]
+            a, b = np.median(lo[members]), np.median(hi[members])
+            if min(b, hi[i]) - max(a, lo[i]) >= 0.5 * (hi[i] - lo[i]):
+                members.append(i)
+                continue
+        lines.append([i])
+    return [np.array(m) for m in lines]

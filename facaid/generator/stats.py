@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from facaid.labels import LABELS
-from facaid.segmentation import Segmentation, class_areas, flatten, rasterize
+from facaid.segmentation import Segmentation, aligned_lines, class_areas, flatten, rasterize
 
 
 @dataclass
@@ -85,22 +85,6 @@ def format_table(generated: ClassStats, real: ClassStats) -> str:
 WINDOW = LABELS.index("window")
 
 
-def _lines(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
-    """Indices of intervals [lo, hi) grouped into lines: sorted by centre, an interval joins the line before it
-    when it overlaps that line's median interval by at least half its own length."""
-    order = np.argsort((lo + hi) / 2, kind="stable")
-    lines: list[list[int]] = []
-    for i in order.tolist():
-        if lines:
-            members = lines[-1]
-            a, b = np.median(lo[members]), np.median(hi[members])
-            if min(b, hi[i]) - max(a, lo[i]) >= 0.5 * (hi[i] - lo[i]):
-                members.append(i)
-                continue
-        lines.append([i])
-    return [np.array(m) for m in lines]
-
-
 def irregularity(segs: list[Segmentation], min_members: int = 3) -> dict[str, float]:
     """How regular the windows' rows and columns are, as medians over every row (column) of at least
     ``min_members`` windows of every facade: the spread of their top (left) edges and of their bottom (right) edges
@@ -118,7 +102,7 @@ def irregularity(segs: list[Segmentation], min_members: int = 3) -> dict[str, fl
         for lo_col, hi_col, side, names in ((2, 4, seg.height, ("row_top", "row_bottom", "row_height_cv")),
                                             (1, 3, seg.width, ("column_left", "column_right", "column_width_cv"))):
             lo, hi = win[:, lo_col], win[:, hi_col]
-            for members in _lines(lo, hi):
+            for members in aligned_lines(lo, hi):
                 if len(members) < min_members:
                     continue
                 extent = hi[members] - lo[members]

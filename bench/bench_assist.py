@@ -1,0 +1,66 @@
+"""Assisted segmentation on the CMP annotations: how much drawing completion saves (issue 43's benchmark).
+
+    .venv/bin/python bench/bench_assist.py [--stride 1] [--limit N] [--min-score S] [--json F]
+
+A simulated annotator (`facaid.evaluation.assist.simulate`) draws each facade's true elements in reading order,
+asks `facaid.completion.complete` for proposals after every third, accepts at no cost each proposal that matches
+a true element not drawn yet (same class, IoU >= 0.7) and pays one action for every other one, and stops at
+95 % pixel accuracy. Effort = actions / elements (1.0: drawing everything). Printed for the dev half (facades
+1-189) and the test half (190-378) apart, beside the effort without completion (the 95 % stop alone), with the
+median time of a completion call. CMP is evaluation data: nothing here trains.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import statistics
+import time
+
+from facaid.completion import DEFAULT_MIN_SCORE, complete
+from facaid.evaluation.assist import simulate, summary
+from facaid.evaluation.real import DEV_FACADES, load_records
+from facaid.paths import DEFAULT_CMP
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--data", default=str(DEFAULT_CMP))
+    ap.add_argument("--stride", type=int, default=1, help="every N-th facade of each half")
+    ap.add_argument("--limit", type=int, default=None, help="at most N facades of each half")
+    ap.add_argument("--min-score", type=float, default=DEFAULT_MIN_SCORE)
+    ap.add_argument("--json", default=None)
+    args = ap.parse_args()
+    records = load_records(args.data)
+    halves = {"dev": records[:DEV_FACADES], "test": records[DEV_FACADES:]}
+    calls: list[float] = []
+
+    def timed(seg, **kw):
+        t0 = time.perf_counter()
+        out = complete(seg, min_score=args.min_score, **kw)
+        calls.append(time.perf_counter() - t0)
+        return out
+
+    result = {"min_score": args.min_score}
+    for name, recs in halves.items():
+        recs = recs[:: args.stride][: args.limit]
+        if not recs:
+            continue
+        assisted = [simulate(seg, timed) for _, seg in recs]
+        alone = [simulate(seg, functools.partial(lambda s, rejected: [])) for _, seg in recs]
+        result[name] = {"assisted": summary(assisted), "unassisted": summary(alone)}
+        a, u = result[name]["assisted"], result[name]["unassisted"]
+        print(f"{name}: {a['facades']} facades, median effort {a['effort_median']:.3f} with completion "
+              f"({a['accepted']} proposals accepted, {a['rejected']} rejected, {a['drawn']} drawn of "
+              f"{a['elements']}), {u['effort_median']:.3f} without")
+    if calls:
+        result["call_seconds_median"] = statistics.median(calls)
+        print(f"completion call: median {1000 * statistics.median(calls):.1f} ms ({len(calls)} calls)")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

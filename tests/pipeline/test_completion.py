@@ -1,0 +1,111 @@
+"""Completion (`facaid.completion.complete`, `facaid complete`) and its simulated annotator
+(`facaid.evaluation.assist`)."""
+
+import json
+
+import pytest
+
+import facaid
+from facaid.cli import main
+from facaid.completion import complete
+from facaid.evaluation.assist import simulate
+from facaid.labels import FACADE, LABEL_ID
+from facaid.segmentation import Rect, Segmentation, SegmentationError
+
+WINDOW = LABEL_ID["window"]
+
+
+def _grid(cols: int = 6, rows: int = 5) -> list[Rect]:
+    """A facade of ``rows`` x ``cols`` windows on a 100 px pitch, in reading order."""
+    return [Rect(WINDOW, 20 + 100 * i, 20 + 100 * j, 80 + 100 * i, 80 + 100 * j)
+            for j in range(rows) for i in range(cols)]
+
+
+WALL = Rect(FACADE, 0, 0, 600, 500)
+
+
+def _boxes(proposals: list[dict]) -> set[tuple]:
+    return {(p["label"], p["x0"], p["y0"], p["x1"], p["y1"]) for p in proposals}
+
+
+def _as_boxes(rects: list[Rect]) -> set[tuple]:
+    return {("window", r.x0, r.y0, r.x1, r.y1) for r in rects}
+
+
+def test_the_windows_missing_from_drawn_rows_and_columns_are_proposed_and_nothing_else():
+    windows = _grid()
+    drawn = [w for i, w in enumerate(windows) if i not in (8, 15, 22)]  # three windows missed in the grid
+    proposals = complete(Segmentation(600, 500, (WALL, *drawn)))
+    assert _boxes(proposals) == _as_boxes([windows[8], windows[15], windows[22]])
+    assert all(p["score"] >= 0.85 and p["reason"] == "grid" for p in proposals)
+    assert facaid.complete is complete
+
+
+def test_a_row_and_a_column_drawn_give_the_grid_and_a_lower_threshold_extends_beyond_them():
+    windows = _grid()
+    first_row, first_column = windows[:6], windows[::6]
+    drawn = Segmentation(600, 500, (WALL, *first_row, *first_column[1:]))
+    assert _boxes(complete(drawn)) == _as_boxes([w for w in windows if w not in first_row + first_column])
+    partial = Segmentation(600, 500, (WALL, *windows[:3]))  # three of a row: the rest of it is a guess
+    assert complete(partial) == []
+    guesses = complete(partial, min_score=0.5)
+    assert _boxes(guesses) == _as_boxes([windows[3]])  # one pitch beyond the drawn ones, inside the facade
+    assert guesses[0]["reason"] == "row" and guesses[0]["score"] < 0.85
+
+
+def test_nothing_drawn_is_repeated_a_lone_ornament_is_not_repeated_and_rejected_boxes_stay_rejected():
+    windows = _grid()
+    assert complete(Segmentation(600, 500, (WALL, *windows))) == []  # complete already
+    lone = Segmentation(600, 500, (WALL, Rect(LABEL_ID["deco"], 250, 200, 300, 240)))
+    assert complete(lone, min_score=0.0) == []
+    drawn = Segmentation(600, 500, (WALL, *[w for i, w in enumerate(windows) if i != 8]))
+    (missing,) = complete(drawn)
+    rejected = [{k: missing[k] for k in ("label", "x0", "y0", "x1", "y1")}]
+    assert complete(drawn, rejected=rejected) == []
+    assert complete(Segmentation(600, 500, ())) == []
+    # proposals stay inside the facade rectangle: a narrower wall keeps the row's continuation out
+    fits = Segmentation(600, 500, (Rect(FACADE, 0, 0, 390, 500), *windows[:3]))
+    assert _boxes(complete(fits, min_score=0.5)) == _as_boxes([windows[3]])
+    narrow = Segmentation(600, 500, (Rect(FACADE, 0, 0, 350, 500), *windows[:3]))
+    assert complete(narrow, min_score=0.5) == []
+
+
+def test_bad_input_gets_a_clear_error():
+    with pytest.raises(SegmentationError, match="x1"):
+        complete({"width": 10, "height": 10, "rects": [{"label": "window", "x0": 5, "y0": 1, "x1": 20, "y1": 3}]})
+    with pytest.raises(SegmentationError):
+        complete({"width": 10, "height": 10, "rects": [{"label": "tower", "x0": 1, "y0": 1, "x1": 2, "y1": 3}]})
+
+
+def test_the_simulated_annotator_on_facades_whose_answer_is_known():
+    seg = Segmentation(600, 500, (WALL, *_grid()))
+    alone = simulate(seg, lambda s, rejected: [])
+    assert alone.rejected == alone.accepted == 0 and alone.accuracy >= 0.95
+    assert alone.drawn < 31 and alone.effort == alone.drawn / 31  # it stops at 95 %, before the last windows
+
+    def oracle(s, rejected):  # proposes every true element not drawn yet, and one wrong box
+        drawn = set(s.rects)
+        out = [{"label": "window", "x0": r.x0, "y0": r.y0, "x1": r.x1, "y1": r.y1, "score": 1.0}
+               for r in seg.rects if r not in drawn and r.label == WINDOW]
+        return out + [{"label": "window", "x0": 590, "y0": 490, "x1": 600, "y1": 500, "score": 0.1}]
+
+    known = simulate(seg, oracle)
+    assert (known.drawn, known.accepted, known.rejected, known.calls) == (3, 28, 1, 1)
+    assert known.effort == pytest.approx(4 / 31) and known.accuracy == 1.0
+    helped = simulate(seg)  # the real completion on a regular grid: fewer actions than drawing it all
+    assert helped.rejected == 0 and helped.accepted > 0 and helped.effort < alone.effort
+
+
+def test_cli_complete(tmp_path, capsys):
+    windows = _grid()
+    path = tmp_path / "drawn.json"
+    path.write_text(Segmentation(600, 500, (WALL, *[w for i, w in enumerate(windows) if i != 8])).to_json())
+    out = tmp_path / "proposals.json"
+    assert main(["complete", str(path), "--json", str(out)]) == 0
+    assert "1 proposal for 30 drawn rectangles: 1 window" in capsys.readouterr().out
+    (p,) = json.loads(out.read_text())["proposals"]
+    assert (p["x0"], p["y0"], p["x1"], p["y1"]) == (220, 120, 280, 180)
+    assert main(["complete", str(path), "--min-score", "2"]) == 2
+    assert "--min-score must be in [0, 1]" in capsys.readouterr().err
+    assert main(["complete", str(path), "--photo", str(tmp_path / "none.png")]) == 2
+    assert "photo not found" in capsys.readouterr().err
