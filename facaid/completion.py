@@ -36,6 +36,8 @@ from facaid.defaults import DEFAULT_MIN_SCORE
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
 from facaid.segmentation import Segmentation, aligned_lines, parse_segmentation
 
+MAX_DRAWN = 2_000  # more drawn rectangles than this are refused (a CMP facade has at most a few hundred)
+MAX_PROPOSALS = 2_000  # proposals gathered at most in one call
 SIZE_TOLERANCE = 0.2  # elements of one class whose width and height agree within this share are one type
 SAME_PLACE = 0.5  # IoU at which a proposal is the same element as a drawn, proposed or rejected one
 OVERLAP = 0.2  # a proposal whose area lies this much over drawn elements of its class is not made
@@ -64,15 +66,16 @@ def _types(rows: np.ndarray) -> list[_Type]:
         boxes = rows[rows[:, 0] == label, 1:].astype(float)
         area = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
         groups: list[list[int]] = []
+        sizes = np.zeros((0, 2))  # each group's first (largest) member's width and height
         for i in np.argsort(-area, kind="stable").tolist():
             w, h = boxes[i, 2] - boxes[i, 0], boxes[i, 3] - boxes[i, 1]
-            for g in groups:
-                gw, gh = boxes[g[0], 2] - boxes[g[0], 0], boxes[g[0], 3] - boxes[g[0], 1]
-                if abs(w - gw) <= SIZE_TOLERANCE * gw and abs(h - gh) <= SIZE_TOLERANCE * gh:
-                    g.append(i)
-                    break
+            fits = np.flatnonzero((np.abs(w - sizes[:, 0]) <= SIZE_TOLERANCE * sizes[:, 0])
+                                  & (np.abs(h - sizes[:, 1]) <= SIZE_TOLERANCE * sizes[:, 1]))
+            if len(fits):
+                groups[fits[0]].append(i)
             else:
                 groups.append([i])
+                sizes = np.vstack([sizes, [w, h]])
         for g in groups:
             b = boxes[g]
             out.append(_Type(int(label), b, float(np.median(b[:, 2] - b[:, 0])), float(np.median(b[:, 3] - b[:, 1]))))
@@ -158,7 +161,7 @@ class _Proposals:
     def add(self, label: int, box: np.ndarray, score: float, reason: str) -> bool:
         box = np.array([max(0.0, box[0]), max(0.0, box[1]), min(self.width, box[2]), min(self.height, box[3])])
         box = np.round(box)
-        if box[2] - box[0] < 1 or box[3] - box[1] < 1 or not self.inside(box):
+        if len(self.items) >= MAX_PROPOSALS or box[2] - box[0] < 1 or box[3] - box[1] < 1 or not self.inside(box):
             return False
         same = self.drawn[self.drawn[:, 0] == label, 1:].astype(float)
         shared = _overlap(box, same)  # over a drawn element of its class, even in part: drawn already
@@ -214,40 +217,46 @@ def _spans(lo: np.ndarray, hi: np.ndarray, lines: list[np.ndarray], pitch: float
 
 def _companions(types: list[_Type], props: _Proposals) -> None:
     """Elements drawn on or against another type's elements, proposed at the same offset for the rest of them."""
-    anchors = [t for t in types if len(t.boxes) >= 1]
-    for a in anchors:
+    for a in types:
+        if len(a.boxes) < COMPANION_MIN:
+            continue
         instances = [box for box in a.boxes] + [box for lab, box, score, _ in list(props.items) if lab == a.label
                                                  and score >= 0.9
                                                  and abs((box[2] - box[0]) - a.width) <= SIZE_TOLERANCE * a.width]
         for s in types:
-            if s is a or s.label == a.label:
+            if s.label == a.label:
                 continue
-            offsets = []
-            for box in a.boxes:
-                for c in s.boxes:
-                    gap_x = max(box[0] - c[2], c[0] - box[2])
-                    gap_y = max(box[1] - c[3], c[1] - box[3])
-                    if gap_x <= COMPANION_TOUCH and gap_y <= COMPANION_TOUCH and c[2] - c[0] <= 1.5 * (box[2] - box[0]):
-                        offsets.append(c - box)
-                        break
-            if len(offsets) < COMPANION_MIN:
+            box, c = a.boxes[:, None, :], s.boxes[None, :, :]  # (anchors, companions, 4)
+            gap_x = np.maximum(box[..., 0] - c[..., 2], c[..., 0] - box[..., 2])
+            gap_y = np.maximum(box[..., 1] - c[..., 3], c[..., 1] - box[..., 3])
+            touch = ((gap_x <= COMPANION_TOUCH) & (gap_y <= COMPANION_TOUCH)
+                     & (c[..., 2] - c[..., 0] <= 1.5 * (box[..., 2] - box[..., 0])))
+            has = touch.any(axis=1)  # each anchor's first touching companion
+            if has.sum() < COMPANION_MIN or has.mean() < COMPANION_SHARE:
                 continue
-            share = len(offsets) / len(a.boxes)
-            if share < COMPANION_SHARE:
-                continue
-            offset = np.median(np.array(offsets), axis=0)
-            for box in instances:
-                props.add(s.label, box + offset, round(0.4 + 0.5 * share, 3), f"with {LABELS[a.label]}")
+            first = touch.argmax(axis=1)[has]
+            offset = np.median(s.boxes[first] - a.boxes[has], axis=0)
+            share = float(has.mean())
+            for anchor in instances:
+                props.add(s.label, anchor + offset, round(0.4 + 0.5 * share, 3), f"with {LABELS[a.label]}")
 
 
 def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: list[dict] | None = None,
              min_score: float = DEFAULT_MIN_SCORE) -> list[dict]:
     """Proposed missing elements for a partly drawn segmentation (a `Segmentation` or its JSON object): dicts
     ``{label, x0, y0, x1, y1, score}`` in the segmentation contract, best first, none repeating a drawn element;
-    ``rejected`` boxes (the same contract) are not proposed again. See the module's docstring."""
+    ``rejected`` boxes (the same contract) are not proposed again. See the module's docstring. Raises
+    `SegmentationError` (a ValueError) naming the field for a bad segmentation or rejected box, ValueError for
+    more than `MAX_DRAWN` rectangles."""
     del photo  # the photo check comes with the editor's completion; structure alone proposes for now
     seg = segmentation if isinstance(segmentation, Segmentation) else parse_segmentation(segmentation)
     rows = seg.to_array()
+    if len(rows) > MAX_DRAWN:
+        raise ValueError(f"too many rectangles for completion: {len(rows)} (at most {MAX_DRAWN})")
+    if rejected is not None and not isinstance(rejected, list):
+        raise ValueError("rejected must be a list of rectangles")
+    if rejected:  # the contract's rectangles, checked as a segmentation of the same size would be
+        parse_segmentation({"width": seg.width, "height": seg.height, "rects": rejected})
     rej = (np.array([[LABEL_ID[r["label"]], r["x0"], r["y0"], r["x1"], r["y1"]] for r in rejected], dtype=float)
            if rejected else np.zeros((0, 5)))
     props = _Proposals(seg, rows, rej)

@@ -18,8 +18,13 @@ export function similarProposals(gray, seg, id, threshold) {
 }
 
 /** The command adding the proposals not rejected (`accepted === false`), or null when none is left. */
-export function acceptCommand(proposals) {
+export function acceptCommand(proposals, name = "find similar") {
   const keep = proposals.filter((p) => p.accepted !== false);
-  return keep.length ? new AddRects(keep.map(({label, x0, y0, x1, y1}) => ({label, x0, y0, x1, y1})), "find similar")
-    : null;
+  return keep.length ? new AddRects(keep.map(({label, x0, y0, x1, y1}) => ({label, x0, y0, x1, y1})), name) : null;
+}
+
+/** The proposals the user rejected (clicked away), as rectangles to pass back to completion so that it does not
+ * propose them again. */
+export function rejectedOf(proposals) {
+  return proposals.filter((p) => p.accepted === false).map(({label, x0, y0, x1, y1}) => ({label, x0, y0, x1, y1}));
 }

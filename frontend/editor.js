@@ -1,6 +1,6 @@
 // The editor page: the glue between the DOM and the editor's DOM-free parts. All changes go through commands and
 // the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
-import {acceptCommand, repeatCommand, similarProposals} from "./assist.js";
+import {acceptCommand, rejectedOf, repeatCommand, similarProposals} from "./assist.js";
 import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
 import {keyAction} from "./keys.js";
 import {buildPalette, markActive} from "./panel.js";
@@ -20,7 +20,7 @@ const ctx = canvas.getContext("2d");
 
 const view = {scale: 1, ox: 0, oy: 0};  // screen = image * scale + offset
 const ui = {tool: "draw", label: "window", selection: new Set(), drag: null, guides: [], proposals: [],
-  space: false, overlay: null, overlayAlpha: 0.5};
+  proposalsFrom: "find similar", rejected: [], space: false, overlay: null, overlayAlpha: 0.5};
 // the photo's API record and image, the segmentation and its history, the photo's gray levels once asked for,
 // and the RectifyMode (rectify-mode.js) while the rectification step is open
 let info = null, photo = null, seg = null, history = null, gray = null, rectifying = null;
@@ -172,7 +172,7 @@ window.addEventListener("keydown", (e) => {
   ({undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: removeSelected,
     selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
     clear: () => { ui.selection.clear(); ui.proposals = []; changed(); },
-    tool: () => setTool(a.tool), label: () => pickLabel(a.label), accept: acceptProposals,
+    tool: () => setTool(a.tool), label: () => pickLabel(a.label), accept: acceptProposals, complete: completeNow,
     nudge: () => run(moveRects(seg, [...ui.selection], a.dx, a.dy))})[a.action]();
 });
 window.addEventListener("keyup", (e) => { if (e.key === " ") { ui.space = false; setTool(ui.tool); } });
@@ -199,13 +199,31 @@ function similar() {
   if (ui.selection.size !== 1) return status("Select one drawn rectangle to look for copies of it.", "error");
   gray = gray || grayPixels(photo, seg.width, seg.height);
   ui.proposals = similarProposals(gray, seg, [...ui.selection][0], Number($("#sim-threshold").value));
+  ui.proposalsFrom = "find similar";
   status(ui.proposals.length ? `${ui.proposals.length} proposals: click one to reject it, Enter or "Accept" to add ` +
     "the rest." : "No similar places found.");
   draw();
 }
 
+// completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
+async function completeNow() {
+  ui.rejected.push(...rejectedOf(ui.proposals));
+  try {
+    const {proposals} = await api(`/api/v1/photos/${photoCode}/complete`, {method: "POST",
+      body: JSON.stringify({...seg.toJSON(), rejected: ui.rejected})});
+    ui.proposals = proposals;
+    ui.proposalsFrom = "complete";
+    status(proposals.length ? `${proposals.length} proposals: click one to reject it, Enter or "Accept" to add ` +
+      "the rest." : "Nothing to propose yet: draw a few elements of a row and a column.");
+  } catch (err) {
+    status(`No proposals: ${err.message}`, "error");
+  }
+  draw();
+}
+
 function acceptProposals() {
-  const cmd = acceptCommand(ui.proposals);
+  ui.rejected.push(...rejectedOf(ui.proposals));
+  const cmd = acceptCommand(ui.proposals, ui.proposalsFrom);
   ui.proposals = [];
   if (cmd) run(cmd);
   changed();
@@ -278,6 +296,7 @@ on("#duplicate", "click", duplicate);
 on("#repeat", "click", () => { try { repeatSelected(); } catch (err) { status(err.message, "error"); } });
 on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
+on("#complete", "click", completeNow);
 on("#export", "click", () => download(seg.toJSON(), `segmentation-${photoCode.slice(0, 8)}.json`));
 on("#import", "change", (e) => e.target.files[0] && importJSON(e.target.files[0]));
 on("#save", "click", saveNow);

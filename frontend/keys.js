@@ -4,8 +4,8 @@ import {HOTKEYS, LABELS} from "./labels.js";
 const ARROWS = {ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1]};
 
 /** `event`: {key, ctrlKey, metaKey, shiftKey}. `state`: {selected: how many, proposals: how many}. Returns
- * {action, ...} with action one of undo, redo, duplicate, selectAll, delete, clear, tool (tool), accept, label
- * (label), nudge (dx, dy), or null. */
+ * {action, ...} with action one of undo, redo, duplicate, selectAll, delete, clear, tool (tool), accept, complete,
+ * label (label), nudge (dx, dy), or null. */
 export function keyAction(event, state = {selected: 0, proposals: 0}) {
   const {key, shiftKey} = event;
   const k = key.toLowerCase();
@@ -20,6 +20,7 @@ export function keyAction(event, state = {selected: 0, proposals: 0}) {
   if (key === "Escape") return {action: "clear"};
   if (key === "r") return {action: "tool", tool: "draw"};
   if (key === "v") return {action: "tool", tool: "select"};
+  if (key === "c") return {action: "complete"};
   if (key === "Enter" && state.proposals) return {action: "accept"};
   const i = HOTKEYS.indexOf(key);
   if (i >= 0) return {action: "label", label: LABELS[i]};

@@ -3,7 +3,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {acceptCommand, repeatCommand} from "../assist.js";
+import {acceptCommand, rejectedOf, repeatCommand} from "../assist.js";
 import {AddRects} from "../commands.js";
 import {History} from "../history.js";
 import {keyAction} from "../keys.js";
@@ -129,6 +129,7 @@ test("keys: shortcuts map to actions, arrows only with a selection, Enter only w
   assert.deepEqual(keyAction({key: "z", ctrlKey: true}), {action: "undo"});
   assert.deepEqual(keyAction({key: "Z", ctrlKey: true, shiftKey: true}), {action: "redo"});
   assert.deepEqual(keyAction({key: "r"}), {action: "tool", tool: "draw"});
+  assert.deepEqual(keyAction({key: "c"}), {action: "complete"});
   assert.deepEqual(keyAction({key: "3"}), {action: "label", label: "window"});
   assert.equal(keyAction({key: "ArrowLeft"}, {selected: 0, proposals: 0}), null);
   assert.deepEqual(keyAction({key: "ArrowLeft", shiftKey: true}, {selected: 2, proposals: 0}),
@@ -148,4 +149,9 @@ test("assist: a grid of copies with gaps; accepting proposals adds those not rej
     {label: "window", x0: 0, y0: 0, x1: 5, y1: 5, accepted: false}]);
   history.execute(cmd);
   assert.equal(cmd.ids.length, 1);
+  assert.equal(cmd.name, "find similar");
+  assert.equal(acceptCommand([{label: "sill", x0: 1, y0: 1, x1: 4, y1: 2}], "complete").name, "complete");
+  assert.deepEqual(rejectedOf([{label: "window", x0: 100, y0: 60, x1: 110, y1: 70, score: 0.9},
+    {label: "sill", x0: 0, y0: 0, x1: 5, y1: 5, score: 0.9, reason: "grid", accepted: false}]),
+  [{label: "sill", x0: 0, y0: 0, x1: 5, y1: 5}]);
 });

@@ -214,3 +214,47 @@ def test_every_registered_download_is_served_as_registered(facade_photo, as_alic
             assert r.status_code == 400 and "photo" in r.json()["name"]
     page = as_charlie.get(f"/procedures/{proc.code}").content.decode()
     assert "download/overlay.png" not in page and "download/mesh.zip" in page
+
+
+def _drawn_grid(width, height, missing=()):
+    """A facade rectangle and a 4 x 3 grid of windows on it, but for the ``missing`` ones (indices)."""
+    rects = [{"label": "facade", "x0": 0, "y0": 0, "x1": width, "y1": height}]
+    pw, ph = width // 5, height // 4
+    for j in range(3):
+        for i in range(4):
+            if 4 * j + i not in missing:
+                rects.append({"label": "window", "x0": pw // 2 + i * pw, "y0": ph // 2 + j * ph,
+                              "x1": pw // 2 + i * pw + pw // 2, "y1": ph // 2 + j * ph + ph // 2})
+    return {"width": width, "height": height, "rects": rects}
+
+
+def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_photo, as_alice, as_bob):
+    photo, _ = facade_photo
+    url = f"/api/v1/photos/{photo['code']}/complete"
+    w, h = photo["width"], photo["height"]
+    full = _drawn_grid(w, h)["rects"]
+    body = _drawn_grid(w, h, missing=(5,))
+    r = as_alice.post(url, body, format="json")
+    assert r.status_code == 200, r.content
+    (p,) = r.json()["proposals"]
+    assert {k: p[k] for k in ("label", "x0", "y0", "x1", "y1")} == full[1 + 5]
+    assert p["score"] >= 0.85 and p["reason"] == "grid"
+    body["rejected"] = [{k: p[k] for k in ("label", "x0", "y0", "x1", "y1")}]
+    assert as_alice.post(url, body, format="json").json()["proposals"] == []
+    assert as_alice.get(seg_url(photo)).json()["count"] == 1  # nothing stored
+    for bad, field, message in (
+        ({**_drawn_grid(w + 10, h)}, "segmentation", "but the photo is"),
+        ({**_drawn_grid(w, h), "min_score": 2}, "min_score", "in [0, 1]"),
+        ({**_drawn_grid(w, h), "min_score": "high"}, "min_score", "in [0, 1]"),
+        ({**_drawn_grid(w, h), "rejected": "all"}, "rejected", "list"),
+        ({**_drawn_grid(w, h), "rejected": [{"label": "window", "x0": 5, "y0": 5, "x1": 2, "y1": 9}]}, "rejected",
+         "x0 < x1"),
+        ({"width": w, "height": h, "rects": [{"label": "window", "x0": 0, "y0": 0, "x1": 1, "y1": 1}] * 2001},
+         "segmentation", "too many rectangles for completion"),
+    ):
+        r = as_alice.post(url, bad, format="json")
+        assert r.status_code == 400, (bad.keys(), r.content)
+        assert field in r.json() and message in json.dumps(r.json()), r.json()
+    r = as_alice.post(url, [1, 2], format="json")
+    assert r.status_code == 400 and "JSON object" in json.dumps(r.json())
+    assert as_bob.post(url, _drawn_grid(w, h), format="json").status_code == 404  # Alice's private photo

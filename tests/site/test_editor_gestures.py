@@ -5,6 +5,7 @@ a photo with repeated windows."""
 from __future__ import annotations
 
 import io
+import json
 import shutil
 
 import numpy as np
@@ -174,3 +175,30 @@ def test_find_similar_proposes_the_other_windows(editor):
     assert not any(abs(r["x0"] - rejected["x0"]) <= 1 and abs(r["y0"] - rejected["y0"]) <= 1 for r in windows)
     page.keyboard.press("Control+z")
     assert len([r for r in rects(page) if r["label"] == "window"]) == 1
+
+
+def test_completion_proposes_the_missing_window_accepted_undone_and_rejected(editor, tmp_path):
+    page = editor
+    drawn = [{"label": "facade", "x0": 0, "y0": 0, "x1": 480, "y1": 360}] + [
+        {"label": "window", "x0": x, "y0": y, "x1": x + WIN_W, "y1": y + WIN_H} for x, y in WINDOWS[:5]]
+    path = tmp_path / "drawn.json"
+    path.write_text(json.dumps({"width": 480, "height": 360, "rects": drawn}))
+    page.set_input_files("#import", str(path))
+    page.wait_for_function(f"{E}.seg.size === 6")
+    page.keyboard.press("c")
+    page.wait_for_function(f"{E}.ui.proposals.length === 1")
+    (p,) = page.evaluate(f"{E}.ui.proposals")
+    x, y = WINDOWS[5]
+    assert (p["label"], p["x0"], p["y0"], p["x1"], p["y1"]) == ("window", x, y, x + WIN_W, y + WIN_H)
+    assert "1 proposals" in page.text_content("#status")
+    page.keyboard.press("Enter")  # accepted: one undoable step
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 6
+    page.keyboard.press("Control+z")
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 5
+    page.click("#complete")
+    page.wait_for_function(f"{E}.ui.proposals.length === 1")
+    page.mouse.click(*screen(page, x + 20, y + 20))  # rejected with a click ...
+    page.keyboard.press("c")  # ... and not proposed again
+    page.wait_for_function(f"{E}.ui.proposals.length === 0 && document.querySelector('#status').textContent"
+                           ".startsWith('Nothing to propose')")
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 5

@@ -166,6 +166,21 @@ def photo_segmentations(request, code):
     return Response(SegmentationSerializer(seg).data, status=status.HTTP_201_CREATED)
 
 
+@extend_schema(request={"application/json": dict}, responses={200: dict},
+               summary="Propose the elements not drawn yet (facaid.complete): the body is the segmentation drawn so "
+                       "far, with optional 'rejected' rectangles and 'min_score'; returns {'proposals': [{label, x0, "
+                       "y0, x1, y1, score, reason}]}; nothing is stored")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def photo_complete(request, code):
+    photo = access.get_photo_for_user(request.user, code)
+    if not isinstance(request.data, dict):
+        raise ValidationError({"segmentation": "must be a JSON object"})
+    return Response({"proposals": services.complete_segmentation(photo, request.data)})
+
+
 @extend_schema(responses=SegmentationSerializer, summary="One segmentation version")
 @api_view(["GET"])
 @permission_classes([AllowAny])

@@ -8,6 +8,7 @@ urlpatterns = [
     path("photos/<str:code>/image", api.photo_image, name="api-photo-image"),
     path("photos/<str:code>/rectify", api.photo_rectify, name="api-photo-rectify"),
     path("photos/<str:code>/segmentations/", api.photo_segmentations, name="api-photo-segmentations"),
+    path("photos/<str:code>/complete", api.photo_complete, name="api-photo-complete"),
     path("segmentations/<str:code>/", api.segmentation_detail, name="api-segmentation"),
     path("jobs/", api.job_list, name="api-jobs"),
     path("jobs/<str:code>/", api.job_detail, name="api-job"),

@@ -10,7 +10,8 @@ from django.db import transaction
 from django.db.models import Max
 from rest_framework.exceptions import APIException, ValidationError
 
-from facaid.defaults import DEFAULT_K
+from facaid.completion import complete
+from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
 from webapp.facades import jobs
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.serializers import parse_procedure, parse_segmentation
@@ -28,16 +29,38 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
     return photo
 
 
-def add_segmentation(photo: Photo, data) -> Segmentation:
+def _segmentation_of(photo: Photo, data):
+    """The segmentation JSON, validated, of the photo's size (the rectified image's once there is one)."""
     seg = parse_segmentation(data)
     w, h = (photo.rectified.width, photo.rectified.height) if photo.rectified else (photo.width, photo.height)
     if (seg.width, seg.height) != (w, h):
         raise ValidationError({"segmentation": f"the segmentation is {seg.width}x{seg.height} but the "
                                                f"{'rectified ' if photo.rectified else ''}photo is {w}x{h}"})
+    return seg
+
+
+def add_segmentation(photo: Photo, data) -> Segmentation:
+    seg = _segmentation_of(photo, data)
     with transaction.atomic():
         last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
         return Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
                                            rect_count=len(seg.rects))
+
+
+def complete_segmentation(photo: Photo, data) -> list[dict]:
+    """Proposals for what is not drawn yet (`facaid.complete`) in a segmentation of the photo: the body is the
+    segmentation JSON, optionally with ``rejected`` (rectangles not to propose again) and ``min_score``."""
+    seg = _segmentation_of(photo, data)
+    rejected = data.get("rejected", [])
+    min_score = data.get("min_score", DEFAULT_MIN_SCORE)
+    if not isinstance(rejected, list):
+        raise ValidationError({"rejected": "give a list of rectangles"})
+    if isinstance(min_score, bool) or not isinstance(min_score, int | float) or not 0 <= min_score <= 1:
+        raise ValidationError({"min_score": f"give a number in [0, 1], got {min_score!r}"})
+    try:
+        return complete(seg, rejected=rejected, min_score=float(min_score))
+    except ValueError as exc:  # a bad rejected rectangle, or too many rectangles
+        raise ValidationError({"rejected" if "rects[" in str(exc) else "segmentation": str(exc)}) from None
 
 
 class TooManyJobs(APIException):
