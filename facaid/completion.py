@@ -9,7 +9,7 @@ a drawn one:
 2. **Lattice**: a type's elements fall into rows (their vertical extents overlapping by half) and columns. Where
    a row (column) has at least `MIN_GAPS` gaps that agree (`PITCH_TOLERANCE`; multiples read as skipped bays),
    its pitch continues the columns (rows) `EXTEND` pitch beyond the drawn ones while they fit in the facade (the
-   union of the drawn facade rectangles, else the image) and fills the whole pitches between them. Every
+   drawn facade rectangles' bounds, else the image) and fills the whole pitches between them. Every
    crossing of a row and a column where nothing of the type is drawn is a proposal, spanning its drawn row's
    and column's median edges: score 0.9 (reason ``grid``) where both the row and the column were drawn in, 0.7
    (``row`` or ``column``) where one was, 0.5 where neither.
@@ -17,12 +17,12 @@ a drawn one:
    another type (a sill under each window) is proposed at the same offset for the rest of them (``with
    window``).
 
-Proposals outside the facade, over a drawn element of the same class, mostly under a drawn element of a class
-that paints over them, or near a ``rejected`` box are left out; those scored below ``min_score``
-(`facaid.defaults.DEFAULT_MIN_SCORE`) are not returned. On the CMP annotations a simulated annotator
-(`facaid.evaluation.assist`, `bench/bench_assist.py`) finds half the 0.9 proposals right and one in five or fewer
-of the 0.7 ones, hence the default. The photo check (appearance against the drawn examples) is not implemented yet:
-``photo`` is accepted and ignored.
+Proposals outside every drawn facade rectangle (the image when none is drawn), cut by the image's edge, over a drawn
+element of the same class, mostly under a drawn element of a class that paints over them, or near a ``rejected`` box
+are left out; those scored below ``min_score`` (`facaid.defaults.DEFAULT_MIN_SCORE`) are not returned. On the CMP
+annotations a simulated annotator (`facaid.evaluation.assist`, `bench/bench_assist.py`) finds half the 0.9 proposals
+right and one in five or fewer of the 0.7 ones, hence the default. The photo check (appearance against the drawn
+examples) is not implemented yet: ``photo`` is accepted and ignored.
 """
 
 from __future__ import annotations
@@ -38,8 +38,10 @@ from facaid.segmentation import Segmentation, aligned_lines, parse_segmentation
 
 MAX_DRAWN = 2_000  # more drawn rectangles than this are refused (a CMP facade has at most a few hundred)
 MAX_PROPOSALS = 2_000  # proposals gathered at most in one call
+MAX_FILL = 16  # two drawn lines at most this many pitches apart are filled between
+MAX_TYPES = 200  # with more types than this (no facade has them), companions are not looked for
 SIZE_TOLERANCE = 0.2  # elements of one class whose width and height agree within this share are one type
-SAME_PLACE = 0.5  # IoU at which a proposal is the same element as a drawn, proposed or rejected one
+SAME_PLACE = 0.5  # IoU at which two proposals are the same element
 OVERLAP = 0.2  # a proposal whose area lies this much over drawn elements of its class is not made
 REJECTED_PLACE = 0.3  # IoU at which a proposal repeats a rejected one
 MIN_GAPS = 2  # a pitch is measured from at least this many gaps that agree
@@ -49,6 +51,10 @@ PITCH_TOLERANCE = 0.1  # the gaps of a row (column) agree within this share of t
 COMPANION_SHARE = 1.0  # a companion is proposed when at least this share of its element's drawn copies have one
 COMPANION_MIN = 4  # ... and at least this many have one
 COMPANION_TOUCH = 3  # pixels: a companion overlaps its element or lies at most this far from it
+
+
+class RejectedError(ValueError):
+    """A rejected rectangle that breaks the segmentation contract; the message names it (``rejected[i]``)."""
 
 
 @dataclass
@@ -84,7 +90,8 @@ def _types(rows: np.ndarray) -> list[_Type]:
 
 def _pitch(starts: list[float], size: float) -> float | None:
     """The spacing of a row's (column's) elements: the median gap between neighbours, gaps that are about a
-    multiple of the smallest read as that many pitches. None with fewer than two elements."""
+    multiple of the smallest read as that many pitches. None with fewer than `MIN_GAPS` gaps (three elements) or
+    gaps that do not agree."""
     s = sorted(starts)
     gaps = [b - a for a, b in zip(s[:-1], s[1:], strict=True) if b - a >= 0.5 * size]
     if len(gaps) < MIN_GAPS:
@@ -99,8 +106,8 @@ def _pitch(starts: list[float], size: float) -> float | None:
 def _positions(observed: list[float], pitch: float | None, lo: float, hi: float, size: float,
                ) -> list[tuple[float, bool, bool]]:
     """(start, drawn, between drawn ones) along a row (column): the drawn elements' starts, the places between two
-    of them a whole number of pitches apart, and those beyond them by the pitch while the element still fits
-    within [lo, hi]."""
+    of them a whole number of pitches apart (at most `MAX_FILL`), and those beyond them by the pitch while the
+    element still fits within [lo, hi]."""
     known = sorted(observed)
     out = [(v, True, False) for v in known]
     if pitch is None or pitch <= 0:
@@ -108,7 +115,7 @@ def _positions(observed: list[float], pitch: float | None, lo: float, hi: float,
     slack = 0.25 * size
     for a, b in zip(known[:-1], known[1:], strict=True):
         steps = round((b - a) / pitch)
-        if steps >= 2 and abs(b - a - steps * pitch) <= 0.25 * pitch:
+        if 2 <= steps <= MAX_FILL and abs(b - a - steps * pitch) <= 0.25 * pitch:
             out += [(a + k * (b - a) / steps, False, True) for k in range(1, steps)]
     v = known[0] - pitch
     for _ in range(EXTEND):
@@ -151,34 +158,55 @@ class _Proposals:
         self.drawn = rows[(rows[:, 0] != FACADE) & (rows[:, 0] != BACKGROUND)]
         self.rejected = rejected
         self.items: list[tuple[int, np.ndarray, float, str]] = []  # label, box, score, reason
+        self.boxes = np.zeros((MAX_PROPOSALS, 4))  # the items' boxes and labels, for comparing in one go
+        self.labels = np.full(MAX_PROPOSALS, -1)
+        self.cache: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+
+    @property
+    def full(self) -> bool:
+        return len(self.items) >= MAX_PROPOSALS
 
     def inside(self, box: np.ndarray) -> bool:
+        """Within one of the drawn facade rectangles (2 px of slack), or the image when none is drawn."""
         slack = 2.0
         w = self.walls
         return bool(((w[:, 0] - slack <= box[0]) & (w[:, 1] - slack <= box[1]) & (box[2] <= w[:, 2] + slack)
                      & (box[3] <= w[:, 3] + slack)).any())
 
+    def _against(self, label: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(drawn boxes of the class, drawn boxes of classes painted over it, rejected boxes of the class)."""
+        if label not in self.cache:
+            drawn = self.drawn
+            above = np.array([PRIORITY[k] > PRIORITY[label] for k in drawn[:, 0].tolist()], dtype=bool)
+            rej = self.rejected[self.rejected[:, 0] == label, 1:] if len(self.rejected) else np.zeros((0, 4))
+            self.cache[label] = (drawn[drawn[:, 0] == label, 1:].astype(float),
+                                 drawn[above, 1:].astype(float).reshape(-1, 4), rej.astype(float))
+        return self.cache[label]
+
     def add(self, label: int, box: np.ndarray, score: float, reason: str) -> bool:
-        box = np.array([max(0.0, box[0]), max(0.0, box[1]), min(self.width, box[2]), min(self.height, box[3])])
-        box = np.round(box)
-        if len(self.items) >= MAX_PROPOSALS or box[2] - box[0] < 1 or box[3] - box[1] < 1 or not self.inside(box):
-            return False
-        same = self.drawn[self.drawn[:, 0] == label, 1:].astype(float)
+        box = np.round(np.asarray(box, dtype=float))
+        if (self.full or box[2] - box[0] < 1 or box[3] - box[1] < 1 or box[0] < 0 or box[1] < 0
+                or box[2] > self.width or box[3] > self.height or not self.inside(box)):
+            return False  # a place cut by the image's edge is no element
+        same, above, rej = self._against(label)
         shared = _overlap(box, same)  # over a drawn element of its class, even in part: drawn already
         if shared.sum() > OVERLAP * _area(box) or (shared / np.maximum(_area(same), 1e-9) > 0.5).any():
             return False
-        above = self.drawn[[PRIORITY[k] > PRIORITY[label] for k in self.drawn[:, 0].tolist()], 1:].astype(float)
         if _overlap(box, above).sum() > 0.6 * _area(box):  # mostly under a drawn element that paints over it
             return False
-        rej = self.rejected[self.rejected[:, 0] == label, 1:].astype(float) if len(self.rejected) else np.zeros((0, 4))
         if (_iou(box, rej) >= REJECTED_PLACE).any():
             return False
-        for i, (lab, b, s, _) in enumerate(self.items):
-            if lab == label and _iou(box, b[None])[0] >= SAME_PLACE:
-                if score > s:
-                    self.items[i] = (label, box, score, reason)
-                return False
+        n = len(self.items)
+        mine = np.flatnonzero(self.labels[:n] == label)
+        hit = mine[_iou(box, self.boxes[mine]) >= SAME_PLACE]
+        if len(hit):
+            i = int(hit[0])
+            if score > self.items[i][2]:
+                self.items[i] = (label, box, score, reason)
+                self.boxes[i] = box
+            return False
         self.items.append((label, box, score, reason))
+        self.boxes[n], self.labels[n] = box, label
         return True
 
 
@@ -199,7 +227,11 @@ def _lattice(t: _Type, props: _Proposals) -> None:
         return
     xs = _spans(b[:, 0], b[:, 2], cols, px, x_lo, x_hi, t.width)
     ys = _spans(b[:, 1], b[:, 3], rows, py, y_lo, y_hi, t.height)
+    if len(xs) * len(ys) > MAX_PROPOSALS:
+        return  # a lattice of thousands of places is no facade's
     for y0, y1, y_seen in ys:
+        if props.full:
+            return
         for x0, x1, x_seen in xs:
             reason = "grid" if x_seen and y_seen else ("row" if y_seen else "column" if x_seen else "lattice")
             props.add(t.label, np.array([x0, y0, x1, y1]), 0.5 + 0.2 * x_seen + 0.2 * y_seen, reason)
@@ -217,8 +249,10 @@ def _spans(lo: np.ndarray, hi: np.ndarray, lines: list[np.ndarray], pitch: float
 
 def _companions(types: list[_Type], props: _Proposals) -> None:
     """Elements drawn on or against another type's elements, proposed at the same offset for the rest of them."""
+    if len(types) > MAX_TYPES:
+        return
     for a in types:
-        if len(a.boxes) < COMPANION_MIN:
+        if len(a.boxes) < COMPANION_MIN or props.full:
             continue
         instances = [box for box in a.boxes] + [box for lab, box, score, _ in list(props.items) if lab == a.label
                                                  and score >= 0.9
@@ -246,17 +280,22 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
     """Proposed missing elements for a partly drawn segmentation (a `Segmentation` or its JSON object): dicts
     ``{label, x0, y0, x1, y1, score}`` in the segmentation contract, best first, none repeating a drawn element;
     ``rejected`` boxes (the same contract) are not proposed again. See the module's docstring. Raises
-    `SegmentationError` (a ValueError) naming the field for a bad segmentation or rejected box, ValueError for
-    more than `MAX_DRAWN` rectangles."""
+    `SegmentationError` (a ValueError) naming the field for a bad segmentation, `RejectedError` (a ValueError)
+    for a bad rejected box, ValueError for more than `MAX_DRAWN` rectangles or ``min_score`` outside [0, 1]."""
     del photo  # the photo check comes with the editor's completion; structure alone proposes for now
     seg = segmentation if isinstance(segmentation, Segmentation) else parse_segmentation(segmentation)
     rows = seg.to_array()
     if len(rows) > MAX_DRAWN:
         raise ValueError(f"too many rectangles for completion: {len(rows)} (at most {MAX_DRAWN})")
+    if not 0 <= min_score <= 1:  # NaN too
+        raise ValueError(f"min_score must be in [0, 1], got {min_score}")
     if rejected is not None and not isinstance(rejected, list):
         raise ValueError("rejected must be a list of rectangles")
     if rejected:  # the contract's rectangles, checked as a segmentation of the same size would be
-        parse_segmentation({"width": seg.width, "height": seg.height, "rects": rejected})
+        try:
+            parse_segmentation({"width": seg.width, "height": seg.height, "rects": rejected})
+        except ValueError as exc:
+            raise RejectedError(str(exc).replace("rects", "rejected")) from None
     rej = (np.array([[LABEL_ID[r["label"]], r["x0"], r["y0"], r["x1"], r["y1"]] for r in rejected], dtype=float)
            if rejected else np.zeros((0, 5)))
     props = _Proposals(seg, rows, rej)

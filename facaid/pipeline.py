@@ -137,7 +137,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
                         denoised = True  # the induced structure fits closer by copying the annotator's noise
                     else:
                         fitted, before, source = other, other.accuracy_before, "induced"
-        if fitted.accuracy < retry_below and retry_k and source == "model":
+        if fitted.accuracy < retry_below and retry_k and source == "model" and not denoised:
             tell(0.75, f"sampling {retry_k} more candidates")
             retried = True
             more = decode(model, tokenizer, readable, k=retry_k, sample=True, greedy=0, seed=seed + 1, prefix=prefix)

@@ -167,11 +167,11 @@ window.addEventListener("keydown", (e) => {
   if (e.target.closest("input, textarea, select")) return;
   if (e.key === " ") { ui.space = true; canvas.style.cursor = "grab"; e.preventDefault(); return; }
   const a = keyAction(e, {selected: ui.selection.size, proposals: ui.proposals.length});
-  if (!a) return;
+  if (!a || (a.action === "complete" && e.repeat)) return;
   if (!["tool", "label", "clear"].includes(a.action)) e.preventDefault();
   ({undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: removeSelected,
     selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
-    clear: () => { ui.selection.clear(); ui.proposals = []; changed(); },
+    clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
     tool: () => setTool(a.tool), label: () => pickLabel(a.label), accept: acceptProposals, complete: completeNow,
     nudge: () => run(moveRects(seg, [...ui.selection], a.dx, a.dy))})[a.action]();
 });
@@ -207,18 +207,25 @@ function similar() {
 
 // completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
 async function completeNow() {
+  if (ui.completing) return;  // one request at a time
   ui.rejected.push(...rejectedOf(ui.proposals));
+  ui.proposals = [];
+  ui.completing = true;
+  const drawn = JSON.stringify(seg.toJSON());
   try {
     const {proposals} = await api(`/api/v1/photos/${photoCode}/complete`, {method: "POST",
       body: JSON.stringify({...seg.toJSON(), rejected: ui.rejected})});
+    if (JSON.stringify(seg.toJSON()) !== drawn) return status("The drawing changed meanwhile: press C again.");
     ui.proposals = proposals;
     ui.proposalsFrom = "complete";
     status(proposals.length ? `${proposals.length} proposals: click one to reject it, Enter or "Accept" to add ` +
       "the rest." : "Nothing to propose yet: draw a few elements of a row and a column.");
   } catch (err) {
     status(`No proposals: ${err.message}`, "error");
+  } finally {
+    ui.completing = false;
+    draw();
   }
-  draw();
 }
 
 function acceptProposals() {

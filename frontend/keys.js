@@ -20,7 +20,7 @@ export function keyAction(event, state = {selected: 0, proposals: 0}) {
   if (key === "Escape") return {action: "clear"};
   if (key === "r") return {action: "tool", tool: "draw"};
   if (key === "v") return {action: "tool", tool: "select"};
-  if (key === "c") return {action: "complete"};
+  if (k === "c") return {action: "complete"};
   if (key === "Enter" && state.proposals) return {action: "accept"};
   const i = HOTKEYS.indexOf(key);
   if (i >= 0) return {action: "label", label: LABELS[i]};

@@ -5,7 +5,7 @@ right; the facade rectangles first where they start highest), and after every ``
 completion. Each proposal that matches a true element not drawn yet (same class, IoU >= ``match``) is accepted
 as proposed at no cost and that element counts as drawn; each other proposal costs one action (rejecting it)
 and is passed back as rejected, so it is not proposed again. The annotator stops once the drawing reproduces
-``stop`` of the facade's pixels (or everything is drawn). Effort = actions / true elements: 1.0 is drawing all
+``stop`` of the image's pixels (or everything is drawn). Effort = actions / true elements: 1.0 is drawing all
 of them by hand.
 """
 
@@ -47,6 +47,8 @@ def simulate(seg: Segmentation, propose: Callable[..., list[dict]] = complete, *
              match: float = 0.7, stop: float = 0.95) -> Session:
     """Annotate ``seg`` as the module's docstring says, with ``propose(segmentation, rejected=[...])`` (by
     default `facaid.completion.complete`) asked for proposals."""
+    if not (0 < match <= 1 and 0 < stop <= 1 and every >= 1):
+        raise ValueError(f"match and stop must be in (0, 1] and every >= 1, got {match}, {stop}, {every}")
     target = rasterize(seg)
     todo = sorted(seg.rects, key=lambda r: (r.y0, r.x0, r.y1, r.x1, r.label))
     drawing: list[Rect] = []

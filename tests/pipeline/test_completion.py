@@ -71,6 +71,20 @@ def test_nothing_drawn_is_repeated_a_lone_ornament_is_not_repeated_and_rejected_
 
 
 def test_bad_input_gets_a_clear_error():
+    from facaid.completion import MAX_PROPOSALS, RejectedError
+
+    seg = Segmentation(600, 500, (WALL, *_grid()[:3]))
+    with pytest.raises(ValueError, match=r"min_score must be in \[0, 1\], got nan"):
+        complete(seg, min_score=float("nan"))
+    with pytest.raises(RejectedError, match=r"rejected\[0\]"):
+        complete(seg, rejected=[{"label": "window", "x0": 5, "y0": 1, "x1": 2, "y1": 3}])
+    with pytest.raises(ValueError, match="too many rectangles for completion: 2001"):
+        complete(Segmentation(600, 500, (Rect(WINDOW, 0, 0, 1, 1),) * 2001))
+    # tiny elements far apart on a huge image: whole pitches between them are not filled by the thousand
+    tiny = [Rect(WINDOW, x, 0, x + 2, 2) for x in (0, 4, 8, 3996)]
+    tiny += [Rect(WINDOW, 0, y, 2, y + 2) for y in (4, 8, 3996)]
+    out = complete(Segmentation(4000, 4000, tuple(tiny)), min_score=0.0)
+    assert len(out) <= MAX_PROPOSALS and all(p["x1"] <= 4000 and p["y1"] <= 4000 for p in out)
     with pytest.raises(SegmentationError, match="x1"):
         complete({"width": 10, "height": 10, "rects": [{"label": "window", "x0": 5, "y0": 1, "x1": 20, "y1": 3}]})
     with pytest.raises(SegmentationError):

@@ -248,13 +248,15 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
         ({**_drawn_grid(w, h), "min_score": "high"}, "min_score", "in [0, 1]"),
         ({**_drawn_grid(w, h), "rejected": "all"}, "rejected", "list"),
         ({**_drawn_grid(w, h), "rejected": [{"label": "window", "x0": 5, "y0": 5, "x1": 2, "y1": 9}]}, "rejected",
-         "x0 < x1"),
+         "rejected[0]"),
+        ({**_drawn_grid(w, h), "rejected": [7]}, "rejected", "rejected[0]"),
         ({"width": w, "height": h, "rects": [{"label": "window", "x0": 0, "y0": 0, "x1": 1, "y1": 1}] * 2001},
          "segmentation", "too many rectangles for completion"),
     ):
         r = as_alice.post(url, bad, format="json")
         assert r.status_code == 400, (bad.keys(), r.content)
         assert field in r.json() and message in json.dumps(r.json()), r.json()
+    assert as_alice.post(url, {**_drawn_grid(w, h), "rejected": None}, format="json").status_code == 200
     r = as_alice.post(url, [1, 2], format="json")
     assert r.status_code == 400 and "JSON object" in json.dumps(r.json())
     assert as_bob.post(url, _drawn_grid(w, h), format="json").status_code == 404  # Alice's private photo

@@ -10,7 +10,7 @@ from django.db import transaction
 from django.db.models import Max
 from rest_framework.exceptions import APIException, ValidationError
 
-from facaid.completion import complete
+from facaid.completion import RejectedError, complete
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
 from webapp.facades import jobs
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
@@ -51,7 +51,7 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
     """Proposals for what is not drawn yet (`facaid.complete`) in a segmentation of the photo: the body is the
     segmentation JSON, optionally with ``rejected`` (rectangles not to propose again) and ``min_score``."""
     seg = _segmentation_of(photo, data)
-    rejected = data.get("rejected", [])
+    rejected = data.get("rejected") or []
     min_score = data.get("min_score", DEFAULT_MIN_SCORE)
     if not isinstance(rejected, list):
         raise ValidationError({"rejected": "give a list of rectangles"})
@@ -59,8 +59,10 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
         raise ValidationError({"min_score": f"give a number in [0, 1], got {min_score!r}"})
     try:
         return complete(seg, rejected=rejected, min_score=float(min_score))
-    except ValueError as exc:  # a bad rejected rectangle, or too many rectangles
-        raise ValidationError({"rejected" if "rects[" in str(exc) else "segmentation": str(exc)}) from None
+    except RejectedError as exc:
+        raise ValidationError({"rejected": str(exc)}) from None
+    except ValueError as exc:  # too many rectangles
+        raise ValidationError({"segmentation": str(exc)}) from None
 
 
 class TooManyJobs(APIException):
