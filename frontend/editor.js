@@ -44,6 +44,7 @@ function changed() {
   $("#redo").disabled = !history.canRedo;
   $("#dirty").textContent = history.dirty ? "unsaved changes" : "saved";
   $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected`;
+  readout(null, null);
   draw();
 }
 
@@ -58,7 +59,9 @@ function run(cmd) {
 // --- view ---------------------------------------------------------------------------------------------------------
 function fit() {
   const box = canvas.parentElement.getBoundingClientRect();
-  [canvas.width, canvas.height] = [box.width, Math.max(400, window.innerHeight - box.top - 24)];
+  const top = box.top + window.scrollY;  // the page's layout, whatever it is scrolled to
+  [canvas.width, canvas.height] = [box.width, Math.max(400, window.innerHeight - top - 24)];
+  $(".tools").style.maxHeight = `${canvas.height}px`;  // the side panel scrolls on its own beside the canvas
   Object.assign(view, fitView(seg.width, seg.height, canvas.width, canvas.height));
   draw();
 }
@@ -68,6 +71,14 @@ const toImage = (sx, sy) => [(sx - view.ox) / view.scale, (sy - view.oy) / view.
 function draw() {
   if (rectifying) return rectifying.draw();
   if (seg) drawScene(ctx, {canvas, photo, seg, view, ui, fill: Number($("#fill").value)});
+  $("#zoom").textContent = `zoom ${Math.round(100 * view.scale)} %`;
+}
+
+/** The cursor's image position and the size of a single selected rectangle, in image pixels. */
+function readout(x, y) {
+  const one = ui.selection.size === 1 ? seg.get([...ui.selection][0]) : null;
+  $("#cursor").textContent = (x === null ? "" : `x ${Math.round(x)}, y ${Math.round(y)}`) +
+    (one ? ` · selection ${one.x1 - one.x0} × ${one.y1 - one.y0}` : "");
 }
 
 // --- palette and tools --------------------------------------------------------------------------------------------
@@ -110,6 +121,7 @@ canvas.addEventListener("pointerdown", (e) => {
 });
 
 canvas.addEventListener("pointermove", (e) => {
+  if (seg && !rectifying) readout(...toImage(e.offsetX, e.offsetY));
   if (rectifying) return rectifying.pointermove(e);
   if (pointers.has(e.pointerId)) pointers.set(e.pointerId, [e.offsetX, e.offsetY]);
   const d = ui.drag;
@@ -171,7 +183,7 @@ window.addEventListener("keydown", (e) => {
   if (!["tool", "label", "clear"].includes(a.action)) e.preventDefault();
   ({undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: removeSelected,
     selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
-    clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
+    fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
     tool: () => setTool(a.tool), label: () => pickLabel(a.label), accept: acceptProposals, complete: completeNow,
     nudge: () => run(moveRects(seg, [...ui.selection], a.dx, a.dy))})[a.action]();
 });
@@ -257,7 +269,11 @@ async function saveNow() {
 
 async function submitNow() {
   try {
-    const job = await submit(api, photoCode, seg, history, {saved: root.dataset.segmentation,
+    const k = Number($("#k").value);
+    if (!Number.isInteger(k) || k < 1 || k > Number($("#k").max)) {
+      return status(`Not submitted: K must be a whole number from 1 to ${$("#k").max}.`, "error");
+    }
+    const job = await submit(api, photoCode, seg, history, {saved: root.dataset.segmentation, k,
       onSaved: (code) => { root.dataset.segmentation = code; },
       progress: (j) => {
         $("#job").hidden = false;
@@ -304,6 +320,7 @@ on("#repeat", "click", () => { try { repeatSelected(); } catch (err) { status(er
 on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
 on("#complete", "click", completeNow);
+on("#fit", "click", fit);
 on("#export", "click", () => download(seg.toJSON(), `segmentation-${photoCode.slice(0, 8)}.json`));
 on("#import", "change", (e) => e.target.files[0] && importJSON(e.target.files[0]));
 on("#save", "click", saveNow);

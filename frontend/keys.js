@@ -5,7 +5,7 @@ const ARROWS = {ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowD
 
 /** `event`: {key, ctrlKey, metaKey, shiftKey}. `state`: {selected: how many, proposals: how many}. Returns
  * {action, ...} with action one of undo, redo, duplicate, selectAll, delete, clear, tool (tool), accept, complete,
- * label (label), nudge (dx, dy), or null. */
+ * fit, label (label), nudge (dx, dy), or null. */
 export function keyAction(event, state = {selected: 0, proposals: 0}) {
   const {key, shiftKey} = event;
   const k = key.toLowerCase();
@@ -21,6 +21,7 @@ export function keyAction(event, state = {selected: 0, proposals: 0}) {
   if (key === "r") return {action: "tool", tool: "draw"};
   if (key === "v") return {action: "tool", tool: "select"};
   if (k === "c") return {action: "complete"};
+  if (k === "f") return {action: "fit"};
   if (key === "Enter" && state.proposals) return {action: "accept"};
   const i = HOTKEYS.indexOf(key);
   if (i >= 0) return {action: "label", label: LABELS[i]};

@@ -130,6 +130,7 @@ test("keys: shortcuts map to actions, arrows only with a selection, Enter only w
   assert.deepEqual(keyAction({key: "Z", ctrlKey: true, shiftKey: true}), {action: "redo"});
   assert.deepEqual(keyAction({key: "r"}), {action: "tool", tool: "draw"});
   assert.deepEqual(keyAction({key: "c"}), {action: "complete"});
+  assert.deepEqual(keyAction({key: "F"}), {action: "fit"});
   assert.deepEqual(keyAction({key: "3"}), {action: "label", label: "window"});
   assert.equal(keyAction({key: "ArrowLeft"}, {selected: 0, proposals: 0}), null);
   assert.deepEqual(keyAction({key: "ArrowLeft", shiftKey: true}, {selected: 2, proposals: 0}),

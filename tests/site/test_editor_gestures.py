@@ -13,6 +13,8 @@ import pytest
 from PIL import Image
 from site_helpers import login, upload
 
+from facaid.defaults import DEFAULT_K
+
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
 
@@ -202,3 +204,37 @@ def test_completion_proposes_the_missing_window_accepted_undone_and_rejected(edi
     page.wait_for_function(f"{E}.ui.proposals.length === 0 && document.querySelector('#status').textContent"
                            ".startsWith('Nothing to propose')")
     assert len([r for r in rects(page) if r["label"] == "window"]) == 5
+
+
+def test_zoom_readout_fit_cursor_and_selection_size_k_and_disabled_buttons(editor):
+    page = editor
+    v0 = view(page)
+    assert page.text_content("#zoom") == f"zoom {round(100 * v0['s'])} %"
+    x, y = screen(page, 230, 255)
+    page.mouse.move(x, y)
+    page.mouse.wheel(0, -400)
+    page.wait_for_function(f"{E}.view.scale > {v0['s']} * 1.5")
+    assert page.text_content("#zoom") == f"zoom {round(100 * view(page)['s'])} %"
+    page.mouse.move(*screen(page, 231, 256))
+    assert page.text_content("#cursor").startswith("x 231, y 256")
+    page.keyboard.press("f")  # fit to screen again
+    assert view(page) == pytest.approx(v0)
+    page.mouse.wheel(0, -400)
+    page.click("#fit")
+    assert view(page) == pytest.approx(v0)
+    # one selected rectangle: its size beside the cursor
+    page.keyboard.press("v")
+    wx, wy = WINDOWS[0]
+    page.mouse.click(*screen(page, wx + 10, wy + 10))
+    page.mouse.move(*screen(page, wx + 11, wy + 11))
+    assert page.text_content("#cursor") == f"x {wx + 11}, y {wy + 11} · selection {WIN_W} × {WIN_H}"
+    # nothing to undo: the Undo button is disabled and looks it
+    assert page.is_disabled("#undo")
+    assert page.eval_on_selector("#undo", "b => getComputedStyle(b).cursor") == "not-allowed"
+    assert page.eval_on_selector("#undo", "b => getComputedStyle(b).backgroundColor") == "rgb(201, 204, 209)"
+    # K on submit (the site's default, as the photo page offers it): refused outside 1..32 before anything is sent
+    assert page.input_value("#k") == str(DEFAULT_K) and page.get_attribute("#k", "max") == "32"
+    page.fill("#k", "0")
+    page.click("#submit")
+    assert "K must be a whole number from 1 to 32" in page.text_content("#status")
+    assert page.evaluate(f"{E}.history.canUndo") is False and page.is_hidden("#job")

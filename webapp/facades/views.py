@@ -14,6 +14,7 @@ from django.views.decorators.http import require_POST
 from rest_framework.exceptions import ValidationError
 
 from facaid.cga import MAX_SCALE
+from facaid.defaults import DEFAULT_K, MAX_K
 from webapp.facades import access, jsonbody, services, throttling
 from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
@@ -130,7 +131,8 @@ def photo_reconstruct(request, code):
 def photo_editor(request, code):
     photo = access.get_rw_photo_for_user(request.user, code)
     segmentation = photo.latest_segmentation()
-    return render(request, "facades/editor.html", {"photo": photo, "segmentation": segmentation})
+    return render(request, "facades/editor.html", {"photo": photo, "segmentation": segmentation,
+                                                   "default_k": DEFAULT_K, "max_k": MAX_K})
 
 
 def job(request, code):
