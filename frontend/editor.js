@@ -2,6 +2,7 @@
 // the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
 import {acceptCommand, rejectedOf, repeatCommand, similarProposals} from "./assist.js";
 import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
+import {identical} from "./geometry.js";
 import {keyAction} from "./keys.js";
 import {buildPalette, markActive} from "./panel.js";
 import {openRectifyMode} from "./rectify-mode.js";
@@ -43,7 +44,10 @@ function changed() {
   $("#undo").disabled = !history.canUndo;
   $("#redo").disabled = !history.canRedo;
   $("#dirty").textContent = history.dirty ? "unsaved changes" : "saved";
-  $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected`;
+  const twice = identical([...seg.rects.values()]);
+  $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected` + (twice.length ? " · " +
+    twice.map((t) => `${t.count} identical ${t.label} rectangles`).join(", ") + " (delete the copies)" : "");
+  $("#count").classList.toggle("warning", twice.length > 0);
   readout(null, null);
   draw();
 }

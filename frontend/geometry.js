@@ -22,6 +22,16 @@ export function intersects(a, b) {
   return a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1;
 }
 
+/** Rectangles drawn twice: for each box and class that more than one rectangle has, {label, count}. */
+export function identical(rects) {
+  const seen = new Map();
+  for (const r of rects) {
+    const key = `${r.label} ${r.x0} ${r.y0} ${r.x1} ${r.y1}`;
+    seen.set(key, {label: r.label, count: (seen.get(key)?.count || 0) + 1});
+  }
+  return [...seen.values()].filter((v) => v.count > 1);
+}
+
 export function translate(r, dx, dy) {
   return {x0: r.x0 + dx, y0: r.y0 + dy, x1: r.x1 + dx, y1: r.y1 + dy};
 }

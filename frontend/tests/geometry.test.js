@@ -1,7 +1,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {clampToImage, handleAt, moveWithin, normalize, repeatRect, resize, snap} from "../geometry.js";
+import {clampToImage, handleAt, identical, moveWithin, normalize, repeatRect, resize, snap} from "../geometry.js";
 
 test("normalize and clamp", () => {
   assert.deepEqual(normalize({x0: 5, y0: 9, x1: 1, y1: 2}), {x0: 1, y0: 2, x1: 5, y1: 9});
@@ -57,4 +57,11 @@ test("homography maps the four corners and is projective in between", async () =
   assert.equal(isConvexQuad(src), true);
   assert.equal(isConvexQuad([[0, 0], [10, 0], [0, 10], [10, 10]]), false);  // crossed
   assert.throws(() => homography([[0, 0], [0, 0], [0, 0], [0, 0]], dst), /homography/);
+});
+
+test("identical: rectangles drawn twice, by box and class", () => {
+  const wall = {label: "facade", x0: 0, y0: 0, x1: 10, y1: 10};
+  assert.deepEqual(identical([wall, {...wall}, {...wall, label: "window"}, {...wall, x1: 9}]),
+    [{label: "facade", count: 2}]);
+  assert.deepEqual(identical([wall]), []);
 });

@@ -238,3 +238,21 @@ def test_zoom_readout_fit_cursor_and_selection_size_k_and_disabled_buttons(edito
     page.click("#submit")
     assert "K must be a whole number from 1 to 32" in page.text_content("#status")
     assert page.evaluate(f"{E}.history.canUndo") is False and page.is_hidden("#job")
+
+
+def test_two_identical_rectangles_are_flagged_until_one_is_deleted(editor, tmp_path):
+    page = editor
+    assert "identical" not in page.text_content("#count")
+    wall = {"label": "facade", "x0": 0, "y0": 0, "x1": 480, "y1": 360}
+    path = tmp_path / "twice.json"
+    path.write_text(json.dumps({"width": 480, "height": 360, "rects": [wall, wall]}))
+    page.set_input_files("#import", str(path))
+    page.wait_for_function(f"{E}.seg.size === 2")
+    assert "2 identical facade rectangles (delete the copies)" in page.text_content("#count")
+    assert page.eval_on_selector("#count", "e => e.classList.contains('warning')")
+    page.keyboard.press("v")
+    page.mouse.click(*screen(page, 5, 5))  # the top one of the two walls
+    page.keyboard.press("Delete")
+    assert page.evaluate(f"{E}.seg.size") == 1
+    assert "identical" not in page.text_content("#count")
+    assert not page.eval_on_selector("#count", "e => e.classList.contains('warning')")
