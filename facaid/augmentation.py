@@ -110,3 +110,8 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
         if box.x0 < box.x1 and box.y0 < box.y1:
             out.append(box)
     return Segmentation(w, h, tuple(out))
+
+
+def cmp_annotation(seg: Segmentation, seed: int, *, drop: float = 0.0, spurious: int = 0) -> Segmentation:
+    """`annotator_noise` with the edge spread calibrated on CMP's annotators (`CMP_EDGE_X`, `CMP_EDGE_Y`)."""
+    return annotator_noise(seg, seed, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=drop, spurious=spurious)

@@ -71,7 +71,7 @@ def cmd_generate(args: argparse.Namespace) -> None:
 def _generate_stats(args: argparse.Namespace) -> None:
     from tqdm import tqdm
 
-    from facaid.augmentation import CMP_EDGE_X, CMP_EDGE_Y, annotator_noise
+    from facaid.augmentation import cmp_annotation
     from facaid.generator import generate
     from facaid.generator.dataset import sample_seed
     from facaid.generator.stats import class_stats, distance, format_table, irregularity, load_cmp
@@ -86,8 +86,7 @@ def _generate_stats(args: argparse.Namespace) -> None:
     real = class_stats(cmp_segs)
     print(f"{args.count} generated facades (seed {args.seed}) vs {real.facades} CMP facades")
     print(format_table(generated, real))
-    annotated = [annotator_noise(seg, i, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=0.0, spurious=0)
-                 for i, seg in enumerate(segs)]
+    annotated = [cmp_annotation(seg, i) for i, seg in enumerate(segs)]
     spread = {"generated": irregularity(segs), "generated, annotated as on CMP": irregularity(annotated),
               "CMP": irregularity(cmp_segs)}
     print("windows off the grid (median over rows and columns of >= 3 windows; spreads as a share of the side):")

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from facaid.defaults import DEFAULT_MIN_SCORE
-from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
+from facaid.labels import BACKGROUND, FACADE, LABELS, PRIORITY
 from facaid.segmentation import Segmentation, aligned_lines, parse_segmentation
 
 MAX_DRAWN = 2_000  # more drawn rectangles than this are refused (a CMP facade has at most a few hundred)
@@ -45,7 +45,6 @@ SAME_PLACE = 0.5  # IoU at which two proposals are the same element
 OVERLAP = 0.2  # a proposal whose area lies this much over drawn elements of its class is not made
 REJECTED_PLACE = 0.3  # IoU at which a proposal repeats a rejected one
 MIN_GAPS = 2  # a pitch is measured from at least this many gaps that agree
-LINE_MEMBERS = 1  # a row (column) with this many drawn elements of a type is drawn in: its crossings score high
 EXTEND = 1  # rows and columns continue by at most this many pitches beyond the drawn ones
 PITCH_TOLERANCE = 0.1  # the gaps of a row (column) agree within this share of the smallest, or it has no pitch
 COMPANION_SHARE = 1.0  # a companion is proposed when at least this share of its element's drawn copies have one
@@ -70,7 +69,7 @@ def _types(rows: np.ndarray) -> list[_Type]:
     out: list[_Type] = []
     for label in np.unique(rows[:, 0]).tolist():
         boxes = rows[rows[:, 0] == label, 1:].astype(float)
-        area = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
+        area = _area(boxes)
         groups: list[list[int]] = []
         sizes = np.zeros((0, 2))  # each group's first (largest) member's width and height
         for i in np.argsort(-area, kind="stable").tolist():
@@ -104,30 +103,30 @@ def _pitch(starts: list[float], size: float) -> float | None:
 
 
 def _positions(observed: list[float], pitch: float | None, lo: float, hi: float, size: float,
-               ) -> list[tuple[float, bool, bool]]:
-    """(start, drawn, between drawn ones) along a row (column): the drawn elements' starts, the places between two
-    of them a whole number of pitches apart (at most `MAX_FILL`), and those beyond them by the pitch while the
-    element still fits within [lo, hi]."""
+               ) -> list[tuple[float, bool]]:
+    """(start, drawn) along a row (column): the drawn elements' starts, the places between two of them a whole
+    number of pitches apart (at most `MAX_FILL`), and those beyond them by the pitch while the element still fits
+    within [lo, hi]."""
     known = sorted(observed)
-    out = [(v, True, False) for v in known]
+    out = [(v, True) for v in known]
     if pitch is None or pitch <= 0:
         return out
     slack = 0.25 * size
     for a, b in zip(known[:-1], known[1:], strict=True):
         steps = round((b - a) / pitch)
         if 2 <= steps <= MAX_FILL and abs(b - a - steps * pitch) <= 0.25 * pitch:
-            out += [(a + k * (b - a) / steps, False, True) for k in range(1, steps)]
+            out += [(a + k * (b - a) / steps, False) for k in range(1, steps)]
     v = known[0] - pitch
     for _ in range(EXTEND):
         if v < lo - slack:
             break
-        out.append((v, False, False))
+        out.append((v, False))
         v -= pitch
     v = known[-1] + pitch
     for _ in range(EXTEND):
         if v + size > hi + slack:
             break
-        out.append((v, False, False))
+        out.append((v, False))
         v += pitch
     return sorted(out)
 
@@ -239,12 +238,10 @@ def _lattice(t: _Type, props: _Proposals) -> None:
 
 def _spans(lo: np.ndarray, hi: np.ndarray, lines: list[np.ndarray], pitch: float | None, start: float, stop: float,
            size: float) -> list[tuple[float, float, bool]]:
-    """(lo, hi, drawn in) of a type's columns (rows): a drawn one spans its members' median edges (and counts as
-    drawn in with at least `LINE_MEMBERS` of them), the others the type's size from where `_positions` puts
-    them."""
-    drawn = {float(np.median(lo[m])): (float(np.median(hi[m])), len(m)) for m in lines}
-    return [(v, drawn[v][0], drawn[v][1] >= LINE_MEMBERS) if seen else (v, v + size, False)
-            for v, seen, _ in _positions(list(drawn), pitch, start, stop, size)]
+    """(lo, hi, drawn) of a type's columns (rows): a drawn one spans its members' median edges, the others the
+    type's size from where `_positions` puts them."""
+    drawn = {float(np.median(lo[m])): float(np.median(hi[m])) for m in lines}
+    return [(v, drawn[v] if seen else v + size, seen) for v, seen in _positions(list(drawn), pitch, start, stop, size)]
 
 
 def _companions(types: list[_Type], props: _Proposals) -> None:
@@ -291,13 +288,12 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
         raise ValueError(f"min_score must be in [0, 1], got {min_score}")
     if rejected is not None and not isinstance(rejected, list):
         raise ValueError("rejected must be a list of rectangles")
+    rej = np.zeros((0, 5))
     if rejected:  # the contract's rectangles, checked as a segmentation of the same size would be
         try:
-            parse_segmentation({"width": seg.width, "height": seg.height, "rects": rejected})
+            rej = parse_segmentation({"width": seg.width, "height": seg.height, "rects": rejected}).to_array()
         except ValueError as exc:
             raise RejectedError(str(exc).replace("rects", "rejected")) from None
-    rej = (np.array([[LABEL_ID[r["label"]], r["x0"], r["y0"], r["x1"], r["y1"]] for r in rejected], dtype=float)
-           if rejected else np.zeros((0, 5)))
     props = _Proposals(seg, rows, rej)
     types = _types(props.drawn)
     for t in types:

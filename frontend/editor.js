@@ -227,11 +227,13 @@ async function completeNow() {
   ui.rejected.push(...rejectedOf(ui.proposals));
   ui.proposals = [];
   ui.completing = true;
-  const drawn = JSON.stringify(seg.toJSON());
+  const drawn = seg.toJSON();
   try {
     const {proposals} = await api(`/api/v1/photos/${photoCode}/complete`, {method: "POST",
-      body: JSON.stringify({...seg.toJSON(), rejected: ui.rejected})});
-    if (JSON.stringify(seg.toJSON()) !== drawn) return status("The drawing changed meanwhile: press C again.");
+      body: JSON.stringify({...drawn, rejected: ui.rejected})});
+    if (JSON.stringify(seg.toJSON()) !== JSON.stringify(drawn)) {
+      return status("The drawing changed meanwhile: press C again.");
+    }
     ui.proposals = proposals;
     ui.proposalsFrom = "complete";
     status(proposals.length ? `${proposals.length} proposals: click one to reject it, Enter or "Accept" to add ` +

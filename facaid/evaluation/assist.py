@@ -53,30 +53,31 @@ def simulate(seg: Segmentation, propose: Callable[..., list[dict]] = complete, *
     todo = sorted(seg.rects, key=lambda r: (r.y0, r.x0, r.y1, r.x1, r.label))
     drawing: list[Rect] = []
     rejected: list[dict] = []
-    drawn = accepted = calls = 0
+    drawn = calls = 0
     accuracy = pixel_accuracy(rasterize(Segmentation(seg.width, seg.height, ())), target)
-    since = 0
     while todo and accuracy < stop:
         drawing.append(todo.pop(0))
         drawn += 1
-        since += 1
-        if since < every:
-            accuracy = pixel_accuracy(rasterize(Segmentation(seg.width, seg.height, tuple(drawing))), target)
-            continue
-        since = 0
-        calls += 1
-        for p in propose(Segmentation(seg.width, seg.height, tuple(drawing)), rejected=rejected):
-            box = Rect(LABEL_ID[p["label"]], p["x0"], p["y0"], p["x1"], p["y1"])
-            scores = [(_iou(box, r), i) for i, r in enumerate(todo) if r.label == box.label]
-            best = max(scores, default=(0.0, -1))
-            if best[0] >= match:
-                todo.pop(best[1])
-                drawing.append(box)
-                accepted += 1
-            else:
-                rejected.append({k: p[k] for k in ("label", "x0", "y0", "x1", "y1")})
+        if drawn % every == 0:
+            calls += 1
+            _review(propose(Segmentation(seg.width, seg.height, tuple(drawing)), rejected=rejected), todo, drawing,
+                    rejected, match)
         accuracy = pixel_accuracy(rasterize(Segmentation(seg.width, seg.height, tuple(drawing))), target)
+    accepted = len(drawing) - drawn
     return Session(len(seg.rects), drawn, accepted, len(rejected), calls, accuracy)
+
+
+def _review(proposals: list[dict], todo: list[Rect], drawing: list[Rect], rejected: list[dict], match: float) -> None:
+    """The annotator's look at one call's proposals: each matching a true element not drawn yet is drawn as
+    proposed (and that element is done), each other one rejected."""
+    for p in proposals:
+        box = Rect(LABEL_ID[p["label"]], p["x0"], p["y0"], p["x1"], p["y1"])
+        best = max(((_iou(box, r), i) for i, r in enumerate(todo) if r.label == box.label), default=(0.0, -1))
+        if best[0] >= match:
+            todo.pop(best[1])
+            drawing.append(box)
+        else:
+            rejected.append({k: p[k] for k in ("label", "x0", "y0", "x1", "y1")})
 
 
 def summary(sessions: list[Session]) -> dict:

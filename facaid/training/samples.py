@@ -14,7 +14,7 @@ import random
 import numpy as np
 import torch
 
-from facaid.augmentation import ANNOTATOR_DROP, ANNOTATOR_SPURIOUS, CMP_EDGE_X, CMP_EDGE_Y, annotator_noise, jitter
+from facaid.augmentation import ANNOTATOR_DROP, ANNOTATOR_SPURIOUS, cmp_annotation, jitter
 from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
 from facaid.tokenizer import Tokenizer, TokenizerConfig
@@ -41,7 +41,7 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
     """The training example of sample ``index`` of dataset ``seed``: (rows, (ids, local, boxes)), or None when
     the facade is too long for the model. ``noise`` = (share, sigma): that share of the inputs get their edges
     jittered (`facaid.augmentation.jitter`, sigma uniform in [0, sigma]), seeded by the sample. ``annotate``: that
-    share of the inputs are annotated as people annotate (`annotator_noise` with the edge spread calibrated on CMP,
+    share of the inputs are annotated as people annotate (`cmp_annotation`: the edge spread calibrated on CMP,
     up to `ANNOTATOR_DROP` of the elements left out and up to `ANNOTATOR_SPURIOUS` boxes added); the target stays
     the clean procedure either way. ``styles``: weights of the generator styles (`sample_style`)."""
     s = generate(sample_seed(seed, index), sample_style(seed, index, styles))
@@ -59,8 +59,7 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
         rng = np.random.default_rng([seed, index, 2])
         if rng.random() < annotate:
             drop, spurious = rng.uniform(0.0, ANNOTATOR_DROP), int(rng.integers(ANNOTATOR_SPURIOUS + 1))
-            seg = annotator_noise(seg, int(rng.integers(2**31)), edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=drop,
-                                  spurious=spurious)
+            seg = cmp_annotation(seg, int(rng.integers(2**31)), drop=drop, spurious=spurious)
     try:
         rows = tokenizer.encode_segmentation(seg)
     except ValueError:  # too many rectangles

@@ -155,7 +155,7 @@ def test_irregularity_measures_how_far_windows_are_from_a_grid():
     calibrated annotation noise spreads them as CMP's annotators do (to a factor of two, on 30 facades)."""
     import numpy as np
 
-    from facaid.augmentation import CMP_EDGE_X, CMP_EDGE_Y, annotator_noise
+    from facaid.augmentation import cmp_annotation
     from facaid.generator.stats import irregularity
     from facaid.segmentation import Rect
 
@@ -169,8 +169,7 @@ def test_irregularity_measures_how_far_windows_are_from_a_grid():
     clean = [generate(s).segmentation for s in range(30)]
     exact = irregularity(clean)
     assert exact["rows"] > 30 and exact["row_top"] == 0.0 and exact["column_left"] == 0.0
-    noisy = irregularity([annotator_noise(seg, i, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=0.0, spurious=0)
-                          for i, seg in enumerate(clean)])
+    noisy = irregularity([cmp_annotation(seg, i) for i, seg in enumerate(clean)])
     assert 0.0017 / 2 < noisy["row_top"] < 0.0017 * 2 and 0.0043 / 2 < noisy["column_left"] < 0.0043 * 2
 
 
