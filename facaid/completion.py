@@ -17,12 +17,12 @@ a drawn one:
    another type (a sill under each window) is proposed at the same offset for the rest of them (``with
    window``).
 
-Proposals outside every drawn facade rectangle (the image when none is drawn), cut by the image's edge, over a drawn
-element of the same class, mostly under a drawn element of a class that paints over them, or near a ``rejected`` box
-are left out; those scored below ``min_score`` (`facaid.defaults.DEFAULT_MIN_SCORE`) are not returned. On the CMP
-annotations a simulated annotator (`facaid.evaluation.assist`, `bench/bench_assist.py`) finds half the 0.9 proposals
-right and one in five or fewer of the 0.7 ones, hence the default. The photo check (appearance against the drawn
-examples) is not implemented yet: ``photo`` is accepted and ignored.
+Proposals outside the drawn facade rectangles' bounds (the image when none is drawn), cut by the image's edge, over
+a drawn element of the same class, mostly under a drawn element of a class that paints over them, or near a
+``rejected`` box are left out; those scored below ``min_score`` (`facaid.defaults.DEFAULT_MIN_SCORE`) are not
+returned. On the CMP annotations a simulated annotator (`facaid.evaluation.assist`, `bench/bench_assist.py`) finds
+half the 0.9 proposals right and one in five or fewer of the 0.7 ones, hence the default. The photo check
+(appearance against the drawn examples) is not implemented yet: ``photo`` is accepted and ignored.
 """
 
 from __future__ import annotations
@@ -166,11 +166,11 @@ class _Proposals:
         return len(self.items) >= MAX_PROPOSALS
 
     def inside(self, box: np.ndarray) -> bool:
-        """Within one of the drawn facade rectangles (2 px of slack), or the image when none is drawn."""
-        slack = 2.0
-        w = self.walls
-        return bool(((w[:, 0] - slack <= box[0]) & (w[:, 1] - slack <= box[1]) & (box[2] <= w[:, 2] + slack)
-                     & (box[3] <= w[:, 3] + slack)).any())
+        """Within the bounds of the drawn facade rectangles (2 px of slack), or the image when none is drawn: a
+        wall drawn as one rectangle or, as flattened segmentations have it, as pieces around the elements."""
+        slack, w = 2.0, self.walls
+        return bool(w[:, 0].min() - slack <= box[0] and w[:, 1].min() - slack <= box[1]
+                    and box[2] <= w[:, 2].max() + slack and box[3] <= w[:, 3].max() + slack)
 
     def _against(self, label: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(drawn boxes of the class, drawn boxes of classes painted over it, rejected boxes of the class)."""

@@ -53,6 +53,17 @@ def test_a_row_and_a_column_drawn_give_the_grid_and_a_lower_threshold_extends_be
     assert guesses[0]["reason"] == "row" and guesses[0]["score"] < 0.85
 
 
+def test_a_wall_drawn_as_pieces_around_the_windows_bounds_the_proposals_as_one_rectangle_does():
+    from facaid.segmentation import flatten
+
+    windows = _grid()
+    pieces = flatten(Segmentation(600, 500, (WALL, *windows)))  # the wall as pieces around the windows
+    walls = [r for r in pieces.rects if r.label == FACADE]
+    assert len(walls) > 1
+    drawn = Segmentation(600, 500, (*walls, *[w for i, w in enumerate(windows) if i != 8]))
+    assert _boxes(complete(drawn)) == _as_boxes([windows[8]])
+
+
 def test_nothing_drawn_is_repeated_a_lone_ornament_is_not_repeated_and_rejected_boxes_stay_rejected():
     windows = _grid()
     assert complete(Segmentation(600, 500, (WALL, *windows))) == []  # complete already
