@@ -252,6 +252,42 @@ def cmd_mesh(args: argparse.Namespace) -> None:
     print(f"wrote {out} ({obj.count(chr(10) + 'f ')} faces) and {mtl_path}")
 
 
+def cmd_convert(args: argparse.Namespace) -> None:
+    from facaid import interchange
+
+    fmt = args.to or interchange.format_for_name(args.out)
+    if fmt is None:
+        raise CliError(f"say the format of {args.out} with --to, or end its name in .coco.json, .labelme.json, "
+                       f".cvat.xml or .json")
+    try:
+        data = Path(args.input).read_bytes()
+    except OSError as exc:
+        raise CliError(f"cannot read {args.input}: {exc.strerror}") from None
+    try:
+        loaded = interchange.load(data, image=args.image)
+        seg, source, name, warnings = loaded.segmentation, loaded.format, loaded.image, loaded.warnings
+    except interchange.SeveralImages as exc:
+        raise CliError(f"{args.input}: {exc} with --image NAME") from None
+    except interchange.InterchangeError:
+        obj = _json_object(data)
+        if not (isinstance(obj, dict) and ("procedure" in obj or obj.get("format") is not None)):
+            raise
+        seg, source, name, warnings = load_segmentation_or_procedure(obj), "procedure", None, ()
+    for line in warnings:
+        print(f"warning: {line}", file=sys.stderr)
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_bytes(interchange.write(seg, fmt, image=name or args.image or "facade.png"))
+    print(f"wrote {out} ({fmt}, {seg.width}x{seg.height}, {len(seg.rects)} rectangles, read as {source})")
+
+
+def _json_object(data: bytes) -> Any:
+    try:
+        return json.loads(data)
+    except (ValueError, RecursionError):
+        return None
+
+
 def cmd_evaluate_real(args: argparse.Namespace) -> None:
     from facaid.evaluation.real import evaluate_real, format_summary
     from facaid.model import load_model
@@ -434,6 +470,22 @@ def build_parser() -> argparse.ArgumentParser:
                        help="the scale (default: a storey, from the floors or the rows of windows, is 3 m tall; "
                             "12 m for the whole facade when it has neither)")
         e.set_defaults(func=func)
+
+    cv = sub.add_parser("convert", help="convert annotations between COCO, LabelMe, CVAT and our segmentation",
+                        description="Read rectangle annotations (COCO object detection JSON, LabelMe JSON, CVAT for "
+                                    "images XML, a segmentation, or a procedure's), the format found from the "
+                                    "content, and write them in another (docs/interchange.md). Edges are rounded to "
+                                    "whole pixels and clipped to the image; polygons become their bounding boxes, "
+                                    "with a warning.")
+    cv.add_argument("input", help="annotation file")
+    cv.add_argument("--out", required=True,
+                    help="file to write; its format from --to, else from its name: .coco.json, .labelme.json, "
+                         ".cvat.xml, or .json for the segmentation contract")
+    cv.add_argument("--to", choices=("coco", "labelme", "cvat", "segmentation"), help="the format to write")
+    cv.add_argument("--image", metavar="NAME",
+                    help="the image to read from a COCO or CVAT file of several (its file name, with or without "
+                         "folders, or its id); also names the image in the output where the input does not")
+    cv.set_defaults(func=cmd_convert)
 
     r2 = sub.add_parser("evaluate-real", help="reconstruct the CMP facades and compare (evaluation only)",
                         description="Reconstruct every facade of an annotations.jsonl (CMP format) and report mean "

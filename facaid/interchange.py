@@ -65,6 +65,15 @@ class InterchangeError(SegmentationError):
     """A file that cannot be read as annotations of the 12 classes; the message names the offending field."""
 
 
+class SeveralImages(InterchangeError):
+    """A file of several images read without naming one; ``names`` are theirs."""
+
+    def __init__(self, names: list[str]):
+        listing = ", ".join(names[:20]) + (f" and {len(names) - 20} more" if len(names) > 20 else "")
+        super().__init__(f"the file holds {len(names)} images ({listing}): name the one to read")
+        self.names = names
+
+
 @dataclass(frozen=True)
 class Loaded:
     """What `load` read from a file."""
@@ -261,7 +270,7 @@ def _pick(names: list[str], ids: list[str], image: str | None, where: str) -> in
     if image is None:
         if len(names) == 1:
             return 0
-        raise InterchangeError(f"the file holds {len(names)} images ({listing}): name the one to read")
+        raise SeveralImages(names)
     for keys in (names, [PurePosixPath(n.replace("\\", "/")).name for n in names], ids):
         hits = [i for i, key in enumerate(keys) if key == image]
         if len(hits) == 1:

@@ -12,7 +12,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from facaid import interchange
+from facaid.cli import main
 from facaid.generator import generate
+from facaid.grammar import to_segmentation
 from facaid.interchange import FORMATS, InterchangeError, format_for_name, load, read, write
 from facaid.labels import LABEL_ID, LABELS
 from facaid.segmentation import Rect, Segmentation
@@ -375,3 +377,53 @@ def test_not_text_at_all():
     with pytest.raises(InterchangeError, match="give the file's bytes or text, not dict"):
         read({"width": 1})
     assert interchange.detect(write(Segmentation(3, 3, ()), "cvat")) == "cvat"
+
+
+# --- the command line ----------------------------------------------------------------------------------------------
+
+def test_cli_converts_by_the_output_name_or_to(tmp_path, capsys):
+    src = DATA / "facade.labelme.json"
+    assert main(["convert", str(src), "--out", str(tmp_path / "f.cvat.xml")]) == 0
+    out, err = capsys.readouterr()
+    assert "wrote" in out and "(cvat, 120x90, 5 rectangles, read as labelme)" in out
+    assert err == "warning: polygons read as their bounding boxes: shapes[3]\n"
+    assert load((tmp_path / "f.cvat.xml").read_bytes()).image == "../photos/facade-0001.jpg"  # the name carried
+    assert read((tmp_path / "f.cvat.xml").read_bytes()) == read(src.read_bytes())
+    assert main(["convert", str(tmp_path / "f.cvat.xml"), "--out", str(tmp_path / "f.txt"), "--to", "coco"]) == 0
+    assert interchange.detect((tmp_path / "f.txt").read_bytes()) == "coco"
+    assert main(["convert", str(tmp_path / "f.txt"), "--out", str(tmp_path / "plain" / "f.json")]) == 0
+    assert Segmentation.from_json((tmp_path / "plain" / "f.json").read_text()) == read(src.read_bytes())
+
+
+def test_cli_converts_a_procedure_and_names_the_image(tmp_path):
+    sample = generate(5)
+    (tmp_path / "p.json").write_text(sample.procedure.to_json())
+    assert main(["convert", str(tmp_path / "p.json"), "--out", str(tmp_path / "p.labelme.json"),
+                 "--image", "rue-5.jpg"]) == 0
+    loaded = load((tmp_path / "p.labelme.json").read_bytes())
+    assert (loaded.segmentation, loaded.image) == (to_segmentation(sample.procedure), "rue-5.jpg")
+
+
+@pytest.mark.parametrize("args, message", [
+    ([str(DATA / "facades.cvat.xml"), "--out", "x.coco.json"],
+     "the file holds 2 images (street/IMG_0001.jpg, street/IMG_0002.jpg): name the one to read with --image NAME"),
+    ([str(DATA / "facades.cvat.xml"), "--out", "x.coco.json", "--image", "IMG_9.jpg"], "no image named 'IMG_9.jpg'"),
+    ([str(DATA / "facade.labelme.json"), "--out", "x.yaml"], "say the format of x.yaml with --to"),
+    (["missing.json", "--out", "x.json"], "cannot read missing.json"),
+    ([str(DATA / "facades.coco.json"), "--out", "x.json", "--image", "rue-12.jpg", "--to", "cvat"], None),
+])
+def test_cli_errors_end_with_status_2(tmp_path, capsys, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)
+    if message is None:  # the good case among them: written where it was asked
+        assert main(["convert", *args]) == 0 and interchange.detect((tmp_path / "x.json").read_bytes()) == "cvat"
+        return
+    assert main(["convert", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and message in err, err
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_cli_bad_file_names_the_field(tmp_path, capsys):
+    (tmp_path / "bad.json").write_text(labelme(shape1_label="spaceship"))
+    assert main(["convert", str(tmp_path / "bad.json"), "--out", str(tmp_path / "x.coco.json")]) == 2
+    assert "error: shapes[1].label 'spaceship' is not one of the 12 labels" in capsys.readouterr().err
