@@ -34,7 +34,8 @@ How they map onto the contract (docs/interchange.md has the table):
   ``z_order`` as the class's place in the paint order, so that tools draw overlaps as flattening paints them.
 
 A COCO or CVAT file may hold many images: ``image=`` names the one to read (its file name, the file name
-without its folders, or its id); several without it is an error listing them. Bad input raises
+without its folders, or its id), or ``size=`` picks the only one of a size; several without either is an error
+listing them. Bad input raises
 `InterchangeError`, a `SegmentationError` (so a `ValueError`) whose message names the field.
 """
 
@@ -94,13 +95,17 @@ def format_for_name(name: str) -> str | None:
     return "cvat" if lower.endswith(".xml") else "segmentation" if lower.endswith(".json") else None
 
 
-def read(data: bytes | str, format: str | None = None, *, image: str | None = None) -> Segmentation:
+def read(data: bytes | str | dict, format: str | None = None, *, image: str | None = None,
+         size: tuple[int, int] | None = None) -> Segmentation:
     """The segmentation of an annotation file (`load` without its warnings)."""
-    return load(data, format, image=image).segmentation
+    return load(data, format, image=image, size=size).segmentation
 
 
-def load(data: bytes | str, format: str | None = None, *, image: str | None = None) -> Loaded:
-    """Read an annotation file of one of `FORMATS`, the format told or else found from the content."""
+def load(data: bytes | str | dict, format: str | None = None, *, image: str | None = None,
+         size: tuple[int, int] | None = None) -> Loaded:
+    """Read an annotation file of one of `FORMATS`, the format told or else found from the content. ``data`` is
+    the file's bytes or text, or its JSON already decoded. Of a file of several images, ``image`` names the one to
+    read; without it, ``size`` (width, height) picks the only one of that size, if one is."""
     if format is not None and format not in FORMATS:
         raise InterchangeError(f"format {format!r} is not one of {', '.join(FORMATS)}")
     found, doc = _parse(data)
@@ -112,11 +117,11 @@ def load(data: bytes | str, format: str | None = None, *, image: str | None = No
             return Loaded(Segmentation.from_dict(doc), found, None, ())
         except SegmentationError as exc:
             raise InterchangeError(str(exc)) from None
-    seg, name = _READERS[found](doc, image, notes)
+    seg, name = _READERS[found](doc, _Choice(image, size), notes)
     return Loaded(seg, found, name, notes.lines())
 
 
-def detect(data: bytes | str) -> str:
+def detect(data: bytes | str | dict) -> str:
     """Which of `FORMATS` the content is."""
     return _parse(data)[0]
 
@@ -132,7 +137,9 @@ def write(seg: Segmentation, format: str, *, image: str = "facade.png") -> bytes
 
 # --- reading: the document, its parts -----------------------------------------------------------------------------
 
-def _parse(data: bytes | str) -> tuple[str, Any]:
+def _parse(data: bytes | str | dict) -> tuple[str, Any]:
+    if isinstance(data, dict):
+        return _json_format(data), data
     if isinstance(data, bytes):
         try:
             text = data.decode("utf-8-sig")
@@ -141,7 +148,7 @@ def _parse(data: bytes | str) -> tuple[str, Any]:
     elif isinstance(data, str):
         text = data.removeprefix("\ufeff")
     else:
-        raise InterchangeError(f"give the file's bytes or text, not {type(data).__name__}")
+        raise InterchangeError(f"give the file's bytes, text or JSON object, not {type(data).__name__}")
     if text.lstrip().startswith("<"):
         return "cvat", _xml(text)
     try:
@@ -152,12 +159,16 @@ def _parse(data: bytes | str) -> tuple[str, Any]:
         raise InterchangeError(f"neither JSON nor XML: {exc}") from None
     if not isinstance(doc, dict):
         raise InterchangeError(f"the JSON is a {type(doc).__name__}; annotations are a JSON object")
+    return _json_format(doc), doc
+
+
+def _json_format(doc: dict) -> str:
     if "shapes" in doc:
-        return "labelme", doc
+        return "labelme"
     if {"images", "annotations"} & doc.keys():
-        return "coco", doc
+        return "coco"
     if "rects" in doc:
-        return "segmentation", doc
+        return "segmentation"
     keys = ", ".join(map(repr, list(doc)[:8])) or "none"
     raise InterchangeError(f"not a segmentation ('rects'), COCO ('images', 'annotations') or LabelMe ('shapes') "
                            f"file: its keys are {keys}")
@@ -262,14 +273,29 @@ def _count(rects: list, where: str) -> None:
         raise InterchangeError(f"too many {where}: more than {MAX_RECTS}")
 
 
-def _pick(names: list[str], ids: list[str], image: str | None, where: str) -> int:
-    """The index of the image to read: ``image`` is its name, its name without folders, or its id."""
-    listing = ", ".join(names[:20]) + (f" and {len(names) - 20} more" if len(names) > 20 else "")
+@dataclass(frozen=True)
+class _Choice:
+    image: str | None  # a name or id
+    size: tuple[int, int] | None  # else the only image of this size
+
+
+def _whole(value: Any) -> int | None:
+    try:
+        return int(float(value))
+    except (TypeError, ValueError, OverflowError):
+        return None
+
+
+def _pick(names: list[str], ids: list[str], sizes: list[tuple], choice: _Choice, where: str) -> int:
+    """The index of the image to read: named by its name, its name without folders, or its id; else the only
+    one, or the only one of the size asked for."""
     if not names:
         raise InterchangeError(f"{where}: the file holds no image")
+    image = choice.image
     if image is None:
-        if len(names) == 1:
-            return 0
+        fits = [i for i, (w, h) in enumerate(sizes) if choice.size == (_whole(w), _whole(h))]
+        if len(names) == 1 or len(fits) == 1:
+            return 0 if len(names) == 1 else fits[0]
         raise SeveralImages(names)
     for keys in (names, [PurePosixPath(n.replace("\\", "/")).name for n in names], ids):
         hits = [i for i, key in enumerate(keys) if key == image]
@@ -277,18 +303,20 @@ def _pick(names: list[str], ids: list[str], image: str | None, where: str) -> in
             return hits[0]
         if hits:
             raise InterchangeError(f"{len(hits)} images are named {image!r}: give the whole name")
+    listing = ", ".join(names[:20]) + (f" and {len(names) - 20} more" if len(names) > 20 else "")
     raise InterchangeError(f"no image named {image!r}; the file holds {listing}")
 
 
 # --- the formats -------------------------------------------------------------------------------------------------
 
-def _read_coco(doc: dict, image: str | None, notes: _Notes) -> tuple[Segmentation, str]:
+def _read_coco(doc: dict, choice: _Choice, notes: _Notes) -> tuple[Segmentation, str]:
     images = _list(doc.get("images"), "images")
     for i, entry in enumerate(images):
         _object(entry, f"images[{i}]")
     names = [e["file_name"] if isinstance(e.get("file_name"), str) and e["file_name"] else str(e.get("id"))
              for e in images]
-    k = _pick(names, [str(e.get("id")) for e in images], image, "images")
+    k = _pick(names, [str(e.get("id")) for e in images], [(e.get("width"), e.get("height")) for e in images],
+              choice, "images")
     entry = images[k]
     if "id" not in entry:
         raise InterchangeError(f"images[{k}].id is missing")
@@ -323,7 +351,7 @@ def _read_coco(doc: dict, image: str | None, notes: _Notes) -> tuple[Segmentatio
     return Segmentation(*size, tuple(rects)), names[k]
 
 
-def _read_labelme(doc: dict, image: str | None, notes: _Notes) -> tuple[Segmentation, str | None]:
+def _read_labelme(doc: dict, choice: _Choice, notes: _Notes) -> tuple[Segmentation, str | None]:
     size = _size(doc.get("imageWidth"), doc.get("imageHeight"), "", ("imageWidth", "imageHeight"))
     shapes = _list(doc.get("shapes"), "shapes")
     _count(shapes, "shapes")
@@ -356,12 +384,13 @@ def _read_labelme(doc: dict, image: str | None, notes: _Notes) -> tuple[Segmenta
 CVAT_SHAPES = ("box", "polygon", "polyline", "points", "ellipse", "cuboid", "mask", "skeleton")
 
 
-def _read_cvat(root: ET.Element, image: str | None, notes: _Notes) -> tuple[Segmentation, str]:
+def _read_cvat(root: ET.Element, choice: _Choice, notes: _Notes) -> tuple[Segmentation, str]:
     images = root.findall("image")
     if not images and root.find("track") is not None:
         raise InterchangeError("this is CVAT for video (<track>s of frames): export the task as CVAT for images")
     names = [el.get("name") or el.get("id") or f"#{i}" for i, el in enumerate(images)]
-    k = _pick(names, [str(el.get("id")) for el in images], image, "<image>")
+    k = _pick(names, [str(el.get("id")) for el in images], [(el.get("width"), el.get("height")) for el in images],
+              choice, "<image>")
     el = images[k]
     at = f"image[{k}]"
     size = _size(el.get("width"), el.get("height"), at)

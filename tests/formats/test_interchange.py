@@ -55,6 +55,19 @@ def test_cvat_file_of_two_images_needs_one_named():
         read(data, image="IMG_0003.jpg")
 
 
+def test_a_size_picks_the_only_image_of_that_size():
+    cvat, coco = (DATA / "facades.cvat.xml").read_bytes(), (DATA / "facades.coco.json").read_bytes()
+    assert load(cvat, size=(160, 120)).image == "street/IMG_0002.jpg"
+    assert load(coco, size=(100, 80)).image == "facades/rue-12.jpg"
+    with pytest.raises(InterchangeError, match="holds 2 images"):
+        read(coco, size=(10, 10))
+    doubled = json.loads(coco)
+    doubled["images"][1].update(width=100, height=80)
+    with pytest.raises(InterchangeError, match="holds 2 images"):
+        read(json.dumps(doubled), size=(100, 80))
+    assert load(doubled, size=(100, 80), image="rue-14.jpg").image == "facades/rue-14.jpg"  # a name comes first
+
+
 def test_coco_file_reads_the_named_image_with_its_categories():
     data = (DATA / "facades.coco.json").read_text()
     with pytest.raises(InterchangeError, match="facades/rue-12.jpg, facades/rue-14.jpg"):
@@ -373,9 +386,11 @@ def test_fuzzed_bytes(data, fmt):
     _accepts_or_names_the_problem(data, fmt)
 
 
-def test_not_text_at_all():
-    with pytest.raises(InterchangeError, match="give the file's bytes or text, not dict"):
-        read({"width": 1})
+def test_decoded_json_and_other_values():
+    doc = json.loads((DATA / "facade.labelme.json").read_text())
+    assert read(doc) == read(json.dumps(doc)) and interchange.detect(doc) == "labelme"
+    with pytest.raises(InterchangeError, match="give the file's bytes, text or JSON object, not list"):
+        read([{"width": 1}])
     assert interchange.detect(write(Segmentation(3, 3, ()), "cvat")) == "cvat"
 
 
