@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+from types import SimpleNamespace
 
 from django.conf import settings
 from django.core.cache import caches
@@ -22,10 +23,12 @@ from rest_framework.decorators import (
     throttle_classes,
 )
 from rest_framework.exceptions import NotAuthenticated, ValidationError
-from rest_framework.parsers import FormParser, MultiPartParser
+from rest_framework.negotiation import DefaultContentNegotiation
+from rest_framework.parsers import BaseParser, FormParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
+from facaid import interchange
 from facaid.grammar import to_segmentation
 from facaid.grammar.procedure import ProcedureError
 from facaid.rectify import rectify_file
@@ -36,6 +39,7 @@ from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.paging import Pagination
 from webapp.facades.serializers import (
+    ConvertSerializer,
     JobCreateSerializer,
     JobSerializer,
     PhotoSerializer,
@@ -54,6 +58,39 @@ from webapp.facades.throttling import HEAVY
 
 GALLERY_CACHE_SECONDS = 60  # how long an unchanged gallery page stays in a process's memory (the most a title edit
 # committed out of order with another change could show late)
+
+
+class XMLParser(BaseParser):
+    """An XML body (a CVAT file) as its bytes, for `facaid.interchange` to read without DTDs."""
+
+    media_type = "application/xml"
+
+    def parse(self, stream, media_type=None, parser_context=None):
+        return stream.read() if stream is not None else b""
+
+
+class TextXMLParser(XMLParser):
+    media_type = "text/xml"
+
+
+class FileFormatNegotiation(DefaultContentNegotiation):
+    """Where ``?format=`` names an annotation file's format (coco, labelme, cvat), it is not DRF's choice of a
+    renderer (which would answer 404 to ``?format=coco``): the answer's is chosen by the Accept header alone."""
+
+    settings = SimpleNamespace(URL_FORMAT_OVERRIDE=None)
+
+
+def file_format_param(view):
+    view.content_negotiation_class = FileFormatNegotiation
+    return view
+
+
+ANNOTATIONS = {"application/json": dict, "application/xml": str}
+IMPORT_PARAMETERS = [
+    OpenApiParameter("format", str, enum=interchange.FORMATS,
+                     description="the body's format (default: found from the content)"),
+    OpenApiParameter("image", str, description="of a COCO or CVAT file of several images, the one to read: its "
+                                               "file name or id (default: the only one of the photo's size)")]
 
 
 def _page(request, queryset, serializer):
@@ -149,11 +186,15 @@ def photo_rectify(request, code):
 
 @extend_schema(methods=["GET"], responses=SegmentationSummarySerializer(many=True),
                summary="Versions, newest first (without their rectangles: GET segmentations/<code>/ for those)")
-@extend_schema(methods=["POST"], request={"application/json": dict}, responses={201: SegmentationSerializer},
-               summary="Save a new version (the segmentation JSON contract; sizes must match the photo)")
+@extend_schema(methods=["POST"], request=ANNOTATIONS, parameters=IMPORT_PARAMETERS,
+               responses={201: SegmentationSerializer},
+               summary="Save a new version: the segmentation JSON contract, or a COCO or LabelMe JSON or CVAT XML "
+                       "file (docs/interchange.md); its size must match the photo's; the answer lists 'warnings' "
+                       "(polygons read as boxes)")
 @api_view(["GET", "POST"])
 @permission_classes([AllowAny])
-@parser_classes([JSONParser])
+@parser_classes([JSONParser, XMLParser, TextXMLParser])
+@file_format_param
 def photo_segmentations(request, code):
     if request.method == "GET":
         photo = access.get_photo_for_user(request.user, code)
@@ -162,8 +203,28 @@ def photo_segmentations(request, code):
     if not request.user.is_authenticated:
         raise NotAuthenticated()
     photo = access.get_rw_photo_for_user(request.user, code)
-    seg = services.add_segmentation(photo, request.data)
-    return Response(SegmentationSerializer(seg).data, status=status.HTTP_201_CREATED)
+    seg, warnings = services.add_segmentation(photo, request.data, request.query_params.get("format"),
+                                              request.query_params.get("image"))
+    return Response({**SegmentationSerializer(seg).data, "warnings": list(warnings)}, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(parameters=[OpenApiParameter("format", str, enum=interchange.FORMATS,
+                                            description="segmentation (our JSON, the default), coco, labelme or "
+                                                        "cvat"),
+                           OpenApiParameter("version", int, description="the version (default: the latest)")],
+               responses={(200, "application/octet-stream"): bytes},
+               summary="The photo's segmentation as a file: our JSON, COCO, LabelMe or CVAT for images XML")
+@api_view(["GET"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@file_format_param
+def photo_segmentation_file(request, code):
+    photo = access.get_photo_for_user(request.user, code)
+    name, content_type, body = services.segmentation_file(photo, request.query_params.get("format", "segmentation"),
+                                                          request.query_params.get("version"))
+    resp = HttpResponse(body, content_type=content_type)
+    resp["Content-Disposition"] = f'attachment; filename="{name}"'
+    return resp
 
 
 @extend_schema(request={"application/json": dict}, responses={200: dict},
@@ -315,6 +376,27 @@ def procedure_variations(request, code):
     return Response({"variants": [v.to_dict() for v in variants]})
 
 
+@extend_schema(request=ConvertSerializer, responses={200: dict},
+               summary="Read a COCO, LabelMe or CVAT file (or our segmentation JSON) into the segmentation JSON "
+                       "contract: {'segmentation', 'format', 'image', 'warnings'}; nothing is stored")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def convert(request):
+    form = ConvertSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    v = form.validated_data
+    size = (v["width"], v["height"]) if "width" in v and "height" in v else None
+    try:
+        loaded = services.read_annotations(v["text"], v.get("format"), v.get("image"), size)
+    except ValidationError as exc:  # the file is the request's 'text'
+        detail = exc.detail
+        raise ValidationError({"text" if k == "segmentation" else k: m for k, m in detail.items()}) from None
+    return Response({"segmentation": loaded.segmentation.to_dict(), "format": loaded.format, "image": loaded.image,
+                     "warnings": list(loaded.warnings)})
+
+
 @extend_schema(request={"application/json": dict}, responses={(200, "image/png"): bytes},
                summary="Render a procedure JSON (the live preview of edited parameters)")
 @api_view(["POST"])
@@ -331,7 +413,9 @@ def render_preview(request):
                                             description="procedure.cga's and mesh.zip's scale (default: a storey "
                                                         "is 3 m)")],
                responses={(200, "application/octet-stream"): bytes},
-               summary="Downloads: procedure.json, segmentation.json (executed), labels.png, labels.svg (one group "
+               summary="Downloads: procedure.json, segmentation.json (executed; segmentation.coco.json, "
+                       "segmentation.labelme.json and segmentation.cvat.xml the same as another tool's annotations of "
+                       "labels.png), labels.png, labels.svg (one group "
                        "of rectangles per class), procedure.cga (CityEngine CGA rules), mesh.zip (a relief mesh: "
                        "facade.obj and facade.mtl), overlay.png")
 @api_view(["GET"])

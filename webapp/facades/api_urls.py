@@ -8,6 +8,7 @@ urlpatterns = [
     path("photos/<str:code>/image", api.photo_image, name="api-photo-image"),
     path("photos/<str:code>/rectify", api.photo_rectify, name="api-photo-rectify"),
     path("photos/<str:code>/segmentations/", api.photo_segmentations, name="api-photo-segmentations"),
+    path("photos/<str:code>/segmentation", api.photo_segmentation_file, name="api-photo-segmentation-file"),
     path("photos/<str:code>/complete", api.photo_complete, name="api-photo-complete"),
     path("segmentations/<str:code>/", api.segmentation_detail, name="api-segmentation"),
     path("jobs/", api.job_list, name="api-jobs"),
@@ -21,4 +22,5 @@ urlpatterns = [
     path("procedures/<str:code>/thumbnail.png", api.procedure_thumbnail, name="api-procedure-thumbnail"),
     path("gallery/", api.gallery, name="api-gallery"),
     path("render", api.render_preview, name="api-render"),
+    path("convert", api.convert, name="api-convert"),
 ]

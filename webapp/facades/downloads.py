@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from PIL import Image
 from rest_framework.exceptions import ValidationError
 
+from facaid import interchange
 from facaid.cga import MAX_SCALE, checked_scale, procedure_cga
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
@@ -72,11 +73,22 @@ def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
         return rendering.overlay_png(to_segmentation(tree), Image.open(f), alpha)
 
 
+def _annotations(fmt: str) -> Callable[[Procedure, Tree, Params], bytes]:
+    """The rectangles it draws as another tool's annotations, of the label map downloaded beside them."""
+    return lambda proc, tree, params: interchange.write(to_segmentation(tree), fmt, image=f"{stem(proc)}-labels.png")
+
+
 DOWNLOADS: dict[str, Download] = {
     "procedure.json": Download("the procedure: the tree with its sizes, to edit or reconstruct from",
                                "application/json", lambda proc, tree, params: tree.to_json(indent=2)),
     "segmentation.json": Download("the labelled rectangles it draws", "application/json",
                                   lambda proc, tree, params: to_segmentation(tree).to_json()),
+    "segmentation.coco.json": Download("those rectangles as COCO object detection annotations", "application/json",
+                                       _annotations("coco")),
+    "segmentation.labelme.json": Download("those rectangles as a LabelMe file", "application/json",
+                                          _annotations("labelme")),
+    "segmentation.cvat.xml": Download("those rectangles as CVAT for images XML", "application/xml",
+                                      _annotations("cvat")),
     "labels.png": Download("the label map as a picture", "image/png", None),
     "labels.svg": Download("the label map as vector rectangles, one group per class", "image/svg+xml",
                            lambda proc, tree, params: segmentation_svg(to_segmentation(tree))),

@@ -16,9 +16,10 @@ class VisibilityForm(forms.Form):
 
 
 class SegmentationForm(forms.Form):
-    file = forms.FileField(required=False, help_text="a segmentation JSON file")
+    file = forms.FileField(required=False, help_text="a segmentation JSON file, or COCO, LabelMe or CVAT XML "
+                                                     "annotations (the image of the photo's size)")
     text = forms.CharField(widget=forms.Textarea(attrs={"rows": 4}), required=False,
-                           help_text="or paste the JSON here")
+                           help_text="or paste the JSON (or XML) here")
 
 
 class ReconstructForm(forms.Form):

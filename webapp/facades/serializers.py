@@ -6,10 +6,12 @@ from __future__ import annotations
 from django.contrib.auth.models import AnonymousUser
 from rest_framework import serializers
 
+from facaid import interchange
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import Procedure as ProcedureTree
 from facaid.grammar.procedure import MAX_NODES, ProcedureError
 from facaid.numbers import finite
+from facaid.segmentation import MAX_SIDE
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
@@ -201,3 +203,14 @@ class RerunSerializer(serializers.Serializer):
 class VariationsSerializer(serializers.Serializer):
     n = serializers.IntegerField(min_value=1, max_value=32, default=8)
     seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
+
+
+class ConvertSerializer(serializers.Serializer):
+    text = TextField(trim_whitespace=False, help_text="the annotation file's content")
+    format = serializers.ChoiceField(interchange.FORMATS, required=False,
+                                     help_text="its format (default: found from the content)")
+    image = TextField(max_length=1000, required=False,
+                      help_text="of a COCO or CVAT file of several images, the one to read: its file name or id")
+    width = serializers.IntegerField(min_value=1, max_value=MAX_SIDE, required=False,
+                                     help_text="with height: of several images, read the only one of this size")
+    height = serializers.IntegerField(min_value=1, max_value=MAX_SIDE, required=False)

@@ -8,10 +8,13 @@ from django.conf import settings
 from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.db.models import Max
+from django.http import Http404
 from rest_framework.exceptions import APIException, ValidationError
 
+from facaid import interchange
 from facaid.completion import RejectedError, complete
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
+from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import jobs
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.serializers import parse_procedure, parse_segmentation
@@ -29,28 +32,88 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
     return photo
 
 
-def _segmentation_of(photo: Photo, data):
-    """The segmentation JSON, validated, of the photo's size (the rectified image's once there is one)."""
-    seg = parse_segmentation(data)
-    w, h = (photo.rectified.width, photo.rectified.height) if photo.rectified else (photo.width, photo.height)
+def _working_size(photo: Photo) -> tuple[int, int]:
+    return (photo.rectified.width, photo.rectified.height) if photo.rectified else (photo.width, photo.height)
+
+
+def _foreign(data) -> bool:
+    """Is ``data`` another tool's file (COCO, LabelMe, CVAT) rather than the segmentation contract's JSON?"""
+    if isinstance(data, bytes | str):  # a file's content: facaid.interchange reads it, or says why not
+        return True
+    try:
+        return interchange.detect(data) != "segmentation"
+    except interchange.InterchangeError:  # neither: the contract's parser says what is wrong, as it always has
+        return False
+
+
+def read_annotations(data, format: str | None = None, image: str | None = None,
+                     size: tuple[int, int] | None = None) -> interchange.Loaded:
+    """A segmentation from the contract's JSON or from a COCO, LabelMe or CVAT file (its text or bytes, or its
+    JSON decoded), found from the content or named by ``format``; of a file of several images, the one named
+    ``image``, else the only one of ``size``. A `ValidationError` names the field."""
+    if format not in (None, *interchange.FORMATS):
+        raise ValidationError({"format": f"give one of {', '.join(interchange.FORMATS)}, got {format!r}"})
+    if format in (None, "segmentation") and not _foreign(data):
+        return interchange.Loaded(parse_segmentation(data), "segmentation", None, ())
+    try:
+        return interchange.load(data, format, image=image, size=size)
+    except interchange.SeveralImages as exc:
+        raise ValidationError({"image": f"{exc} by its name or id"}) from None
+    except interchange.InterchangeError as exc:
+        raise ValidationError({"segmentation": str(exc)}) from None
+
+
+def _segmentation_of(photo: Photo, data, format: str | None = None, image: str | None = None) -> interchange.Loaded:
+    """The segmentation, validated, of the photo's size (the rectified image's once there is one): the contract's
+    JSON, or another tool's file read by `read_annotations`."""
+    w, h = _working_size(photo)
+    loaded = read_annotations(data, format, image, size=(w, h))
+    seg = loaded.segmentation
     if (seg.width, seg.height) != (w, h):
         raise ValidationError({"segmentation": f"the segmentation is {seg.width}x{seg.height} but the "
                                                f"{'rectified ' if photo.rectified else ''}photo is {w}x{h}"})
-    return seg
+    return loaded
 
 
-def add_segmentation(photo: Photo, data) -> Segmentation:
-    seg = _segmentation_of(photo, data)
+def add_segmentation(photo: Photo, data, format: str | None = None,
+                     image: str | None = None) -> tuple[Segmentation, tuple[str, ...]]:
+    """A new version from the body of an upload (see `_segmentation_of`), and the warnings of reading it."""
+    loaded = _segmentation_of(photo, data, format, image)
+    seg = loaded.segmentation
     with transaction.atomic():
         last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
-        return Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
-                                           rect_count=len(seg.rects))
+        version = Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
+                                              rect_count=len(seg.rects))
+    return version, loaded.warnings
+
+
+def segmentation_file(photo: Photo, format: str, version: str | None = None) -> tuple[str, str, bytes]:
+    """A version of the photo's segmentation (the latest by default) as a file of ``format``: its name, content
+    type and bytes; `Http404` when there is none."""
+    if format not in interchange.FORMATS:
+        raise ValidationError({"format": f"give one of {', '.join(interchange.FORMATS)}, got {format!r}"})
+    versions = photo.segmentations.order_by("-version")
+    if version is not None:
+        if not (version.isascii() and version.isdigit()) or len(version) > 9:
+            raise ValidationError({"version": f"give a version number, got {version[:20]!r}"})
+        versions = versions.filter(version=int(version))
+    row = versions.first()
+    if row is None:
+        raise Http404("no such segmentation version" if version else "this photo has no segmentation yet")
+    seg = SegmentationData.from_dict(row.data)
+    # the picture it was drawn on: one drawn before rectification has the original's size
+    rectified = bool(photo.rectified) and (seg.width, seg.height) != (photo.width, photo.height)
+    field = photo.rectified if rectified else photo.image
+    stem = f"facaid-photo-{str(photo.code)[:8]}"
+    picture = f"{stem}{'-rectified' if rectified else ''}.{field.name.rsplit('.', 1)[-1]}"
+    name = f"{stem}-v{row.version}{interchange.SUFFIXES[format]}"
+    return name, interchange.CONTENT_TYPES[format], interchange.write(seg, format, image=picture)
 
 
 def complete_segmentation(photo: Photo, data) -> list[dict]:
     """Proposals for what is not drawn yet (`facaid.complete`) in a segmentation of the photo: the body is the
     segmentation JSON, optionally with ``rejected`` (rectangles not to propose again) and ``min_score``."""
-    seg = _segmentation_of(photo, data)
+    seg = _segmentation_of(photo, data, "segmentation").segmentation
     rejected = data.get("rejected") or []
     min_score = data.get("min_score", DEFAULT_MIN_SCORE)
     if not isinstance(rejected, list):

@@ -20,6 +20,8 @@ from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
 from webapp.facades.models import Job, Photo, Procedure
 
+INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
+
 
 def _error_text(exc: ValidationError) -> str:
     detail = exc.detail
@@ -74,6 +76,7 @@ def photo(request, code):
                    *access.JOB_WITHOUT)[:10] if owner
                else Job.objects.none(),
                "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
+               "interchange_formats": INTERCHANGE_FORMATS,
                "visibility_form": VisibilityForm(initial={"visibility": photo.visibility})}
     return render(request, "facades/photo.html", context)
 
@@ -97,13 +100,17 @@ def photo_segmentation(request, code):
             return redirect(photo)
         raw = upload.read() if upload else form.cleaned_data["text"]
         try:
-            seg = services.add_segmentation(photo, jsonbody.loads(raw))
+            # XML is a CVAT file, read as it is; JSON is ours, COCO's or LabelMe's, read with bounded nesting
+            data = raw if raw.lstrip()[:1] in ("<", b"<") else jsonbody.loads(raw)
+            seg, warnings = services.add_segmentation(photo, data)
         except jsonbody.JSONError as exc:
             messages.error(request, f"The segmentation could not be read: {exc}")
         except ValidationError as exc:
             messages.error(request, _error_text(exc))
         else:
             messages.success(request, f"Segmentation version {seg.version} saved ({seg.rect_count} rectangles).")
+            for line in warnings:
+                messages.warning(request, f"Read with a change: {line}.")
     return redirect(photo)
 
 
