@@ -257,9 +257,9 @@ function acceptProposals() {
 // --- files, saving, submitting, rectifying (frontend/session.js) ------------------------------------------------
 async function importJSON(file) {
   try {
-    const rects = await readSegmentationFile(file, seg.width, seg.height);
+    const {rects, warnings} = await readSegmentationFile(file, seg.width, seg.height, api);
     run(new ReplaceAll(rects));
-    status(`Imported ${rects.length} rectangles.`, "success");
+    status(`Imported ${rects.length} rectangles.${warnings.map((w) => ` Note: ${w}.`).join("")}`, "success");
   } catch (err) {
     status(`Not imported: ${err.message}`, "error");
   }

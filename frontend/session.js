@@ -62,13 +62,26 @@ export async function submit(api, photoCode, seg, history, {saved, k = 4, onSave
   return followJob(api, job.code, progress);
 }
 
-/** The rectangles of a segmentation JSON file for an image of the given size; throws a message otherwise. */
-export async function readSegmentationFile(file, width, height) {
-  const parsed = Segmentation.fromJSON(JSON.parse(await file.text()));
+/** {rects, warnings}: the rectangles of a segmentation file for an image of the given size, and what was read other
+ * than as it stands. Our JSON is read here; COCO, LabelMe and CVAT files by the site (`POST /api/v1/convert`: of a
+ * file of several images, the only one of the photo's size); throws a message otherwise. */
+export async function readSegmentationFile(file, width, height, api) {
+  const text = await file.text();
+  let data = null, warnings = [];
+  try {
+    data = JSON.parse(text);
+  } catch {
+    // not JSON (CVAT's XML, or not a file we read): the site reads it or says why not
+  }
+  if (!data || typeof data !== "object" || !("rects" in data)) {
+    ({segmentation: data, warnings} = await api("/api/v1/convert", {method: "POST",
+      body: JSON.stringify({text, width, height})}));
+  }
+  const parsed = Segmentation.fromJSON(data);
   if (parsed.width !== width || parsed.height !== height) {
     throw new Error(`the file is ${parsed.width}x${parsed.height}; the photo is ${width}x${height}`);
   }
-  return parsed.toJSON().rects;
+  return {rects: parsed.toJSON().rects, warnings};
 }
 
 export async function rectify(api, photoCode, corners) {

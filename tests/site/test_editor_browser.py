@@ -88,3 +88,34 @@ def test_editor_draw_undo_repeat_save_export(live_server, facade_photo, browser,
     page.wait_for_timeout(300)
     assert "beforeunload" in dialogs
     assert errors == []
+
+
+def test_editor_imports_a_coco_file_of_several_images(live_server, facade_photo, browser, tmp_path):
+    from facaid import interchange
+    from facaid.segmentation import Segmentation as SegmentationData
+
+    photo, _ = facade_photo
+    w, h = photo["width"], photo["height"]
+    drawn = SegmentationData.from_dict({"width": w, "height": h, "rects": [
+        {"label": "facade", "x0": 0, "y0": 0, "x1": w, "y1": h},
+        {"label": "window", "x0": 10, "y0": 12, "x1": 30, "y1": 40}]})
+    doc = json.loads(interchange.write(drawn, "coco", image="rue-12.jpg"))
+    doc["images"].append({"id": 2, "width": w + 5, "height": h, "file_name": "rue-14.jpg"})  # the photo's is picked
+    doc["annotations"].append({"id": 9, "image_id": 2, "category_id": 4, "bbox": [1, 1, 5, 5], "area": 25})
+    path = tmp_path / "facades.coco.json"
+    path.write_text(json.dumps(doc))
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
+    page.wait_for_function(f"{E}?.seg?.size > 0")
+    n0 = page.evaluate(f"{E}.seg.size")
+    page.set_input_files("#import", str(path))
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Imported')")
+    assert page.text_content("#status") == "Imported 2 rectangles."
+    assert page.evaluate(f"{E}.seg.toJSON()") == drawn.to_dict()
+    page.keyboard.press("Control+z")  # one step in the history
+    assert page.evaluate(f"{E}.seg.size") == n0
+    assert page.get_attribute("a[href$='segmentation?format=coco']", "download") is not None
+    assert errors == []
