@@ -52,6 +52,12 @@ COMPANION_MIN = 4  # ... and at least this many have one
 COMPANION_TOUCH = 3  # pixels: a companion overlaps its element or lies at most this far from it
 
 
+GRID_FILL = 0.8  # a crossing of drawn lines scores high only where the type's lattice is this full
+FLOOR_MIN_ROW = 2  # a row is continued from a neighbouring one of at least this many elements
+FLOOR_STRAYS = 0.5  # ... when at most this many of the begun row's elements per aligned one stray off its columns
+COLUMN_TOLERANCE = 0.3  # elements whose left edges agree within this share of the width stand in one column
+
+
 class RejectedError(ValueError):
     """A rejected rectangle that breaks the segmentation contract; the message names it (``rejected[i]``)."""
 
@@ -228,20 +234,43 @@ def _lattice(t: _Type, props: _Proposals) -> None:
     ys = _spans(b[:, 1], b[:, 3], rows, py, y_lo, y_hi, t.height)
     if len(xs) * len(ys) > MAX_PROPOSALS:
         return  # a lattice of thousands of places is no facade's
-    for y0, y1, y_seen in ys:
+    regular = len(b) >= GRID_FILL * len(rows) * len(cols)
+    for y0, y1, row in ys:
         if props.full:
             return
-        for x0, x1, x_seen in xs:
+        for x0, x1, col in xs:
+            x_seen, y_seen = col is not None, row is not None
+            score = 0.5 + 0.2 * x_seen + 0.2 * y_seen
+            if x_seen and y_seen and not regular:  # on CMP such crossings are right one time in ten
+                score = 0.75
             reason = "grid" if x_seen and y_seen else ("row" if y_seen else "column" if x_seen else "lattice")
-            props.add(t.label, np.array([x0, y0, x1, y1]), 0.5 + 0.2 * x_seen + 0.2 * y_seen, reason)
+            props.add(t.label, np.array([x0, y0, x1, y1]), score, reason)
+
+
+def _floors(t: _Type, props: _Proposals) -> None:
+    """Two neighbouring rows of the type, one begun in the other's columns: the fuller one's other columns are
+    proposed in the row begun, at its height."""
+    b = t.boxes
+    rows = sorted(aligned_lines(b[:, 1], b[:, 3]), key=lambda r: float(np.median(b[r, 1])))
+    for a, c in zip(rows[:-1], rows[1:], strict=False):
+        full, begun = (a, c) if len(a) >= len(c) else (c, a)
+        if len(full) < FLOOR_MIN_ROW:
+            continue
+        aligned = sum(bool((np.abs(b[full, 0] - b[i, 0]) <= COLUMN_TOLERANCE * t.width).any()) for i in begun)
+        if aligned == 0 or len(begun) - aligned > FLOOR_STRAYS * aligned:
+            continue  # the row begun is laid out otherwise: another floor
+        y0, y1 = float(np.median(b[begun, 1])), float(np.median(b[begun, 3]))
+        for j in full.tolist():
+            props.add(t.label, np.array([b[j, 0], y0, b[j, 2], y1]), 0.9, "floor")
 
 
 def _spans(lo: np.ndarray, hi: np.ndarray, lines: list[np.ndarray], pitch: float | None, start: float, stop: float,
-           size: float) -> list[tuple[float, float, bool]]:
-    """(lo, hi, drawn) of a type's columns (rows): a drawn one spans its members' median edges, the others the
-    type's size from where `_positions` puts them."""
-    drawn = {float(np.median(lo[m])): float(np.median(hi[m])) for m in lines}
-    return [(v, drawn[v] if seen else v + size, seen) for v, seen in _positions(list(drawn), pitch, start, stop, size)]
+           size: float) -> list[tuple[float, float, np.ndarray | None]]:
+    """(lo, hi, members) of a type's columns (rows): a drawn one spans its members' median edges, the others
+    (members None) the type's size from where `_positions` puts them."""
+    drawn = {float(np.median(lo[m])): (float(np.median(hi[m])), m) for m in lines}
+    return [(v, drawn[v][0], drawn[v][1]) if seen else (v, v + size, None)
+            for v, seen in _positions(list(drawn), pitch, start, stop, size)]
 
 
 def _companions(types: list[_Type], props: _Proposals) -> None:
@@ -269,7 +298,7 @@ def _companions(types: list[_Type], props: _Proposals) -> None:
             offset = np.median(s.boxes[first] - a.boxes[has], axis=0)
             share = float(has.mean())
             for anchor in instances:
-                props.add(s.label, anchor + offset, round(0.4 + 0.5 * share, 3), f"with {LABELS[a.label]}")
+                props.add(s.label, anchor + offset, round(0.3 + 0.5 * share, 3), f"with {LABELS[a.label]}")
 
 
 def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: list[dict] | None = None,
@@ -296,6 +325,8 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
             raise RejectedError(str(exc).replace("rects", "rejected")) from None
     props = _Proposals(seg, rows, rej)
     types = _types(props.drawn)
+    for t in types:
+        _floors(t, props)
     for t in types:
         _lattice(t, props)
     _companions(types, props)
