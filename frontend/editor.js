@@ -61,12 +61,20 @@ function run(cmd) {
 }
 
 // --- view ---------------------------------------------------------------------------------------------------------
-function fit() {
+/** The canvas fills the window below the rows above it (saving and the job stay in view there); the side panel
+ * scrolls on its own beside it. Run again whenever those rows change height (a long message, the job showing). */
+function layout() {
   const box = canvas.parentElement.getBoundingClientRect();
   const top = box.top + window.scrollY;  // the page's layout, whatever it is scrolled to
-  [canvas.width, canvas.height] = [box.width, Math.max(400, window.innerHeight - top - 24)];
-  $(".tools").style.maxHeight = `${canvas.height}px`;  // the side panel scrolls on its own beside the canvas
-  Object.assign(view, fitView(seg.width, seg.height, canvas.width, canvas.height));
+  const [w, h] = [Math.round(box.width), Math.max(400, Math.floor(window.innerHeight - top - 24))];
+  if (canvas.width !== w || canvas.height !== h) [canvas.width, canvas.height] = [w, h];  // a resize clears it
+  $(".tools").style.maxHeight = `${h}px`;
+  draw();
+}
+
+function fit() {
+  layout();
+  if (seg) Object.assign(view, fitView(seg.width, seg.height, canvas.width, canvas.height));
   draw();
 }
 
@@ -337,6 +345,8 @@ on("#rectify", "click", openRectify);
 on("#rectify-apply", "click", applyRectify);
 on("#rectify-cancel", "click", () => { rectifying = null; $("#rectify-panel").hidden = true; draw(); });
 window.addEventListener("resize", fit);
+const rows = new ResizeObserver(layout);
+for (const bar of document.querySelectorAll(".editor-bar")) rows.observe(bar);
 window.addEventListener("beforeunload", (e) => { if (history?.dirty) { e.preventDefault(); e.returnValue = ""; } });
 setTool("draw");
 load().catch((err) => status(`Could not load the photo: ${err.message}`, "error"));
