@@ -1,6 +1,6 @@
 // The editor page: the glue between the DOM and the editor's DOM-free parts. All changes go through commands and
 // the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
-import {acceptCommand, rejectedOf, repeatCommand, similarProposals} from "./assist.js";
+import {acceptCommand, proposalAt, rejectedOf, repeatSelection, similarProposals} from "./assist.js";
 import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
 import {identical} from "./geometry.js";
 import {keyAction} from "./keys.js";
@@ -126,7 +126,10 @@ canvas.addEventListener("pointerdown", (e) => {
     ui.guides = [];
     return draw();
   }
-  const {gesture, selection} = press(ui.tool, pointerOf(e), toolContext(), view, {pan: ui.space || e.button === 1});
+  const pan = ui.space || e.button === 1;
+  // a press on a proposal is the start of a click that rejects it (below): it selects and moves nothing under it
+  if (!pan && proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY))) return;
+  const {gesture, selection} = press(ui.tool, pointerOf(e), toolContext(), view, {pan});
   ui.drag = gesture;
   ui.selection = selection;
   changed();
@@ -181,25 +184,34 @@ canvas.addEventListener("wheel", (e) => {
 
 // proposals: a click rejects (or takes back) one before any tool sees the press
 canvas.addEventListener("click", (e) => {
-  const [x, y] = toImage(e.offsetX, e.offsetY);
-  const p = ui.proposals.find((q) => x >= q.x0 && x < q.x1 && y >= q.y0 && y < q.y1);
+  const p = ui.drag ? null : proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY));
   if (p) { p.accepted = p.accepted === false; draw(); }
 }, true);
 
 // --- keyboard: frontend/keys.js maps keys to actions ---------------------------------------------------------------
 window.addEventListener("keydown", (e) => {
-  if (e.target.closest("input, textarea, select")) return;
-  if (e.key === " ") { ui.space = true; canvas.style.cursor = "grab"; e.preventDefault(); return; }
-  const a = keyAction(e, {selected: ui.selection.size, proposals: ui.proposals.length});
+  const field = e.target.closest("input, textarea, select");
+  const onButton = Boolean(e.target.closest("button, a"));
+  if (e.key === " " && !field && !onButton) { ui.space = true; canvas.style.cursor = "grab"; e.preventDefault(); return; }
+  const a = keyAction(e, {selected: ui.selection.size, proposals: ui.proposals.length, field: field ? field.id : null,
+    onButton});
   if (!a || (a.action === "complete" && e.repeat)) return;
   if (!["tool", "label", "clear"].includes(a.action)) e.preventDefault();
   ({undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: removeSelected,
     selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
     fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
     tool: () => setTool(a.tool), label: () => pickLabel(a.label), accept: acceptProposals, complete: completeNow,
+    similar,
     nudge: () => run(moveRects(seg, [...ui.selection], a.dx, a.dy))})[a.action]();
 });
 window.addEventListener("keyup", (e) => { if (e.key === " ") { ui.space = false; setTool(ui.tool); } });
+// A button clicked with the pointer does not take the focus: the keys go on to the canvas, so that Enter accepts
+// proposals rather than pressing the last button clicked again (and leaves a field it was typed in).
+root.addEventListener("mousedown", (e) => {
+  if (!e.target.closest("button, label.button")) return;
+  e.preventDefault();
+  canvas.focus({preventScroll: true});
+});
 
 const removeSelected = () => ui.selection.size && run(new DeleteRects([...ui.selection]));
 
@@ -213,19 +225,32 @@ function duplicate() {
 
 // --- repeat and find similar (frontend/assist.js) ------------------------------------------------------------------
 function repeatSelected() {
-  if (ui.selection.size !== 1) return status("Select one rectangle to repeat.", "error");
   const n = (sel) => Number($(sel).value);
-  run(repeatCommand(seg, [...ui.selection][0], {cols: n("#rep-cols"), rows: n("#rep-rows"), gapX: n("#rep-gapx"),
-    gapY: n("#rep-gapy")}));
+  const plan = repeatSelection(seg, [...ui.selection], {cols: n("#rep-cols"), rows: n("#rep-rows"),
+    gapX: n("#rep-gapx"), gapY: n("#rep-gapy")});
+  if (plan.error) return status(plan.error, "error");
+  run(plan.command);
+  status(plan.message, "success");
 }
 
+// run again by Enter in the threshold field (keys.js), with the new threshold; the old proposals go
 function similar() {
-  if (ui.selection.size !== 1) return status("Select one drawn rectangle to look for copies of it.", "error");
+  // with no single selection, while its proposals are shown, the search runs again for the rectangle it ran for
+  const again = ui.proposalsFrom === "find similar" && ui.proposals.length && seg.rects.has(ui.similarSource);
+  if (ui.selection.size !== 1 && !again) {
+    return status(`Find similar looks for copies of one rectangle, and ${ui.selection.size} are selected.`, "error");
+  }
+  const source = ui.selection.size === 1 ? [...ui.selection][0] : ui.similarSource;
+  const field = $("#sim-threshold"), threshold = Number(field.value);
+  if (!(field.value !== "" && threshold >= Number(field.min) && threshold <= Number(field.max))) {
+    return status(`The threshold must be a number from ${field.min} to ${field.max}.`, "error");
+  }
   gray = gray || grayPixels(photo, seg.width, seg.height);
-  ui.proposals = similarProposals(gray, seg, [...ui.selection][0], Number($("#sim-threshold").value));
-  ui.proposalsFrom = "find similar";
-  status(ui.proposals.length ? `${ui.proposals.length} proposals: click one to reject it, Enter or "Accept" to add ` +
-    "the rest." : "No similar places found.");
+  ui.proposals = similarProposals(gray, seg, source, threshold);
+  [ui.proposalsFrom, ui.similarSource] = ["find similar", source];
+  status(ui.proposals.length ? `${ui.proposals.length} proposals at threshold ${threshold}: click one to reject it; ` +
+    '"Accept" or Enter adds the rest (Enter in the threshold field searches again).'
+    : `No similar places found at threshold ${threshold}.`);
   draw();
 }
 
@@ -330,7 +355,7 @@ on("#undo", "click", () => history.undo());
 on("#redo", "click", () => history.redo());
 on("#delete", "click", removeSelected);
 on("#duplicate", "click", duplicate);
-on("#repeat", "click", () => { try { repeatSelected(); } catch (err) { status(err.message, "error"); } });
+on("#repeat", "click", repeatSelected);
 on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
 on("#complete", "click", completeNow);

@@ -3,12 +3,19 @@ import {HOTKEYS, LABELS} from "./labels.js";
 
 const ARROWS = {ArrowLeft: [-1, 0], ArrowRight: [1, 0], ArrowUp: [0, -1], ArrowDown: [0, 1]};
 
-/** `event`: {key, ctrlKey, metaKey, shiftKey}. `state`: {selected: how many, proposals: how many}. Returns
- * {action, ...} with action one of undo, redo, duplicate, selectAll, delete, clear, tool (tool), accept, complete,
- * fit, label (label), nudge (dx, dy), or null. */
+// Enter in these fields runs what they set (the rest of what is typed in a field stays with it)
+export const FIELD_ENTER = {"sim-threshold": "similar"};
+
+/** `event`: {key, ctrlKey, metaKey, shiftKey}. `state`: {selected: how many, proposals: how many, field: the id of
+ * the focused text field or null, onButton: whether a button or link has the focus}. Returns {action, ...} with
+ * action one of undo, redo, duplicate, selectAll, delete, clear, tool (tool), accept, complete, fit, label (label),
+ * nudge (dx, dy), similar, or null. */
 export function keyAction(event, state = {selected: 0, proposals: 0}) {
   const {key, shiftKey} = event;
   const k = key.toLowerCase();
+  if (state.field != null) return key === "Enter" && FIELD_ENTER[state.field] ? {action: FIELD_ENTER[state.field]} : null;
+  // a button reached with Tab keeps its own Enter and Space (pointer clicks leave the focus on the canvas)
+  if (state.onButton && (key === "Enter" || key === " ")) return null;
   if (event.ctrlKey || event.metaKey) {
     if (k === "z") return {action: shiftKey ? "redo" : "undo"};
     if (k === "y") return {action: "redo"};

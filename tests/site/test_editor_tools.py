@@ -7,7 +7,7 @@ import os
 import shutil
 
 import pytest
-from editor_helpers import E, open_editor
+from editor_helpers import WINDOWS, E, open_editor, rects, screen
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
@@ -52,8 +52,66 @@ def test_at_1280x720_the_canvas_saving_and_the_job_are_in_view(small_screen, tmp
     # the side panel scrolls on its own: no taller than the canvas
     panel, canvas = (page.locator(s).bounding_box() for s in (".tools", "#canvas"))
     assert panel["height"] <= canvas["height"] + 1
-    assert page.evaluate("document.querySelector('.tools').scrollHeight > document.querySelector('.tools').clientHeight")
+    assert page.eval_on_selector(".tools", "p => p.scrollHeight > p.clientHeight")
     page.evaluate("document.querySelector('#status').textContent = 'Ready.'")
     path = os.environ.get("FACAID_EDITOR_SCREENSHOT") or str(tmp_path / "editor-1280x720.png")
     page.screenshot(path=path)
     assert page.evaluate(f"{E}.history.canUndo") is False
+
+
+def select_window(page, x: int, y: int, shift: bool = False) -> None:
+    page.keyboard.press("v")
+    if shift:
+        page.keyboard.down("Shift")
+    page.mouse.click(*screen(page, x + 10, y + 10))
+    if shift:
+        page.keyboard.up("Shift")
+
+
+def test_enter_in_the_threshold_field_searches_again_and_enter_elsewhere_accepts(editor):
+    page = editor
+    select_window(page, *WINDOWS[0])
+    page.click("#similar")
+    assert len(page.evaluate(f"{E}.ui.proposals")) == 5
+    assert "at threshold 0.8" in page.text_content("#status")
+    # the click left the focus off the button: Enter does not press "Find similar" again
+    assert page.evaluate("document.activeElement.id") != "similar"
+    page.mouse.click(*screen(page, WINDOWS[1][0] + 20, WINDOWS[1][1] + 20))  # reject one
+    assert page.evaluate(f"{E}.ui.proposals.filter(p => p.accepted === false).length") == 1
+    # a new threshold and Enter in its field: a new search (nothing added, the rejection gone), focus kept there
+    page.fill("#sim-threshold", "0.9")
+    page.press("#sim-threshold", "Enter")
+    assert "at threshold 0.9" in page.text_content("#status")
+    assert page.evaluate(f"{E}.ui.proposals.filter(p => p.accepted === false).length") == 0
+    assert len(rects(page)) == 2 and page.evaluate("document.activeElement.id") == "sim-threshold"
+    # out of range: refused with the range, the proposals kept
+    page.fill("#sim-threshold", "5")
+    page.press("#sim-threshold", "Enter")
+    assert page.text_content("#status") == "The threshold must be a number from 0.3 to 1."
+    assert len(page.evaluate(f"{E}.ui.proposals")) == 5
+    # back on the canvas, Enter accepts the proposals: one step of five windows
+    page.focus("#canvas")
+    page.keyboard.press("Enter")
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 6
+
+
+def test_repeat_with_several_selected_says_so_and_each_press_leaves_its_own_message(editor):
+    page = editor
+    select_window(page, *WINDOWS[0])
+    page.fill("#rep-cols", "3")
+    page.fill("#rep-gapx", "80")
+    page.click("#repeat")
+    assert page.text_content("#status") == "Added 2 window copies (3 × 1)."
+    assert len(rects(page)) == 4
+    # two selected: refused, the message about this press (not the last success), nothing added
+    page.keyboard.press("Escape")
+    select_window(page, *WINDOWS[0])
+    select_window(page, WINDOWS[1][0], WINDOWS[1][1], shift=True)
+    assert page.evaluate(f"{E}.ui.selection.size") == 2
+    page.click("#repeat")
+    assert page.text_content("#status") == "Repeat copies one rectangle, and 2 are selected: select one of them."
+    assert "error" in page.get_attribute("#status", "class")
+    assert len(rects(page)) == 4
+    page.keyboard.press("Escape")
+    page.click("#repeat")
+    assert page.text_content("#status") == "Repeat copies the selected rectangle: select one first."
