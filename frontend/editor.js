@@ -3,7 +3,8 @@
 import {acceptCommand, proposalAt, rejectedOf, repeatSelection, similarProposals} from "./assist.js";
 import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
 import {identical} from "./geometry.js";
-import {keyAction} from "./keys.js";
+import {buildHelp} from "./help.js";
+import {ACTIONS, keyAction} from "./keys.js";
 import {buildPalette, markActive} from "./panel.js";
 import {openRectifyMode} from "./rectify-mode.js";
 import {drawScene, grayPixels} from "./render.js";
@@ -189,20 +190,23 @@ canvas.addEventListener("click", (e) => {
 }, true);
 
 // --- keyboard: frontend/keys.js maps keys to actions ---------------------------------------------------------------
+const keyHandlers = {undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: () => removeSelected(),
+  selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
+  fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
+  tool: (a) => setTool(a.tool), label: (a) => pickLabel(a.label), accept: () => acceptProposals(),
+  complete: () => completeNow(), similar: () => similar(), help: (a) => showHelp(a.open),
+  pan: () => { ui.space = true; canvas.style.cursor = "grab"; },
+  nudge: (a) => run(moveRects(seg, [...ui.selection], a.dx, a.dy))};
+const unhandled = ACTIONS.filter((name) => !keyHandlers[name]);
+if (unhandled.length) throw new Error(`keys.js has actions the editor does not handle: ${unhandled.join(", ")}`);
+
 window.addEventListener("keydown", (e) => {
   const field = e.target.closest("input, textarea, select");
-  const onButton = Boolean(e.target.closest("button, a"));
-  if (e.key === " " && !field && !onButton) { ui.space = true; canvas.style.cursor = "grab"; e.preventDefault(); return; }
-  const a = keyAction(e, {selected: ui.selection.size, proposals: ui.proposals.length, field: field ? field.id : null,
-    onButton});
+  const a = keyAction(e, {selected: ui.selection.size, proposals: ui.proposals.length, help: !$("#help").hidden,
+    field: field ? field.id : null, onButton: Boolean(e.target.closest("button, a"))});
   if (!a || (a.action === "complete" && e.repeat)) return;
   if (!["tool", "label", "clear"].includes(a.action)) e.preventDefault();
-  ({undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: removeSelected,
-    selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
-    fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
-    tool: () => setTool(a.tool), label: () => pickLabel(a.label), accept: acceptProposals, complete: completeNow,
-    similar,
-    nudge: () => run(moveRects(seg, [...ui.selection], a.dx, a.dy))})[a.action]();
+  keyHandlers[a.action](a);
 });
 window.addEventListener("keyup", (e) => { if (e.key === " ") { ui.space = false; setTool(ui.tool); } });
 // A button clicked with the pointer does not take the focus: the keys go on to the canvas, so that Enter accepts
@@ -212,6 +216,12 @@ root.addEventListener("mousedown", (e) => {
   e.preventDefault();
   canvas.focus({preventScroll: true});
 });
+
+function showHelp(open) {
+  $("#help").hidden = !open;
+  if (open) $("#help-close").focus({preventScroll: true});  // Escape and Tab start in the dialog
+  else canvas.focus({preventScroll: true});
+}
 
 const removeSelected = () => ui.selection.size && run(new DeleteRects([...ui.selection]));
 
@@ -360,6 +370,9 @@ on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
 on("#complete", "click", completeNow);
 on("#fit", "click", fit);
+on("#help-open", "click", () => showHelp(true));
+on("#help-close", "click", () => showHelp(false));
+on("#help", "click", (e) => { if (e.target.id === "help") showHelp(false); });  // a click beside the dialog
 on("#export", "click", () => download(seg.toJSON(), `segmentation-${photoCode.slice(0, 8)}.json`));
 on("#import", "change", (e) => e.target.files[0] && importJSON(e.target.files[0]));
 on("#save", "click", saveNow);
@@ -374,6 +387,7 @@ const rows = new ResizeObserver(layout);
 for (const bar of document.querySelectorAll(".editor-bar")) rows.observe(bar);
 window.addEventListener("beforeunload", (e) => { if (history?.dirty) { e.preventDefault(); e.returnValue = ""; } });
 setTool("draw");
+buildHelp($("#help-body"));
 load().catch((err) => status(`Could not load the photo: ${err.message}`, "error"));
 
 // for tests and the console

@@ -115,3 +115,33 @@ def test_repeat_with_several_selected_says_so_and_each_press_leaves_its_own_mess
     page.keyboard.press("Escape")
     page.click("#repeat")
     assert page.text_content("#status") == "Repeat copies the selected rectangle: select one first."
+
+
+def test_the_shortcuts_help_lists_the_key_table_opens_on_question_mark_and_closes_on_escape(editor):
+    page = editor
+    select_window(page, *WINDOWS[0])
+    assert page.is_hidden("#help")
+    page.keyboard.press("?")
+    assert page.is_visible("#help")
+    # the rows are keys.js's table, as the page loaded it
+    table = page.evaluate("import('/static/editor/keys.js').then(k => k.shortcutRows())")
+    shown = page.eval_on_selector_all("#help-body section:first-child tr", "rows => rows.map(r => "
+                                      "({keys: r.cells[0].textContent, does: r.cells[1].textContent}))")
+    assert shown == table and len(shown) >= 15
+    assert {"keys": "Ctrl+Shift+Z / Ctrl+Y", "does": "redo"} in shown
+    assert page.locator("#help-body").get_by_text("no snapping").is_visible()
+    # while it is open the keys do not reach the editor; Escape closes it and leaves the selection alone
+    page.keyboard.press("r")
+    assert page.evaluate(f"{E}.ui.tool") == "select"
+    page.keyboard.press("Escape")
+    assert page.is_hidden("#help") and page.evaluate(f"{E}.ui.selection.size") == 1
+    # the button opens it, its Close button and a click beside the dialog close it
+    page.click("#help-open")
+    assert page.is_visible("#help")
+    page.click("#help-close")
+    assert page.is_hidden("#help")
+    page.click("#help-open")
+    page.mouse.click(5, 700)
+    assert page.is_hidden("#help")
+    page.keyboard.press("Escape")  # closed, Escape clears the selection as before
+    assert page.evaluate(f"{E}.ui.selection.size") == 0
