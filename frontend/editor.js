@@ -10,7 +10,7 @@ import {openRectifyMode} from "./rectify-mode.js";
 import {drawScene, grayPixels} from "./render.js";
 import {download, makeApi} from "./server.js";
 import {keepDraft, loadPhoto, readSegmentationFile, rectify, save, submit} from "./session.js";
-import {PinchGesture, clampScale, fitView} from "./tools/view.js";
+import {PinchGesture, clampScale, fitView, photoFilter} from "./tools/view.js";
 import {press} from "./tools/select.js";
 
 const $ = (sel) => document.querySelector(sel);
@@ -223,6 +223,15 @@ function showHelp(open) {
   else canvas.focus({preventScroll: true});
 }
 
+// brightness and contrast: how the photo is shown, never the photo (nor an undo step)
+function adjustPhoto() {
+  const [brightness, contrast] = [Number($("#brightness").value), Number($("#contrast").value)];
+  ui.photoFilter = photoFilter({brightness, contrast});
+  $("#adjust-reset").disabled = ui.photoFilter === "none";
+  $("#adjust-value").textContent = `${Math.round(100 * brightness)} %, ${Math.round(100 * contrast)} %`;
+  draw();
+}
+
 const removeSelected = () => ui.selection.size && run(new DeleteRects([...ui.selection]));
 
 function duplicate() {
@@ -378,6 +387,9 @@ on("#import", "change", (e) => e.target.files[0] && importJSON(e.target.files[0]
 on("#save", "click", saveNow);
 on("#submit", "click", submitNow);
 on("#fill", "input", draw);
+on("#brightness", "input", adjustPhoto);
+on("#contrast", "input", adjustPhoto);
+on("#adjust-reset", "click", () => { $("#brightness").value = $("#contrast").value = 1; adjustPhoto(); });
 on("#overlay-alpha", "input", (e) => { ui.overlayAlpha = Number(e.target.value); draw(); });
 on("#rectify", "click", openRectify);
 on("#rectify-apply", "click", applyRectify);
@@ -388,6 +400,7 @@ for (const bar of document.querySelectorAll(".editor-bar")) rows.observe(bar);
 window.addEventListener("beforeunload", (e) => { if (history?.dirty) { e.preventDefault(); e.returnValue = ""; } });
 setTool("draw");
 buildHelp($("#help-body"));
+adjustPhoto();
 load().catch((err) => status(`Could not load the photo: ${err.message}`, "error"));
 
 // for tests and the console

@@ -27,7 +27,9 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
   ctx.fillStyle = "#2a2f36";
   ctx.fillRect(0, 0, canvas.width, canvas.height);
   ctx.imageSmoothingEnabled = view.scale < 1;
+  ctx.filter = ui.photoFilter || "none";  // brightness and contrast of the photo layer alone
   ctx.drawImage(photo, view.ox, view.oy, seg.width * view.scale, seg.height * view.scale);
+  ctx.filter = "none";
   const drag = ui.drag;
   const preview = drag?.preview || new Map();
   for (const r0 of seg.paintOrder()) {

@@ -145,3 +145,47 @@ def test_the_shortcuts_help_lists_the_key_table_opens_on_question_mark_and_close
     assert page.is_hidden("#help")
     page.keyboard.press("Escape")  # closed, Escape clears the selection as before
     assert page.evaluate(f"{E}.ui.selection.size") == 0
+
+
+def canvas_pixel(page, x: float, y: float) -> list[int]:
+    """The canvas's RGB at image point (x, y)."""
+    return page.evaluate(f"""(() => {{
+      const v = {E}.view, c = document.querySelector('#canvas');
+      return [...c.getContext('2d').getImageData(Math.floor(v.ox + {x} * v.scale), Math.floor(v.oy + {y} * v.scale),
+        1, 1).data].slice(0, 3);
+    }})()""")
+
+
+def set_range(page, selector: str, value: float) -> None:
+    page.eval_on_selector(selector, f"e => {{ e.value = {value}; e.dispatchEvent(new Event('input')); }}")
+
+
+def test_brightness_and_contrast_change_the_photo_shown_not_the_rectangles_nor_the_photo(editor):
+    page = editor
+    requests = []
+    page.on("request", lambda r: requests.append(r.url))
+    set_range(page, "#fill", 0)  # the photo alone inside the rectangles, their outlines on top
+    wall = (30, 30)  # inside the facade, away from the windows
+    outline = (WINDOWS[0][0] + 30, WINDOWS[0][1])  # the window's top edge, drawn over the photo
+    before, edge = canvas_pixel(page, *wall), canvas_pixel(page, *outline)
+    assert page.is_disabled("#adjust-reset")
+    set_range(page, "#brightness", 2)
+    brighter = canvas_pixel(page, *wall)
+    assert all(b >= min(255, 1.8 * a) for a, b in zip(before, brighter, strict=True)), (before, brighter)
+    # the rectangles are drawn as before (a few levels of the photo show through the outline's antialiasing)
+    assert all(abs(a - b) <= 4 for a, b in zip(canvas_pixel(page, *outline), edge, strict=True))
+    set_range(page, "#brightness", 1)
+    set_range(page, "#contrast", 0.2)
+    flat = canvas_pixel(page, *wall)
+    assert max(abs(c - 128) for c in flat) < max(abs(c - 128) for c in before)  # pulled toward mid gray
+    assert page.text_content("#adjust-value") == "100 %, 20 %" and not page.is_disabled("#adjust-reset")
+    # nothing was sent, nothing to undo, nothing to save; Reset shows the photo as it is
+    assert requests == [] and not page.evaluate(f"{E}.history.canUndo") and page.text_content("#dirty") == "saved"
+    page.click("#adjust-reset")
+    assert canvas_pixel(page, *wall) == before and page.is_disabled("#adjust-reset")
+    assert page.input_value("#brightness") == "1" and page.input_value("#contrast") == "1"
+    # find similar reads the photo, not the view: the same five windows with the photo shown darker
+    set_range(page, "#brightness", 0.3)
+    select_window(page, *WINDOWS[0])
+    page.click("#similar")
+    assert len(page.evaluate(f"{E}.ui.proposals")) == 5
