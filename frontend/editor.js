@@ -5,12 +5,14 @@ import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./co
 import {identical} from "./geometry.js";
 import {buildHelp} from "./help.js";
 import {ACTIONS, keyAction} from "./keys.js";
+import {buildObjectList} from "./object-list.js";
+import {freeView, layersNote, objectGroups, pickable, pickableSelection, toggleLayer} from "./objects.js";
 import {buildPalette, markActive} from "./panel.js";
 import {openRectifyMode} from "./rectify-mode.js";
 import {drawScene, grayPixels} from "./render.js";
 import {download, makeApi} from "./server.js";
 import {keepDraft, loadPhoto, readSegmentationFile, rectify, save, submit} from "./session.js";
-import {PinchGesture, clampScale, fitView, photoFilter} from "./tools/view.js";
+import {PinchGesture, clampScale, fitView, photoFilter, reveal} from "./tools/view.js";
 import {press} from "./tools/select.js";
 
 const $ = (sel) => document.querySelector(sel);
@@ -22,7 +24,8 @@ const ctx = canvas.getContext("2d");
 
 const view = {scale: 1, ox: 0, oy: 0};  // screen = image * scale + offset
 const ui = {tool: "draw", label: "window", selection: new Set(), drag: null, guides: [], proposals: [],
-  proposalsFrom: "find similar", rejected: [], space: false, overlay: null, overlayAlpha: 0.5};
+  proposalsFrom: "find similar", rejected: [], space: false, overlay: null, overlayAlpha: 0.5,
+  layers: freeView(), openGroups: new Set()};  // layers: the classes hidden or locked in the object list
 // the photo's API record and image, the segmentation and its history, the photo's gray levels once asked for,
 // and the RectifyMode (rectify-mode.js) while the rectification step is open
 let info = null, photo = null, seg = null, history = null, gray = null, rectifying = null;
@@ -46,11 +49,31 @@ function changed() {
   $("#redo").disabled = !history.canRedo;
   $("#dirty").textContent = history.dirty ? "unsaved changes" : "saved";
   const twice = identical([...seg.rects.values()]);
-  $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected` + (twice.length ? " · " +
-    twice.map((t) => `${t.count} identical ${t.label} rectangles`).join(", ") + " (delete the copies)" : "");
+  const note = layersNote(ui.layers);
+  $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected` + (note ? ` · ${note}` : "") +
+    (twice.length ? " · " + twice.map((t) => `${t.count} identical ${t.label} rectangles`).join(", ") +
+    " (delete the copies)" : "");
   $("#count").classList.toggle("warning", twice.length > 0);
   readout(null, null);
+  objectList();
   draw();
+}
+
+// --- the object list (objects.js): hide and lock are view state, no command -----------------------------------
+function objectList() {
+  buildObjectList($("#objects"), objectGroups(seg, ui.layers), ui.selection, ui.openGroups, {
+    rebuild: objectList,
+    toggle: (kind, label) => {
+      ui.layers = toggleLayer(ui.layers, kind, label);
+      ui.selection = pickableSelection(seg, ui.selection, ui.layers);
+      changed();
+    },
+    select: (id) => {
+      ui.selection = new Set([id]);
+      Object.assign(view, reveal(view, seg.get(id), canvas.width, canvas.height));
+      changed();
+    },
+  });
 }
 
 function run(cmd) {
@@ -69,7 +92,7 @@ function layout() {
   const top = box.top + window.scrollY;  // the page's layout, whatever it is scrolled to
   const [w, h] = [Math.round(box.width), Math.max(400, Math.floor(window.innerHeight - top - 24))];
   if (canvas.width !== w || canvas.height !== h) [canvas.width, canvas.height] = [w, h];  // a resize clears it
-  $(".tools").style.maxHeight = `${h}px`;
+  for (const panel of document.querySelectorAll(".editor-grid > aside")) panel.style.maxHeight = `${h}px`;
   draw();
 }
 
@@ -109,7 +132,8 @@ function setTool(tool) {
 }
 
 // --- pointer: frontend/tools/ turns presses and moves into previews and commands ----------------------------------
-const toolContext = () => ({seg, selection: ui.selection, label: ui.label, scale: view.scale, snap: $("#snap").checked});
+const toolContext = () => ({seg, selection: ui.selection, label: ui.label, scale: view.scale, snap: $("#snap").checked,
+  layers: ui.layers});
 const pointers = new Map();  // pointerId -> [offsetX, offsetY] while down: two pinch
 
 function pointerOf(e) {
@@ -191,7 +215,10 @@ canvas.addEventListener("click", (e) => {
 
 // --- keyboard: frontend/keys.js maps keys to actions ---------------------------------------------------------------
 const keyHandlers = {undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: () => removeSelected(),
-  selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
+  selectAll: () => {  // what can be picked: Ctrl+A then Delete must not remove a hidden or locked class
+    ui.selection = new Set([...seg.rects.values()].filter((r) => pickable(ui.layers, r)).map((r) => r.id));
+    changed();
+  },
   fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
   tool: (a) => setTool(a.tool), label: (a) => pickLabel(a.label), accept: () => acceptProposals(),
   complete: () => completeNow(), similar: () => similar(), help: (a) => showHelp(a.open),

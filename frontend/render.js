@@ -4,6 +4,7 @@
 import {handlePoints, normalize} from "./geometry.js";
 import {cssColor} from "./labels.js";
 import {toGray} from "./match.js";
+import {shown} from "./objects.js";
 
 /** The photo's gray levels at its own size, for `match.findSimilar`. */
 export function grayPixels(photo, width, height) {
@@ -33,6 +34,7 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
   const drag = ui.drag;
   const preview = drag?.preview || new Map();
   for (const r0 of seg.paintOrder()) {
+    if (!shown(ui.layers, r0)) continue;  // a hidden class (the object list)
     const r = preview.get(r0.id) || r0;
     ctx.fillStyle = cssColor(r.label, fill);
     ctx.fillRect(...box(r));

@@ -18,6 +18,16 @@ export function fitView(width, height, canvasWidth, canvasHeight) {
   return {scale, ox: (canvasWidth - width * scale) / 2, oy: (canvasHeight - height * scale) / 2};
 }
 
+/** The view with `rect` (image pixels) in sight: unchanged when it already is whole, else centred on it at the
+ * same scale. */
+export function reveal(view, rect, canvasWidth, canvasHeight) {
+  const [x0, y0] = [rect.x0 * view.scale + view.ox, rect.y0 * view.scale + view.oy];
+  const [x1, y1] = [rect.x1 * view.scale + view.ox, rect.y1 * view.scale + view.oy];
+  if (x0 >= 0 && y0 >= 0 && x1 <= canvasWidth && y1 <= canvasHeight) return {...view};
+  return {scale: view.scale, ox: canvasWidth / 2 - (rect.x0 + rect.x1) / 2 * view.scale,
+    oy: canvasHeight / 2 - (rect.y0 + rect.y1) / 2 * view.scale};
+}
+
 function midpoint(points) {
   const [[ax, ay], [bx, by]] = points;
   return {mx: (ax + bx) / 2, my: (ay + by) / 2, dist: Math.hypot(bx - ax, by - ay) || 1};

@@ -7,7 +7,9 @@ import os
 import shutil
 
 import pytest
-from editor_helpers import WINDOWS, E, open_editor, rects, screen
+from editor_helpers import WINDOWS, E, drag, open_editor, rects, screen, selected
+
+from webapp.facades.models import Segmentation
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
@@ -189,3 +191,57 @@ def test_brightness_and_contrast_change_the_photo_shown_not_the_rectangles_nor_t
     select_window(page, *WINDOWS[0])
     page.click("#similar")
     assert len(page.evaluate(f"{E}.ui.proposals")) == 5
+
+
+
+def test_object_list_selects_and_hides_or_locks_a_class_without_changing_what_is_saved(editor):
+    page = editor
+    wx, wy = WINDOWS[0]
+    summary = "#objects details[data-label={}] summary"
+    assert page.text_content(summary.format("window") + " .name") == "window 1"
+    assert page.text_content(summary.format("facade") + " .name") == "facade 1"
+    set_range(page, "#fill", 0)
+    outline = canvas_pixel(page, wx + 30, wy)  # the window's top edge, not selected
+    # an entry selects its rectangle
+    page.click(summary.format("window") + " .name")
+    page.click("#objects details[data-label=window] ol button")
+    assert [r["label"] for r in selected(page)] == ["window"]
+    # locked: drawn, but its entry disabled (and greyed), dropped from the selection, a press goes to the wall
+    page.click(summary.format("window") + " button.locked")
+    assert page.evaluate(f"{E}.ui.selection.size") == 0 and "locked: window" in page.text_content("#count")
+    entry = "#objects details[data-label=window] ol button"
+    assert page.is_disabled(entry)
+    assert page.eval_on_selector(entry, "b => getComputedStyle(b).cursor") == "not-allowed"
+    assert canvas_pixel(page, wx + 30, wy) == outline
+    page.keyboard.press("v")
+    page.mouse.click(*screen(page, wx + 10, wy + 10))
+    assert [r["label"] for r in selected(page)] == ["facade"]
+    page.keyboard.press("Control+a")
+    assert [r["label"] for r in selected(page)] == ["facade"]
+    page.keyboard.press("Escape")
+    # the wall locked too: a drag over the window draws a box, moving nothing
+    page.click(summary.format("facade") + " button.locked")
+    before = rects(page)
+    drag(page, (wx + 10, wy + 10), (wx + 40, wy + 40))
+    assert rects(page) == before and not page.evaluate(f"{E}.history.canUndo")
+    # hidden: not drawn (the outline is gone), not hit; Delete after Ctrl+A removes nothing of it
+    page.click(summary.format("window") + " button.locked")
+    page.click(summary.format("window") + " button.hidden")
+    assert "hidden: window; locked: facade" in page.text_content("#count")
+    assert canvas_pixel(page, wx + 30, wy) != outline
+    page.mouse.click(*screen(page, wx + 10, wy + 10))
+    assert page.evaluate(f"{E}.ui.selection.size") == 0
+    page.keyboard.press("Control+a")
+    page.keyboard.press("Delete")
+    assert len(rects(page)) == 2
+    # none of it was an edit: nothing to undo, "saved", and a save stores both rectangles
+    assert not page.evaluate(f"{E}.history.canUndo") and page.text_content("#dirty") == "saved"
+    page.click("#save")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Saved')")
+    latest = Segmentation.objects.filter(photo__code=page.photo["code"]).order_by("-version").first()
+    assert latest.version == 2 and sorted(r["label"] for r in latest.data["rects"]) == ["facade", "window"]
+    # shown again: drawn and picked as before
+    page.click(summary.format("window") + " button.hidden")
+    assert canvas_pixel(page, wx + 30, wy) == outline
+    page.mouse.click(*screen(page, wx + 10, wy + 10))
+    assert [r["label"] for r in selected(page)] == ["window"]
