@@ -58,10 +58,11 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
   if (drag?.kind === "marquee") stroke(normalize(drag.box), "#9cf", 1, [3, 3]);
   ctx.strokeStyle = "#ff4fd8";
   ctx.lineWidth = 1;
-  for (const g of ui.guides) {
+  for (const g of ui.guides) {  // on the middle of a whole pixel: a crisp line, not two half-bright ones
     ctx.beginPath();
-    if (g.axis === "x") { ctx.moveTo(sx(g.at) + 0.5, 0); ctx.lineTo(sx(g.at) + 0.5, canvas.height); }
-    else { ctx.moveTo(0, sy(g.at) + 0.5); ctx.lineTo(canvas.width, sy(g.at) + 0.5); }
+    const [gx, gy] = [Math.round(sx(g.at)) + 0.5, Math.round(sy(g.at)) + 0.5];
+    if (g.axis === "x") { ctx.moveTo(gx, 0); ctx.lineTo(gx, canvas.height); }
+    else { ctx.moveTo(0, gy); ctx.lineTo(canvas.width, gy); }
     ctx.stroke();
   }
   if (ui.overlay) {

@@ -245,3 +245,46 @@ def test_object_list_selects_and_hides_or_locks_a_class_without_changing_what_is
     assert canvas_pixel(page, wx + 30, wy) == outline
     page.mouse.click(*screen(page, wx + 10, wy + 10))
     assert [r["label"] for r in selected(page)] == ["window"]
+
+
+def guide_seen(page, x: float) -> bool:
+    """Is a snap guide (magenta) drawn down the canvas at image x, in its top rows?"""
+    return page.evaluate(f"""(() => {{
+      const v = {E}.view, c = document.querySelector('#canvas'), sx = Math.floor(v.ox + {x} * v.scale);
+      const d = c.getContext('2d').getImageData(sx - 1, 3, 3, 1).data;
+      return [0, 4, 8].some((i) => d[i] > 200 && d[i + 1] < 140 && d[i + 2] > 170);
+    }})()""")
+
+
+def test_snapping_is_a_few_screen_pixels_at_two_zooms_with_a_guide_while_it_snaps(editor):
+    page = editor
+    wx, wy = WINDOWS[0]
+    right = wx + 60  # the window's right edge
+    page.keyboard.press("4")  # door
+
+    def draw_to(screen_px):
+        """Draw a door whose moving corner ends `screen_px` screen pixels right of the window's right edge:
+        (its left edge, whether a guide showed before the release)."""
+        s = page.evaluate(f"{E}.view.scale")
+        page.mouse.move(*screen(page, right + 30, wy + 150))
+        page.mouse.down()
+        page.mouse.move(*screen(page, right + screen_px / s, wy + 110), steps=5)
+        seen = guide_seen(page, right)
+        page.mouse.up()
+        x0 = selected(page)[0]["x0"]
+        page.keyboard.press("Control+z")
+        return x0, seen
+
+    for zoom in ("fit", "zoomed"):
+        if zoom == "zoomed":  # about 3.3 times closer, about the window's right edge
+            for _ in range(2):
+                page.mouse.move(*screen(page, right + 10, wy + 120))
+                page.mouse.wheel(0, -400)
+                page.wait_for_timeout(50)
+        s = page.evaluate(f"{E}.view.scale")
+        assert (s > 4) == (zoom == "zoomed"), s
+        # 3 screen pixels: snapped onto the edge, the guide shown while dragging
+        assert draw_to(3) == (right, True), zoom
+        # 12 screen pixels (at the higher zoom under 2 image pixels): left where the pointer was, no guide
+        x0, seen = draw_to(12)
+        assert x0 == pytest.approx(right + 12 / s, abs=1.01) and x0 != right and not seen, zoom
