@@ -4,6 +4,7 @@ import {acceptCommand, proposalAt, rejectedOf, repeatSelection, similarProposals
 import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
 import {identical} from "./geometry.js";
 import {buildHelp} from "./help.js";
+import {BOX_FIELDS, boxFields, setBoxCommand} from "./inspect.js";
 import {ACTIONS, keyAction} from "./keys.js";
 import {buildObjectList} from "./object-list.js";
 import {freeView, layersNote, objectGroups, pickable, pickableSelection, toggleLayer} from "./objects.js";
@@ -56,7 +57,29 @@ function changed() {
   $("#count").classList.toggle("warning", twice.length > 0);
   readout(null, null);
   objectList();
+  selectionFields();
   draw();
+}
+
+// --- the selection's exact numbers (inspect.js) ----------------------------------------------------------------
+function selectionFields() {
+  const one = ui.selection.size === 1 ? seg.get([...ui.selection][0]) : null;
+  const shown = one ? boxFields(one) : null;
+  for (const k of BOX_FIELDS) Object.assign($(`#sel-${k}`), {disabled: !one, value: shown ? shown[k] : ""});
+  $("#sel-apply").disabled = !one;
+  $("#sel-size").textContent = one ? `${one.label} ${one.x1 - one.x0} × ${one.y1 - one.y0}` : "select one rectangle";
+}
+
+function applyBox() {
+  if (ui.selection.size !== 1) return status("The numbers are those of one selected rectangle: select one.", "error");
+  const typed = Object.fromEntries(BOX_FIELDS.map((k) => [k, $(`#sel-${k}`).value]));
+  // a number field reports "" for what it cannot read ("1e", "--2"): say so rather than guess
+  for (const k of BOX_FIELDS) if ($(`#sel-${k}`).validity.badInput) typed[k] = "(not a number)";
+  const {command, error} = setBoxCommand(seg, [...ui.selection][0], typed);
+  if (error) return status(`Not applied: ${error}`, "error");
+  if (!command) return status("The rectangle already has these numbers.");
+  run(command);
+  status(`Set to ${BOX_FIELDS.map((k) => `${k} ${typed[k].trim()}`).join(", ")}.`, "success");
 }
 
 // --- the object list (objects.js): hide and lock are view state, no command -----------------------------------
@@ -222,6 +245,7 @@ const keyHandlers = {undo: () => history.undo(), redo: () => history.redo(), dup
   fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
   tool: (a) => setTool(a.tool), label: (a) => pickLabel(a.label), accept: () => acceptProposals(),
   complete: () => completeNow(), similar: () => similar(), help: (a) => showHelp(a.open),
+  applyBox: () => applyBox(),
   pan: () => { ui.space = true; canvas.style.cursor = "grab"; },
   nudge: (a) => run(moveRects(seg, [...ui.selection], a.dx, a.dy))};
 const unhandled = ACTIONS.filter((name) => !keyHandlers[name]);
@@ -406,6 +430,7 @@ on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
 on("#complete", "click", completeNow);
 on("#fit", "click", fit);
+on("#sel-apply", "click", applyBox);
 on("#help-open", "click", () => showHelp(true));
 on("#help-close", "click", () => showHelp(false));
 on("#help", "click", (e) => { if (e.target.id === "help") showHelp(false); });  // a click beside the dialog

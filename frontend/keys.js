@@ -14,6 +14,8 @@ const nudge = (step) => (i) => ({action: "nudge", dx: STEP[ARROWS[i]][0] * step,
 export const SHORTCUTS = [
   {keys: ["Enter"], field: ["sim-threshold"], action: {action: "similar"},
     does: "in the find-similar threshold: search again"},
+  {keys: ["Enter"], field: ["sel-x0", "sel-y0", "sel-x1", "sel-y1"], action: {action: "applyBox"},
+    does: "in the selection's x0, y0, x1, y1: apply them"},
   {keys: ["Ctrl+Z"], action: {action: "undo"}, does: "undo (a drag is one step)"},
   {keys: ["Ctrl+Shift+Z", "Ctrl+Y"], action: {action: "redo"}, does: "redo"},
   {keys: ["Ctrl+D"], action: {action: "duplicate"}, does: "duplicate the selection"},

@@ -288,3 +288,36 @@ def test_snapping_is_a_few_screen_pixels_at_two_zooms_with_a_guide_while_it_snap
         # 12 screen pixels (at the higher zoom under 2 image pixels): left where the pointer was, no guide
         x0, seen = draw_to(12)
         assert x0 == pytest.approx(right + 12 / s, abs=1.01) and x0 != right and not seen, zoom
+
+
+def test_exact_numbers_of_one_selection_are_one_undo_step_and_bad_ones_are_refused(editor):
+    page = editor
+    wx, wy = WINDOWS[0]
+    assert page.is_disabled("#sel-x0") and page.is_disabled("#sel-apply")  # nothing selected
+    select_window(page, wx, wy)
+    assert [page.input_value(f"#sel-{k}") for k in ("x0", "y0", "x1", "y1")] == ["60", "60", "120", "150"]
+    assert page.text_content("#sel-size") == "window 60 × 90"
+    # typed and applied with Enter: one step, the fields and the size follow
+    page.fill("#sel-x1", "130")
+    page.fill("#sel-y0", "55")
+    page.press("#sel-y0", "Enter")
+    assert selected(page)[0] | {"id": 0} == {"id": 0, "label": "window", "x0": 60, "y0": 55, "x1": 130, "y1": 150}
+    assert page.text_content("#sel-size") == "window 70 × 95" and page.text_content("#status").startswith("Set to")
+    page.click("#undo")
+    assert selected(page)[0]["x1"] == 120 and page.input_value("#sel-x1") == "120"
+    assert not page.evaluate(f"{E}.history.canUndo")
+    # refused, with the field named, and nothing changed or recorded
+    for field, value, message in [("x1", "481", "x1 must be at most the image's width, 480, not 481."),
+                                  ("x1", "50", "x1 must be greater than x0 (60), not 50."),
+                                  ("y0", "-3", "y0 must be at least 0, not -3."),
+                                  ("x0", "2.5", 'x0 must be a whole number of pixels, not "2.5".')]:
+        page.fill(f"#sel-{field}", value)
+        page.click("#sel-apply")
+        assert page.text_content("#status") == f"Not applied: {message}"
+        assert "error" in page.get_attribute("#status", "class")
+        assert selected(page)[0]["x1"] == 120 and not page.evaluate(f"{E}.history.canUndo")
+        page.fill(f"#sel-{field}", {"x1": "120", "y0": "60", "x0": "60"}[field])
+    # two selected: no numbers to edit
+    select_window(page, *WINDOWS[0])
+    page.keyboard.press("Control+a")
+    assert page.is_disabled("#sel-x0") and page.input_value("#sel-x0") == ""
