@@ -1,6 +1,7 @@
 // The editor page: the glue between the DOM and the editor's DOM-free parts. All changes go through commands and
 // the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
-import {acceptCommand, proposalAt, rejectedOf, repeatSelection, similarProposals} from "./assist.js";
+import {acceptCommand, proposalAt, rejectedOf, repeatByPitch, repeatSelection, similarProposals, splitCommand}
+  from "./assist.js";
 import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
 import {identical} from "./geometry.js";
 import {buildHelp} from "./help.js";
@@ -296,11 +297,18 @@ function duplicate() {
 // --- repeat and find similar (frontend/assist.js) ------------------------------------------------------------------
 function repeatSelected() {
   const n = (sel) => Number($(sel).value);
-  const plan = repeatSelection(seg, [...ui.selection], {cols: n("#rep-cols"), rows: n("#rep-rows"),
-    gapX: n("#rep-gapx"), gapY: n("#rep-gapy")});
+  carryOut(repeatSelection(seg, [...ui.selection], {cols: n("#rep-cols"), rows: n("#rep-rows"), gapX: n("#rep-gapx"),
+    gapY: n("#rep-gapy")}));
+}
+
+/** Run a {command, message} | {error} plan of assist.js and say what happened; the pieces a split made, or the
+ * copies, become the selection when `select`. */
+function carryOut(plan, select = false) {
   if (plan.error) return status(plan.error, "error");
   run(plan.command);
+  if (select && plan.command.ids?.length) ui.selection = new Set(plan.command.ids);
   status(plan.message, "success");
+  changed();
 }
 
 // run again by Enter in the threshold field (keys.js), with the new threshold; the old proposals go
@@ -426,6 +434,9 @@ on("#redo", "click", () => history.redo());
 on("#delete", "click", removeSelected);
 on("#duplicate", "click", duplicate);
 on("#repeat", "click", repeatSelected);
+on("#repeat-edge", "click", () => carryOut(repeatByPitch(seg, [...ui.selection])));
+on("#split", "click", () => carryOut(splitCommand(seg, [...ui.selection], {n: Number($("#split-n").value),
+  direction: $("#split-dir").value, gap: Number($("#split-gap").value)}), true));
 on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
 on("#complete", "click", completeNow);

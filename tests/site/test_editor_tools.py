@@ -3,6 +3,7 @@ view), and the side panels' tools."""
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 
@@ -111,7 +112,8 @@ def test_repeat_with_several_selected_says_so_and_each_press_leaves_its_own_mess
     select_window(page, WINDOWS[1][0], WINDOWS[1][1], shift=True)
     assert page.evaluate(f"{E}.ui.selection.size") == 2
     page.click("#repeat")
-    assert page.text_content("#status") == "Repeat copies one rectangle, and 2 are selected: select one of them."
+    assert page.text_content("#status") == ('Repeat copies one rectangle, and 2 are selected: select one of them, or '
+                                            '"Repeat to the edge" to repeat the two at their pitch.')
     assert "error" in page.get_attribute("#status", "class")
     assert len(rects(page)) == 4
     page.keyboard.press("Escape")
@@ -321,3 +323,49 @@ def test_exact_numbers_of_one_selection_are_one_undo_step_and_bad_ones_are_refus
     select_window(page, *WINDOWS[0])
     page.keyboard.press("Control+a")
     assert page.is_disabled("#sel-x0") and page.input_value("#sel-x0") == ""
+
+
+
+def test_repeat_to_the_edge_from_two_examples_and_split_into_columns_each_one_undo_step(editor, tmp_path):
+    page = editor
+    # a wall from x 20 to 460 and two windows of a row, 140 px apart (the photo's own pitch)
+    path = tmp_path / "two.json"
+    path.write_text(json.dumps({"width": 480, "height": 360, "rects": [
+        {"label": "facade", "x0": 20, "y0": 0, "x1": 460, "y1": 360},
+        {"label": "window", "x0": 200, "y0": 60, "x1": 260, "y1": 150},
+        {"label": "window", "x0": 340, "y0": 60, "x1": 400, "y1": 150}]}))
+    page.set_input_files("#import", str(path))
+    page.wait_for_function(f"{E}.seg.size === 3")
+    steps = page.evaluate(f"{E}.history.done.length")
+    select_window(page, 200, 60)
+    select_window(page, 340, 60, shift=True)
+    page.click("#repeat-edge")
+    assert page.text_content("#status") == "Added 1 window copy at a pitch of 140, 0 px, to the facade's edge."
+    windows = sorted((r["x0"], r["y0"], r["x1"], r["y1"]) for r in rects(page) if r["label"] == "window")
+    assert windows == [(60, 60, 120, 150), (200, 60, 260, 150), (340, 60, 400, 150)]
+    assert page.evaluate(f"{E}.history.done.length") == steps + 1
+    # one selected: no pitch to measure, refused with the count
+    page.keyboard.press("Escape")
+    select_window(page, 60, 60)
+    page.click("#repeat-edge")
+    assert "and 1 is selected" in page.text_content("#status")
+    page.click("#undo")
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 2
+    # split the first window into three columns with 3 px gaps: one step, the pieces selected
+    page.keyboard.press("Escape")
+    select_window(page, 200, 60)
+    page.fill("#split-n", "3")
+    page.select_option("#split-dir", "columns")
+    page.fill("#split-gap", "3")
+    page.click("#split")
+    assert page.text_content("#status") == "Split the window into 3 columns with gaps of 3 px."
+    pieces = sorted((r["x0"], r["x1"], r["y0"], r["y1"]) for r in selected(page))
+    assert pieces == [(200, 218, 60, 150), (221, 239, 60, 150), (242, 260, 60, 150)]
+    page.click("#undo")
+    assert sorted(r["x0"] for r in rects(page) if r["label"] == "window") == [200, 340]
+    # too many pieces for the width: refused, nothing changed
+    select_window(page, 200, 60)
+    page.fill("#split-n", "40")
+    page.click("#split")
+    assert page.text_content("#status") == "40 columns with gaps of 3 px do not fit in 60 px."
+    assert len(rects(page)) == 3
