@@ -9,6 +9,7 @@ import shutil
 
 import pytest
 from editor_helpers import WINDOWS, E, drag, open_editor, rects, screen, selected
+from site_helpers import login
 
 from webapp.facades.models import Segmentation
 
@@ -25,10 +26,19 @@ def editor(live_server, as_alice, browser):
 
 
 @pytest.fixture
-def small_screen(live_server, as_alice, browser):
-    page, context = open_editor(live_server, as_alice, browser, viewport=(1280, 720))
+def small_screen(live_server, facade_photo, browser):
+    """The editor on a 1280x720 screen, open on a generated facade of some 300 rectangles (its label map as the
+    photo)."""
+    photo, seg = facade_photo
+    context = browser.new_context(viewport={"width": 1280, "height": 720})
+    page = context.new_page()
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
+    page.wait_for_function(f"{E}?.seg?.size === {seg['rect_count']}")
     yield page
-    assert page.errors == []
+    assert errors == []
     context.close()
 
 
@@ -40,6 +50,7 @@ def in_view(page, selector: str) -> bool:
 
 def test_at_1280x720_the_canvas_saving_and_the_job_are_in_view(small_screen, tmp_path):
     page = small_screen
+    hint = page.text_content("#status")
     # the job and its result as submitting shows them, with a message long enough to wrap: the rows above the
     # canvas grow, and the canvas shrinks to stay on the screen
     page.evaluate("""() => {
@@ -56,7 +67,14 @@ def test_at_1280x720_the_canvas_saving_and_the_job_are_in_view(small_screen, tmp
     panel, canvas = (page.locator(s).bounding_box() for s in (".tools", "#canvas"))
     assert panel["height"] <= canvas["height"] + 1
     assert page.eval_on_selector(".tools", "p => p.scrollHeight > p.clientHeight")
-    page.evaluate("document.querySelector('#status').textContent = 'Ready.'")
+    # the picture for docs/img/editor-1280x720.png: a window selected from the object list, its numbers shown
+    page.click("#objects details[data-label=window] summary .name")
+    page.click("#objects details[data-label=window] ol button")
+    assert page.input_value("#sel-x0") == str(selected(page)[0]["x0"]) and selected(page)[0]["label"] == "window"
+    page.evaluate("hint => { document.querySelector('#job-status').textContent = 'done'; "
+                  "document.querySelector('#job-progress').value = 1; "
+                  "document.querySelector('#status').textContent = hint; }", hint)
+    assert all(in_view(page, s) for s in ("#canvas", "#save", "#submit", "#job-progress", "#result-link"))
     path = os.environ.get("FACAID_EDITOR_SCREENSHOT") or str(tmp_path / "editor-1280x720.png")
     page.screenshot(path=path)
     assert page.evaluate(f"{E}.history.canUndo") is False
