@@ -17,11 +17,12 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
   const sx = (x) => x * view.scale + view.ox;
   const sy = (y) => y * view.scale + view.oy;
   const box = (r) => [sx(r.x0), sy(r.y0), (r.x1 - r.x0) * view.scale, (r.y1 - r.y0) * view.scale];
-  const stroke = (r, color, width = 1, dash = []) => {
+  const stroke = (r, color, width = 1, dash = []) => {  // on whole pixels: crisp edges at any zoom
     ctx.setLineDash(dash);
     ctx.strokeStyle = color;
     ctx.lineWidth = width;
-    ctx.strokeRect(sx(r.x0) + 0.5, sy(r.y0) + 0.5, (r.x1 - r.x0) * view.scale, (r.y1 - r.y0) * view.scale);
+    const [x0, y0] = [Math.round(sx(r.x0)), Math.round(sy(r.y0))];
+    ctx.strokeRect(x0 + 0.5, y0 + 0.5, Math.round(sx(r.x1)) - x0, Math.round(sy(r.y1)) - y0);
     ctx.setLineDash([]);
   };
   ctx.setTransform(1, 0, 0, 1, 0, 0);
