@@ -48,6 +48,15 @@ export function repeatRects(seg, id, options) {
   return new AddRects(copies, "repeat");
 }
 
+/** Several commands as one step (a split: the rectangle deleted and its pieces added); undone in reverse. */
+export class Batch {
+  constructor(commands, name) { this.commands = commands; this.name = name; }
+  do(seg) { for (const c of this.commands) c.do(seg); }
+  undo(seg) { for (const c of [...this.commands].reverse()) c.undo(seg); }
+  /** The ids its AddRects gave, once done. */
+  get ids() { return this.commands.flatMap((c) => (c instanceof AddRects ? c.ids || [] : [])); }
+}
+
 /** Replace everything (import of a segmentation JSON). */
 export class ReplaceAll {
   constructor(records) { this.records = records.map((r) => ({...r})); this.name = "import"; }

@@ -1,15 +1,20 @@
 // The editor page: the glue between the DOM and the editor's DOM-free parts. All changes go through commands and
 // the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
-import {acceptCommand, rejectedOf, repeatCommand, similarProposals} from "./assist.js";
+import {acceptCommand, proposalAt, rejectedOf, repeatByPitch, repeatSelection, similarProposals, splitCommand}
+  from "./assist.js";
 import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
 import {identical} from "./geometry.js";
-import {keyAction} from "./keys.js";
+import {buildHelp} from "./help.js";
+import {BOX_FIELDS, boxFields, setBoxCommand} from "./inspect.js";
+import {ACTIONS, keyAction} from "./keys.js";
+import {buildObjectList} from "./object-list.js";
+import {freeView, layersNote, objectGroups, pickable, pickableSelection, toggleLayer} from "./objects.js";
 import {buildPalette, markActive} from "./panel.js";
 import {openRectifyMode} from "./rectify-mode.js";
 import {drawScene, grayPixels} from "./render.js";
 import {download, makeApi} from "./server.js";
 import {keepDraft, loadPhoto, readSegmentationFile, rectify, save, submit} from "./session.js";
-import {PinchGesture, clampScale, fitView} from "./tools/view.js";
+import {PinchGesture, clampScale, fitView, photoFilter, reveal} from "./tools/view.js";
 import {press} from "./tools/select.js";
 
 const $ = (sel) => document.querySelector(sel);
@@ -21,7 +26,8 @@ const ctx = canvas.getContext("2d");
 
 const view = {scale: 1, ox: 0, oy: 0};  // screen = image * scale + offset
 const ui = {tool: "draw", label: "window", selection: new Set(), drag: null, guides: [], proposals: [],
-  proposalsFrom: "find similar", rejected: [], space: false, overlay: null, overlayAlpha: 0.5};
+  proposalsFrom: "find similar", rejected: [], space: false, overlay: null, overlayAlpha: 0.5,
+  layers: freeView(), openGroups: new Set()};  // layers: the classes hidden or locked in the object list
 // the photo's API record and image, the segmentation and its history, the photo's gray levels once asked for,
 // and the RectifyMode (rectify-mode.js) while the rectification step is open
 let info = null, photo = null, seg = null, history = null, gray = null, rectifying = null;
@@ -45,11 +51,53 @@ function changed() {
   $("#redo").disabled = !history.canRedo;
   $("#dirty").textContent = history.dirty ? "unsaved changes" : "saved";
   const twice = identical([...seg.rects.values()]);
-  $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected` + (twice.length ? " · " +
-    twice.map((t) => `${t.count} identical ${t.label} rectangles`).join(", ") + " (delete the copies)" : "");
+  const note = layersNote(ui.layers);
+  $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected` + (note ? ` · ${note}` : "") +
+    (twice.length ? " · " + twice.map((t) => `${t.count} identical ${t.label} rectangles`).join(", ") +
+    " (delete the copies)" : "");
   $("#count").classList.toggle("warning", twice.length > 0);
   readout(null, null);
+  objectList();
+  selectionFields();
   draw();
+}
+
+// --- the selection's exact numbers (inspect.js) ----------------------------------------------------------------
+function selectionFields() {
+  const one = ui.selection.size === 1 ? seg.get([...ui.selection][0]) : null;
+  const shown = one ? boxFields(one) : null;
+  for (const k of BOX_FIELDS) Object.assign($(`#sel-${k}`), {disabled: !one, value: shown ? shown[k] : ""});
+  $("#sel-apply").disabled = !one;
+  $("#sel-size").textContent = one ? `${one.label} ${one.x1 - one.x0} × ${one.y1 - one.y0}` : "select one rectangle";
+}
+
+function applyBox() {
+  if (ui.selection.size !== 1) return status("The numbers are those of one selected rectangle: select one.", "error");
+  const typed = Object.fromEntries(BOX_FIELDS.map((k) => [k, $(`#sel-${k}`).value]));
+  // a number field reports "" for what it cannot read ("1e", "--2"): say so rather than guess
+  for (const k of BOX_FIELDS) if ($(`#sel-${k}`).validity.badInput) typed[k] = "(not a number)";
+  const {command, error} = setBoxCommand(seg, [...ui.selection][0], typed);
+  if (error) return status(`Not applied: ${error}`, "error");
+  if (!command) return status("The rectangle already has these numbers.");
+  run(command);
+  status(`Set to ${BOX_FIELDS.map((k) => `${k} ${typed[k].trim()}`).join(", ")}.`, "success");
+}
+
+// --- the object list (objects.js): hide and lock are view state, no command -----------------------------------
+function objectList() {
+  buildObjectList($("#objects"), objectGroups(seg, ui.layers), ui.selection, ui.openGroups, {
+    rebuild: objectList,
+    toggle: (kind, label) => {
+      ui.layers = toggleLayer(ui.layers, kind, label);
+      ui.selection = pickableSelection(seg, ui.selection, ui.layers);
+      changed();
+    },
+    select: (id) => {
+      ui.selection = new Set([id]);
+      Object.assign(view, reveal(view, seg.get(id), canvas.width, canvas.height));
+      changed();
+    },
+  });
 }
 
 function run(cmd) {
@@ -61,12 +109,20 @@ function run(cmd) {
 }
 
 // --- view ---------------------------------------------------------------------------------------------------------
-function fit() {
+/** The canvas fills the window below the rows above it (saving and the job stay in view there); the side panel
+ * scrolls on its own beside it. Run again whenever those rows change height (a long message, the job showing). */
+function layout() {
   const box = canvas.parentElement.getBoundingClientRect();
   const top = box.top + window.scrollY;  // the page's layout, whatever it is scrolled to
-  [canvas.width, canvas.height] = [box.width, Math.max(400, window.innerHeight - top - 24)];
-  $(".tools").style.maxHeight = `${canvas.height}px`;  // the side panel scrolls on its own beside the canvas
-  Object.assign(view, fitView(seg.width, seg.height, canvas.width, canvas.height));
+  const [w, h] = [Math.round(box.width), Math.max(400, Math.floor(window.innerHeight - top - 24))];
+  if (canvas.width !== w || canvas.height !== h) [canvas.width, canvas.height] = [w, h];  // a resize clears it
+  for (const panel of document.querySelectorAll(".editor-grid > aside")) panel.style.maxHeight = `${h}px`;
+  draw();
+}
+
+function fit() {
+  layout();
+  if (seg) Object.assign(view, fitView(seg.width, seg.height, canvas.width, canvas.height));
   draw();
 }
 
@@ -100,7 +156,8 @@ function setTool(tool) {
 }
 
 // --- pointer: frontend/tools/ turns presses and moves into previews and commands ----------------------------------
-const toolContext = () => ({seg, selection: ui.selection, label: ui.label, scale: view.scale, snap: $("#snap").checked});
+const toolContext = () => ({seg, selection: ui.selection, label: ui.label, scale: view.scale, snap: $("#snap").checked,
+  layers: ui.layers});
 const pointers = new Map();  // pointerId -> [offsetX, offsetY] while down: two pinch
 
 function pointerOf(e) {
@@ -118,7 +175,10 @@ canvas.addEventListener("pointerdown", (e) => {
     ui.guides = [];
     return draw();
   }
-  const {gesture, selection} = press(ui.tool, pointerOf(e), toolContext(), view, {pan: ui.space || e.button === 1});
+  const pan = ui.space || e.button === 1;
+  // a press on a proposal is the start of a click that rejects it (below): it selects and moves nothing under it
+  if (!pan && proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY))) return;
+  const {gesture, selection} = press(ui.tool, pointerOf(e), toolContext(), view, {pan});
   ui.drag = gesture;
   ui.selection = selection;
   changed();
@@ -173,25 +233,56 @@ canvas.addEventListener("wheel", (e) => {
 
 // proposals: a click rejects (or takes back) one before any tool sees the press
 canvas.addEventListener("click", (e) => {
-  const [x, y] = toImage(e.offsetX, e.offsetY);
-  const p = ui.proposals.find((q) => x >= q.x0 && x < q.x1 && y >= q.y0 && y < q.y1);
+  const p = ui.drag ? null : proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY));
   if (p) { p.accepted = p.accepted === false; draw(); }
 }, true);
 
 // --- keyboard: frontend/keys.js maps keys to actions ---------------------------------------------------------------
+const keyHandlers = {undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: () => removeSelected(),
+  selectAll: () => {  // what can be picked: Ctrl+A then Delete must not remove a hidden or locked class
+    ui.selection = new Set([...seg.rects.values()].filter((r) => pickable(ui.layers, r)).map((r) => r.id));
+    changed();
+  },
+  fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
+  tool: (a) => setTool(a.tool), label: (a) => pickLabel(a.label), accept: () => acceptProposals(),
+  complete: () => completeNow(), similar: () => similar(), help: (a) => showHelp(a.open),
+  applyBox: () => applyBox(),
+  pan: () => { ui.space = true; canvas.style.cursor = "grab"; },
+  nudge: (a) => run(moveRects(seg, [...ui.selection], a.dx, a.dy))};
+const unhandled = ACTIONS.filter((name) => !keyHandlers[name]);
+if (unhandled.length) throw new Error(`keys.js has actions the editor does not handle: ${unhandled.join(", ")}`);
+
 window.addEventListener("keydown", (e) => {
-  if (e.target.closest("input, textarea, select")) return;
-  if (e.key === " ") { ui.space = true; canvas.style.cursor = "grab"; e.preventDefault(); return; }
-  const a = keyAction(e, {selected: ui.selection.size, proposals: ui.proposals.length});
+  const field = e.target.closest("input, textarea, select");
+  const a = keyAction(e, {selected: ui.selection.size, proposals: ui.proposals.length, help: !$("#help").hidden,
+    field: field ? field.id : null, onButton: Boolean(e.target.closest("button, a"))});
   if (!a || (a.action === "complete" && e.repeat)) return;
   if (!["tool", "label", "clear"].includes(a.action)) e.preventDefault();
-  ({undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: removeSelected,
-    selectAll: () => { ui.selection = new Set(seg.rects.keys()); changed(); },
-    fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
-    tool: () => setTool(a.tool), label: () => pickLabel(a.label), accept: acceptProposals, complete: completeNow,
-    nudge: () => run(moveRects(seg, [...ui.selection], a.dx, a.dy))})[a.action]();
+  keyHandlers[a.action](a);
 });
 window.addEventListener("keyup", (e) => { if (e.key === " ") { ui.space = false; setTool(ui.tool); } });
+// A button clicked with the pointer does not take the focus: the keys go on to the canvas, so that Enter accepts
+// proposals rather than pressing the last button clicked again (and leaves a field it was typed in).
+root.addEventListener("mousedown", (e) => {
+  if (!e.target.closest("button, label.button")) return;
+  e.preventDefault();
+  canvas.focus({preventScroll: true});
+});
+
+function showHelp(open) {
+  $("#help").hidden = !open;
+  if (open) $("#help-close").focus({preventScroll: true});  // Escape and Tab start in the dialog
+  else canvas.focus({preventScroll: true});
+}
+
+// brightness and contrast: how the photo is shown, never the photo (nor an undo step)
+function adjustPhoto() {
+  const [brightness, contrast] = [Number($("#brightness").value), Number($("#contrast").value)];
+  ui.photoFilter = photoFilter({brightness, contrast});
+  $("#adjust-reset").disabled = ui.photoFilter === "none";
+  $("#adjust-value").textContent = `${Math.round(100 * brightness)} %, ${Math.round(100 * contrast)} %`;
+  draw();
+}
 
 const removeSelected = () => ui.selection.size && run(new DeleteRects([...ui.selection]));
 
@@ -205,19 +296,39 @@ function duplicate() {
 
 // --- repeat and find similar (frontend/assist.js) ------------------------------------------------------------------
 function repeatSelected() {
-  if (ui.selection.size !== 1) return status("Select one rectangle to repeat.", "error");
   const n = (sel) => Number($(sel).value);
-  run(repeatCommand(seg, [...ui.selection][0], {cols: n("#rep-cols"), rows: n("#rep-rows"), gapX: n("#rep-gapx"),
+  carryOut(repeatSelection(seg, [...ui.selection], {cols: n("#rep-cols"), rows: n("#rep-rows"), gapX: n("#rep-gapx"),
     gapY: n("#rep-gapy")}));
 }
 
+/** Run a {command, message} | {error} plan of assist.js and say what happened; the pieces a split made, or the
+ * copies, become the selection when `select`. */
+function carryOut(plan, select = false) {
+  if (plan.error) return status(plan.error, "error");
+  run(plan.command);
+  if (select && plan.command.ids?.length) ui.selection = new Set(plan.command.ids);
+  status(plan.message, "success");
+  changed();
+}
+
+// run again by Enter in the threshold field (keys.js), with the new threshold; the old proposals go
 function similar() {
-  if (ui.selection.size !== 1) return status("Select one drawn rectangle to look for copies of it.", "error");
+  // with no single selection, while its proposals are shown, the search runs again for the rectangle it ran for
+  const again = ui.proposalsFrom === "find similar" && ui.proposals.length && seg.rects.has(ui.similarSource);
+  if (ui.selection.size !== 1 && !again) {
+    return status(`Find similar looks for copies of one rectangle, and ${ui.selection.size} are selected.`, "error");
+  }
+  const source = ui.selection.size === 1 ? [...ui.selection][0] : ui.similarSource;
+  const field = $("#sim-threshold"), threshold = Number(field.value);
+  if (!(field.value !== "" && threshold >= Number(field.min) && threshold <= Number(field.max))) {
+    return status(`The threshold must be a number from ${field.min} to ${field.max}.`, "error");
+  }
   gray = gray || grayPixels(photo, seg.width, seg.height);
-  ui.proposals = similarProposals(gray, seg, [...ui.selection][0], Number($("#sim-threshold").value));
-  ui.proposalsFrom = "find similar";
-  status(ui.proposals.length ? `${ui.proposals.length} proposals: click one to reject it, Enter or "Accept" to add ` +
-    "the rest." : "No similar places found.");
+  ui.proposals = similarProposals(gray, seg, source, threshold);
+  [ui.proposalsFrom, ui.similarSource] = ["find similar", source];
+  status(ui.proposals.length ? `${ui.proposals.length} proposals at threshold ${threshold}: click one to reject it; ` +
+    '"Accept" or Enter adds the rest (Enter in the threshold field searches again).'
+    : `No similar places found at threshold ${threshold}.`);
   draw();
 }
 
@@ -322,23 +433,37 @@ on("#undo", "click", () => history.undo());
 on("#redo", "click", () => history.redo());
 on("#delete", "click", removeSelected);
 on("#duplicate", "click", duplicate);
-on("#repeat", "click", () => { try { repeatSelected(); } catch (err) { status(err.message, "error"); } });
+on("#repeat", "click", repeatSelected);
+on("#repeat-edge", "click", () => carryOut(repeatByPitch(seg, [...ui.selection])));
+on("#split", "click", () => carryOut(splitCommand(seg, [...ui.selection], {n: Number($("#split-n").value),
+  direction: $("#split-dir").value, gap: Number($("#split-gap").value)}), true));
 on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
 on("#complete", "click", completeNow);
 on("#fit", "click", fit);
+on("#sel-apply", "click", applyBox);
+on("#help-open", "click", () => showHelp(true));
+on("#help-close", "click", () => showHelp(false));
+on("#help", "click", (e) => { if (e.target.id === "help") showHelp(false); });  // a click beside the dialog
 on("#export", "click", () => download(seg.toJSON(), `segmentation-${photoCode.slice(0, 8)}.json`));
 on("#import", "change", (e) => e.target.files[0] && importJSON(e.target.files[0]));
 on("#save", "click", saveNow);
 on("#submit", "click", submitNow);
 on("#fill", "input", draw);
+on("#brightness", "input", adjustPhoto);
+on("#contrast", "input", adjustPhoto);
+on("#adjust-reset", "click", () => { $("#brightness").value = $("#contrast").value = 1; adjustPhoto(); });
 on("#overlay-alpha", "input", (e) => { ui.overlayAlpha = Number(e.target.value); draw(); });
 on("#rectify", "click", openRectify);
 on("#rectify-apply", "click", applyRectify);
 on("#rectify-cancel", "click", () => { rectifying = null; $("#rectify-panel").hidden = true; draw(); });
 window.addEventListener("resize", fit);
+const rows = new ResizeObserver(layout);
+for (const bar of document.querySelectorAll(".editor-bar")) rows.observe(bar);
 window.addEventListener("beforeunload", (e) => { if (history?.dirty) { e.preventDefault(); e.returnValue = ""; } });
 setTool("draw");
+buildHelp($("#help-body"));
+adjustPhoto();
 load().catch((err) => status(`Could not load the photo: ${err.message}`, "error"));
 
 // for tests and the console

@@ -46,15 +46,19 @@ export function moveWithin(r, dx, dy, width, height) {
 
 export const HANDLES = ["nw", "n", "ne", "e", "se", "s", "sw", "w"];
 
-/** The rectangle with the edges named by a handle ("nw", "e", ...) moved to (x, y). */
-export function resize(r, handle, x, y) {
+/** The rectangle with the edges named by a handle ("nw", "e", ...) moved to (x, y), not normalized: a handle
+ * dragged across the opposite edge keeps its name (x0 may pass x1), so that snapping moves the dragged edge. */
+export function dragEdges(r, handle, x, y) {
   const out = {...r};
   if (handle.includes("n")) out.y0 = y;
   if (handle.includes("s")) out.y1 = y;
   if (handle.includes("w")) out.x0 = x;
   if (handle.includes("e")) out.x1 = x;
-  return normalize(out);
+  return out;
 }
+
+/** The rectangle with the edges named by a handle moved to (x, y). */
+export const resize = (r, handle, x, y) => normalize(dragEdges(r, handle, x, y));
 
 /** Handle positions of a rectangle: {name: [x, y]}. */
 export function handlePoints(r) {

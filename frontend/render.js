@@ -4,6 +4,7 @@
 import {handlePoints, normalize} from "./geometry.js";
 import {cssColor} from "./labels.js";
 import {toGray} from "./match.js";
+import {shown} from "./objects.js";
 
 /** The photo's gray levels at its own size, for `match.findSimilar`. */
 export function grayPixels(photo, width, height) {
@@ -16,21 +17,25 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
   const sx = (x) => x * view.scale + view.ox;
   const sy = (y) => y * view.scale + view.oy;
   const box = (r) => [sx(r.x0), sy(r.y0), (r.x1 - r.x0) * view.scale, (r.y1 - r.y0) * view.scale];
-  const stroke = (r, color, width = 1, dash = []) => {
+  const stroke = (r, color, width = 1, dash = []) => {  // on whole pixels: crisp edges at any zoom
     ctx.setLineDash(dash);
     ctx.strokeStyle = color;
     ctx.lineWidth = width;
-    ctx.strokeRect(sx(r.x0) + 0.5, sy(r.y0) + 0.5, (r.x1 - r.x0) * view.scale, (r.y1 - r.y0) * view.scale);
+    const [x0, y0] = [Math.round(sx(r.x0)), Math.round(sy(r.y0))];
+    ctx.strokeRect(x0 + 0.5, y0 + 0.5, Math.round(sx(r.x1)) - x0, Math.round(sy(r.y1)) - y0);
     ctx.setLineDash([]);
   };
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.fillStyle = "#2a2f36";
   ctx.fillRect(0, 0, canvas.width, canvas.height);
   ctx.imageSmoothingEnabled = view.scale < 1;
+  ctx.filter = ui.photoFilter || "none";  // brightness and contrast of the photo layer alone
   ctx.drawImage(photo, view.ox, view.oy, seg.width * view.scale, seg.height * view.scale);
+  ctx.filter = "none";
   const drag = ui.drag;
   const preview = drag?.preview || new Map();
   for (const r0 of seg.paintOrder()) {
+    if (!shown(ui.layers, r0)) continue;  // a hidden class (the object list)
     const r = preview.get(r0.id) || r0;
     ctx.fillStyle = cssColor(r.label, fill);
     ctx.fillRect(...box(r));
@@ -54,10 +59,11 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
   if (drag?.kind === "marquee") stroke(normalize(drag.box), "#9cf", 1, [3, 3]);
   ctx.strokeStyle = "#ff4fd8";
   ctx.lineWidth = 1;
-  for (const g of ui.guides) {
+  for (const g of ui.guides) {  // on the middle of a whole pixel: a crisp line, not two half-bright ones
     ctx.beginPath();
-    if (g.axis === "x") { ctx.moveTo(sx(g.at) + 0.5, 0); ctx.lineTo(sx(g.at) + 0.5, canvas.height); }
-    else { ctx.moveTo(0, sy(g.at) + 0.5); ctx.lineTo(canvas.width, sy(g.at) + 0.5); }
+    const [gx, gy] = [Math.round(sx(g.at)) + 0.5, Math.round(sy(g.at)) + 0.5];
+    if (g.axis === "x") { ctx.moveTo(gx, 0); ctx.lineTo(gx, canvas.height); }
+    else { ctx.moveTo(0, gy); ctx.lineTo(canvas.width, gy); }
     ctx.stroke();
   }
   if (ui.overlay) {

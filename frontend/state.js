@@ -62,12 +62,12 @@ export class Segmentation {
     return [...this.rects.values()].sort((a, b) => priority(a.label) - priority(b.label) || a.id - b.id);
   }
 
-  /** The topmost record at (x, y) in the paint order, or null. */
-  topAt(x, y) {
+  /** The topmost record at (x, y) in the paint order among those `accept` takes, or null. */
+  topAt(x, y, accept = () => true) {
     const order = this.paintOrder();
     for (let i = order.length - 1; i >= 0; i--) {
       const r = order[i];
-      if (x >= r.x0 && x < r.x1 && y >= r.y0 && y < r.y1) return r;
+      if (x >= r.x0 && x < r.x1 && y >= r.y0 && y < r.y1 && accept(r)) return r;
     }
     return null;
   }

@@ -1,6 +1,7 @@
 // Selecting by a box: every rectangle it touches joins the selection, except the facade rectangles, which lie
-// under everything and would always be caught.
+// under everything and would always be caught, and the hidden and locked classes.
 import {intersects, normalize} from "../geometry.js";
+import {pickable} from "../objects.js";
 
 export class MarqueeGesture {
   constructor(pointer) {
@@ -18,7 +19,9 @@ export class MarqueeGesture {
   up(ctx) {
     const box = normalize(this.box);
     const selection = new Set(ctx.selection);
-    for (const r of ctx.seg.rects.values()) if (intersects(r, box) && r.label !== "facade") selection.add(r.id);
+    for (const r of ctx.seg.rects.values()) {
+      if (intersects(r, box) && r.label !== "facade" && pickable(ctx.layers, r)) selection.add(r.id);
+    }
     return {selection};
   }
 }

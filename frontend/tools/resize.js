@@ -1,6 +1,6 @@
 // Resizing one rectangle by a handle: the handle's edges follow the pointer and snap; the rest stays.
 import {UpdateRects} from "../commands.js";
-import {clampToImage, resize} from "../geometry.js";
+import {clampToImage, dragEdges} from "../geometry.js";
 import {snapped} from "./context.js";
 
 export class ResizeGesture {
@@ -18,8 +18,9 @@ export class ResizeGesture {
     if (this.handle.includes("s")) edges.push("y1");
     if (this.handle.includes("w")) edges.push("x0");
     if (this.handle.includes("e")) edges.push("x1");
-    const s = snapped(ctx, resize(r, this.handle, pointer.x, pointer.y), new Set([this.id]), edges, pointer);
-    const box = clampToImage(s.rect, ctx.seg.width, ctx.seg.height);
+    // snapped before normalizing: past the opposite edge the dragged edge is still the one named by the handle
+    const s = snapped(ctx, dragEdges(r, this.handle, pointer.x, pointer.y), new Set([this.id]), edges, pointer);
+    const box = clampToImage(s.rect, ctx.seg.width, ctx.seg.height);  // normalizes
     this.preview = box ? new Map([[this.id, {...r, ...box}]]) : new Map();
     return {guides: s.guides};
   }

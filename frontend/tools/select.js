@@ -5,7 +5,9 @@
 //   - the select tool, on a rectangle: select it (Shift toggles it) and move the selection; a press inside the
 //     selection grabs it even where another class paints on top;
 //   - the select tool, on nothing: a marquee (Shift keeps the selection).
+// Hidden and locked classes (ctx.layers) are passed through.
 import {contains, handleAt} from "../geometry.js";
+import {pickable} from "../objects.js";
 import {HANDLE_PX} from "./context.js";
 import {DrawGesture} from "./draw.js";
 import {MarqueeGesture} from "./marquee.js";
@@ -24,7 +26,8 @@ export function press(tool, pointer, ctx, view, {pan = false} = {}) {
   }
   if (tool === "draw") return {gesture: new DrawGesture(pointer), selection};
   const inside = [...selection].map((id) => ctx.seg.get(id)).find((r) => contains(r, pointer.x, pointer.y));
-  const hit = inside && !pointer.shift ? inside : ctx.seg.topAt(pointer.x, pointer.y);
+  // hidden and locked classes are not hit: a press goes through them to what lies below
+  const hit = inside && !pointer.shift ? inside : ctx.seg.topAt(pointer.x, pointer.y, (r) => pickable(ctx.layers, r));
   if (!hit) {
     if (!pointer.shift) selection.clear();
     return {gesture: new MarqueeGesture(pointer), selection};

@@ -1,0 +1,388 @@
+"""The editor's panels and helpers in Debian's Chromium: the layout on a 1280x720 screen (saving and the job in
+view), and the side panels' tools."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+
+import pytest
+from editor_helpers import WINDOWS, E, drag, open_editor, rects, screen, selected
+from site_helpers import login
+
+from webapp.facades.models import Segmentation
+
+pytestmark = [pytest.mark.django_db(transaction=True),
+              pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
+
+
+@pytest.fixture
+def editor(live_server, as_alice, browser):
+    page, context = open_editor(live_server, as_alice, browser)
+    yield page
+    assert page.errors == []
+    context.close()
+
+
+@pytest.fixture
+def small_screen(live_server, facade_photo, browser):
+    """The editor on a 1280x720 screen, open on a generated facade of some 300 rectangles (its label map as the
+    photo)."""
+    photo, seg = facade_photo
+    context = browser.new_context(viewport={"width": 1280, "height": 720})
+    page = context.new_page()
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
+    page.wait_for_function(f"{E}?.seg?.size === {seg['rect_count']}")
+    yield page
+    assert errors == []
+    context.close()
+
+
+def in_view(page, selector: str) -> bool:
+    """Is the element wholly inside the window, the page not scrolled?"""
+    b = page.locator(selector).bounding_box()
+    return b is not None and b["x"] >= 0 and b["y"] >= 0 and b["x"] + b["width"] <= 1280 and b["y"] + b["height"] <= 720
+
+
+def test_at_1280x720_the_canvas_saving_and_the_job_are_in_view(small_screen, tmp_path):
+    page = small_screen
+    hint = page.text_content("#status")
+    # the job and its result as submitting shows them, with a message long enough to wrap: the rows above the
+    # canvas grow, and the canvas shrinks to stay on the screen
+    page.evaluate("""() => {
+      document.querySelector('#job').hidden = false;
+      document.querySelector('#job-status').textContent = 'running (decoding)';
+      document.querySelector('#result').hidden = false;
+      document.querySelector('#status').textContent = 'A long message '.repeat(12);
+    }""")
+    page.wait_for_function("document.querySelector('#canvas').getBoundingClientRect().bottom <= innerHeight")
+    assert page.evaluate("scrollY") == 0
+    for selector in ("#canvas", "#save", "#submit", "#k", "#job-progress", "#job-status", "#result-link"):
+        assert in_view(page, selector), selector
+    # the side panel scrolls on its own: no taller than the canvas
+    panel, canvas = (page.locator(s).bounding_box() for s in (".tools", "#canvas"))
+    assert panel["height"] <= canvas["height"] + 1
+    assert page.eval_on_selector(".tools", "p => p.scrollHeight > p.clientHeight")
+    # the picture for docs/img/editor-1280x720.png: a window selected from the object list, its numbers shown
+    page.click("#objects details[data-label=window] summary .name")
+    page.click("#objects details[data-label=window] ol button")
+    assert page.input_value("#sel-x0") == str(selected(page)[0]["x0"]) and selected(page)[0]["label"] == "window"
+    page.evaluate("hint => { document.querySelector('#job-status').textContent = 'done'; "
+                  "document.querySelector('#job-progress').value = 1; "
+                  "document.querySelector('#status').textContent = hint; }", hint)
+    assert all(in_view(page, s) for s in ("#canvas", "#save", "#submit", "#job-progress", "#result-link"))
+    path = os.environ.get("FACAID_EDITOR_SCREENSHOT") or str(tmp_path / "editor-1280x720.png")
+    page.screenshot(path=path)
+    assert page.evaluate(f"{E}.history.canUndo") is False
+
+
+def select_window(page, x: int, y: int, shift: bool = False) -> None:
+    page.keyboard.press("v")
+    if shift:
+        page.keyboard.down("Shift")
+    page.mouse.click(*screen(page, x + 10, y + 10))
+    if shift:
+        page.keyboard.up("Shift")
+
+
+def test_enter_in_the_threshold_field_searches_again_and_enter_elsewhere_accepts(editor):
+    page = editor
+    select_window(page, *WINDOWS[0])
+    page.click("#similar")
+    assert len(page.evaluate(f"{E}.ui.proposals")) == 5
+    assert "at threshold 0.8" in page.text_content("#status")
+    # the click left the focus off the button: Enter does not press "Find similar" again
+    assert page.evaluate("document.activeElement.id") != "similar"
+    page.mouse.click(*screen(page, WINDOWS[1][0] + 20, WINDOWS[1][1] + 20))  # reject one
+    assert page.evaluate(f"{E}.ui.proposals.filter(p => p.accepted === false).length") == 1
+    # a new threshold and Enter in its field: a new search (nothing added, the rejection gone), focus kept there
+    page.fill("#sim-threshold", "0.9")
+    page.press("#sim-threshold", "Enter")
+    assert "at threshold 0.9" in page.text_content("#status")
+    assert page.evaluate(f"{E}.ui.proposals.filter(p => p.accepted === false).length") == 0
+    assert len(rects(page)) == 2 and page.evaluate("document.activeElement.id") == "sim-threshold"
+    # out of range: refused with the range, the proposals kept
+    page.fill("#sim-threshold", "5")
+    page.press("#sim-threshold", "Enter")
+    assert page.text_content("#status") == "The threshold must be a number from 0.3 to 1."
+    assert len(page.evaluate(f"{E}.ui.proposals")) == 5
+    # back on the canvas, Enter accepts the proposals: one step of five windows
+    page.focus("#canvas")
+    page.keyboard.press("Enter")
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 6
+
+
+def test_repeat_with_several_selected_says_so_and_each_press_leaves_its_own_message(editor):
+    page = editor
+    select_window(page, *WINDOWS[0])
+    page.fill("#rep-cols", "3")
+    page.fill("#rep-gapx", "80")
+    page.click("#repeat")
+    assert page.text_content("#status") == "Added 2 window copies (3 × 1)."
+    assert len(rects(page)) == 4
+    # two selected: refused, the message about this press (not the last success), nothing added
+    page.keyboard.press("Escape")
+    select_window(page, *WINDOWS[0])
+    select_window(page, WINDOWS[1][0], WINDOWS[1][1], shift=True)
+    assert page.evaluate(f"{E}.ui.selection.size") == 2
+    page.click("#repeat")
+    assert page.text_content("#status") == ('Repeat copies one rectangle, and 2 are selected: select one of them, or '
+                                            '"Repeat to the edge" to repeat the two at their pitch.')
+    assert "error" in page.get_attribute("#status", "class")
+    assert len(rects(page)) == 4
+    page.keyboard.press("Escape")
+    page.click("#repeat")
+    assert page.text_content("#status") == "Repeat copies the selected rectangle: select one first."
+
+
+def test_the_shortcuts_help_lists_the_key_table_opens_on_question_mark_and_closes_on_escape(editor):
+    page = editor
+    select_window(page, *WINDOWS[0])
+    assert page.is_hidden("#help")
+    page.keyboard.press("?")
+    assert page.is_visible("#help")
+    # the rows are keys.js's table, as the page loaded it
+    table = page.evaluate("import('/static/editor/keys.js').then(k => k.shortcutRows())")
+    shown = page.eval_on_selector_all("#help-body section:first-child tr", "rows => rows.map(r => "
+                                      "({keys: r.cells[0].textContent, does: r.cells[1].textContent}))")
+    assert shown == table and len(shown) >= 15
+    assert {"keys": "Ctrl+Shift+Z / Ctrl+Y", "does": "redo"} in shown
+    assert page.locator("#help-body").get_by_text("no snapping").is_visible()
+    # while it is open the keys do not reach the editor; Escape closes it and leaves the selection alone
+    page.keyboard.press("r")
+    assert page.evaluate(f"{E}.ui.tool") == "select"
+    page.keyboard.press("Escape")
+    assert page.is_hidden("#help") and page.evaluate(f"{E}.ui.selection.size") == 1
+    # the button opens it, its Close button and a click beside the dialog close it
+    page.click("#help-open")
+    assert page.is_visible("#help")
+    page.click("#help-close")
+    assert page.is_hidden("#help")
+    page.click("#help-open")
+    page.mouse.click(5, 700)
+    assert page.is_hidden("#help")
+    page.keyboard.press("Escape")  # closed, Escape clears the selection as before
+    assert page.evaluate(f"{E}.ui.selection.size") == 0
+
+
+def canvas_pixel(page, x: float, y: float) -> list[int]:
+    """The canvas's RGB at image point (x, y), the pixel an outline along that edge is drawn on."""
+    return page.evaluate(f"""(() => {{
+      const v = {E}.view, c = document.querySelector('#canvas');
+      return [...c.getContext('2d').getImageData(Math.round(v.ox + {x} * v.scale), Math.round(v.oy + {y} * v.scale),
+        1, 1).data].slice(0, 3);
+    }})()""")
+
+
+def set_range(page, selector: str, value: float) -> None:
+    page.eval_on_selector(selector, f"e => {{ e.value = {value}; e.dispatchEvent(new Event('input')); }}")
+
+
+def test_brightness_and_contrast_change_the_photo_shown_not_the_rectangles_nor_the_photo(editor):
+    page = editor
+    requests = []
+    page.on("request", lambda r: requests.append(r.url))
+    set_range(page, "#fill", 0)  # the photo alone inside the rectangles, their outlines on top
+    wall = (30, 30)  # inside the facade, away from the windows
+    outline = (WINDOWS[0][0] + 30, WINDOWS[0][1])  # the window's top edge, drawn over the photo
+    before, edge = canvas_pixel(page, *wall), canvas_pixel(page, *outline)
+    assert page.is_disabled("#adjust-reset")
+    set_range(page, "#brightness", 2)
+    brighter = canvas_pixel(page, *wall)
+    assert all(b >= min(255, 1.8 * a) for a, b in zip(before, brighter, strict=True)), (before, brighter)
+    assert canvas_pixel(page, *outline) == edge  # the rectangles are drawn as before
+    set_range(page, "#brightness", 1)
+    set_range(page, "#contrast", 0.2)
+    flat = canvas_pixel(page, *wall)
+    assert max(abs(c - 128) for c in flat) < max(abs(c - 128) for c in before)  # pulled toward mid gray
+    assert page.text_content("#adjust-value") == "100 %, 20 %" and not page.is_disabled("#adjust-reset")
+    # nothing was sent, nothing to undo, nothing to save; Reset shows the photo as it is
+    assert requests == [] and not page.evaluate(f"{E}.history.canUndo") and page.text_content("#dirty") == "saved"
+    page.click("#adjust-reset")
+    assert canvas_pixel(page, *wall) == before and page.is_disabled("#adjust-reset")
+    assert page.input_value("#brightness") == "1" and page.input_value("#contrast") == "1"
+    # find similar reads the photo, not the view: the same five windows with the photo shown darker
+    set_range(page, "#brightness", 0.3)
+    select_window(page, *WINDOWS[0])
+    page.click("#similar")
+    assert len(page.evaluate(f"{E}.ui.proposals")) == 5
+
+
+
+def test_object_list_selects_and_hides_or_locks_a_class_without_changing_what_is_saved(editor):
+    page = editor
+    wx, wy = WINDOWS[0]
+    summary = "#objects details[data-label={}] summary"
+    assert page.text_content(summary.format("window") + " .name") == "window 1"
+    assert page.text_content(summary.format("facade") + " .name") == "facade 1"
+    set_range(page, "#fill", 0)
+    outline = canvas_pixel(page, wx + 30, wy)  # the window's top edge, not selected
+    # an entry selects its rectangle
+    page.click(summary.format("window") + " .name")
+    page.click("#objects details[data-label=window] ol button")
+    assert [r["label"] for r in selected(page)] == ["window"]
+    # locked: drawn, but its entry disabled (and greyed), dropped from the selection, a press goes to the wall
+    page.click(summary.format("window") + " button.locked")
+    assert page.evaluate(f"{E}.ui.selection.size") == 0 and "locked: window" in page.text_content("#count")
+    entry = "#objects details[data-label=window] ol button"
+    assert page.is_disabled(entry)
+    assert page.eval_on_selector(entry, "b => getComputedStyle(b).cursor") == "not-allowed"
+    assert canvas_pixel(page, wx + 30, wy) == outline
+    page.keyboard.press("v")
+    page.mouse.click(*screen(page, wx + 10, wy + 10))
+    assert [r["label"] for r in selected(page)] == ["facade"]
+    page.keyboard.press("Control+a")
+    assert [r["label"] for r in selected(page)] == ["facade"]
+    page.keyboard.press("Escape")
+    # the wall locked too: a drag over the window draws a box, moving nothing
+    page.click(summary.format("facade") + " button.locked")
+    before = rects(page)
+    drag(page, (wx + 10, wy + 10), (wx + 40, wy + 40))
+    assert rects(page) == before and not page.evaluate(f"{E}.history.canUndo")
+    # hidden: not drawn (the outline is gone), not hit; Delete after Ctrl+A removes nothing of it
+    page.click(summary.format("window") + " button.locked")
+    page.click(summary.format("window") + " button.hidden")
+    assert "hidden: window; locked: facade" in page.text_content("#count")
+    assert canvas_pixel(page, wx + 30, wy) != outline
+    page.mouse.click(*screen(page, wx + 10, wy + 10))
+    assert page.evaluate(f"{E}.ui.selection.size") == 0
+    page.keyboard.press("Control+a")
+    page.keyboard.press("Delete")
+    assert len(rects(page)) == 2
+    # none of it was an edit: nothing to undo, "saved", and a save stores both rectangles
+    assert not page.evaluate(f"{E}.history.canUndo") and page.text_content("#dirty") == "saved"
+    page.click("#save")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Saved')")
+    latest = Segmentation.objects.filter(photo__code=page.photo["code"]).order_by("-version").first()
+    assert latest.version == 2 and sorted(r["label"] for r in latest.data["rects"]) == ["facade", "window"]
+    # shown again: drawn and picked as before
+    page.click(summary.format("window") + " button.hidden")
+    assert canvas_pixel(page, wx + 30, wy) == outline
+    page.mouse.click(*screen(page, wx + 10, wy + 10))
+    assert [r["label"] for r in selected(page)] == ["window"]
+
+
+def guide_seen(page, x: float) -> bool:
+    """Is a snap guide (magenta) drawn down the canvas at image x, in its top rows?"""
+    return page.evaluate(f"""(() => {{
+      const v = {E}.view, c = document.querySelector('#canvas'), sx = Math.floor(v.ox + {x} * v.scale);
+      const d = c.getContext('2d').getImageData(sx - 1, 3, 3, 1).data;
+      return [0, 4, 8].some((i) => d[i] > 200 && d[i + 1] < 140 && d[i + 2] > 170);
+    }})()""")
+
+
+def test_snapping_is_a_few_screen_pixels_at_two_zooms_with_a_guide_while_it_snaps(editor):
+    page = editor
+    wx, wy = WINDOWS[0]
+    right = wx + 60  # the window's right edge
+    page.keyboard.press("4")  # door
+
+    def draw_to(screen_px):
+        """Draw a door whose moving corner ends `screen_px` screen pixels right of the window's right edge:
+        (its left edge, whether a guide showed before the release)."""
+        s = page.evaluate(f"{E}.view.scale")
+        page.mouse.move(*screen(page, right + 30, wy + 150))
+        page.mouse.down()
+        page.mouse.move(*screen(page, right + screen_px / s, wy + 110), steps=5)
+        seen = guide_seen(page, right)
+        page.mouse.up()
+        x0 = selected(page)[0]["x0"]
+        page.keyboard.press("Control+z")
+        return x0, seen
+
+    for zoom in ("fit", "zoomed"):
+        if zoom == "zoomed":  # about 3.3 times closer, about the window's right edge
+            for _ in range(2):
+                page.mouse.move(*screen(page, right + 10, wy + 120))
+                page.mouse.wheel(0, -400)
+                page.wait_for_timeout(50)
+        s = page.evaluate(f"{E}.view.scale")
+        assert (s > 4) == (zoom == "zoomed"), s
+        # 3 screen pixels: snapped onto the edge, the guide shown while dragging
+        assert draw_to(3) == (right, True), zoom
+        # 12 screen pixels (at the higher zoom under 2 image pixels): left where the pointer was, no guide
+        x0, seen = draw_to(12)
+        assert x0 == pytest.approx(right + 12 / s, abs=1.01) and x0 != right and not seen, zoom
+
+
+def test_exact_numbers_of_one_selection_are_one_undo_step_and_bad_ones_are_refused(editor):
+    page = editor
+    wx, wy = WINDOWS[0]
+    assert page.is_disabled("#sel-x0") and page.is_disabled("#sel-apply")  # nothing selected
+    select_window(page, wx, wy)
+    assert [page.input_value(f"#sel-{k}") for k in ("x0", "y0", "x1", "y1")] == ["60", "60", "120", "150"]
+    assert page.text_content("#sel-size") == "window 60 × 90"
+    # typed and applied with Enter: one step, the fields and the size follow
+    page.fill("#sel-x1", "130")
+    page.fill("#sel-y0", "55")
+    page.press("#sel-y0", "Enter")
+    assert selected(page)[0] | {"id": 0} == {"id": 0, "label": "window", "x0": 60, "y0": 55, "x1": 130, "y1": 150}
+    assert page.text_content("#sel-size") == "window 70 × 95" and page.text_content("#status").startswith("Set to")
+    page.click("#undo")
+    assert selected(page)[0]["x1"] == 120 and page.input_value("#sel-x1") == "120"
+    assert not page.evaluate(f"{E}.history.canUndo")
+    # refused, with the field named, and nothing changed or recorded
+    for field, value, message in [("x1", "481", "x1 must be at most the image's width, 480, not 481."),
+                                  ("x1", "50", "x1 must be greater than x0 (60), not 50."),
+                                  ("y0", "-3", "y0 must be at least 0, not -3."),
+                                  ("x0", "2.5", 'x0 must be a whole number of pixels, not "2.5".')]:
+        page.fill(f"#sel-{field}", value)
+        page.click("#sel-apply")
+        assert page.text_content("#status") == f"Not applied: {message}"
+        assert "error" in page.get_attribute("#status", "class")
+        assert selected(page)[0]["x1"] == 120 and not page.evaluate(f"{E}.history.canUndo")
+        page.fill(f"#sel-{field}", {"x1": "120", "y0": "60", "x0": "60"}[field])
+    # two selected: no numbers to edit
+    select_window(page, *WINDOWS[0])
+    page.keyboard.press("Control+a")
+    assert page.is_disabled("#sel-x0") and page.input_value("#sel-x0") == ""
+
+
+
+def test_repeat_to_the_edge_from_two_examples_and_split_into_columns_each_one_undo_step(editor, tmp_path):
+    page = editor
+    # a wall from x 20 to 460 and two windows of a row, 140 px apart (the photo's own pitch)
+    path = tmp_path / "two.json"
+    path.write_text(json.dumps({"width": 480, "height": 360, "rects": [
+        {"label": "facade", "x0": 20, "y0": 0, "x1": 460, "y1": 360},
+        {"label": "window", "x0": 200, "y0": 60, "x1": 260, "y1": 150},
+        {"label": "window", "x0": 340, "y0": 60, "x1": 400, "y1": 150}]}))
+    page.set_input_files("#import", str(path))
+    page.wait_for_function(f"{E}.seg.size === 3")
+    steps = page.evaluate(f"{E}.history.done.length")
+    select_window(page, 200, 60)
+    select_window(page, 340, 60, shift=True)
+    page.click("#repeat-edge")
+    assert page.text_content("#status") == "Added 1 window copy at a pitch of 140, 0 px, to the facade's edge."
+    windows = sorted((r["x0"], r["y0"], r["x1"], r["y1"]) for r in rects(page) if r["label"] == "window")
+    assert windows == [(60, 60, 120, 150), (200, 60, 260, 150), (340, 60, 400, 150)]
+    assert page.evaluate(f"{E}.history.done.length") == steps + 1
+    # one selected: no pitch to measure, refused with the count
+    page.keyboard.press("Escape")
+    select_window(page, 60, 60)
+    page.click("#repeat-edge")
+    assert "and 1 is selected" in page.text_content("#status")
+    page.click("#undo")
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 2
+    # split the first window into three columns with 3 px gaps: one step, the pieces selected
+    page.keyboard.press("Escape")
+    select_window(page, 200, 60)
+    page.fill("#split-n", "3")
+    page.select_option("#split-dir", "columns")
+    page.fill("#split-gap", "3")
+    page.click("#split")
+    assert page.text_content("#status") == "Split the window into 3 columns with gaps of 3 px."
+    pieces = sorted((r["x0"], r["x1"], r["y0"], r["y1"]) for r in selected(page))
+    assert pieces == [(200, 218, 60, 150), (221, 239, 60, 150), (242, 260, 60, 150)]
+    page.click("#undo")
+    assert sorted(r["x0"] for r in rects(page) if r["label"] == "window") == [200, 340]
+    # too many pieces for the width: refused, nothing changed
+    select_window(page, 200, 60)
+    page.fill("#split-n", "40")
+    page.click("#split")
+    assert page.text_content("#status") == "40 columns with gaps of 3 px do not fit in 60 px."
+    assert len(rects(page)) == 3
