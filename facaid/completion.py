@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from facaid import appearance
 from facaid.defaults import DEFAULT_MIN_SCORE
 from facaid.labels import BACKGROUND, FACADE, LABELS, PRIORITY
 from facaid.segmentation import Segmentation, aligned_lines, parse_segmentation
@@ -56,6 +57,11 @@ GRID_FILL = 0.8  # a crossing of drawn lines scores high only where the type's l
 FLOOR_MIN_ROW = 2  # a row is continued from a neighbouring one of at least this many elements
 FLOOR_STRAYS = 0.5  # ... when at most this many of the begun row's elements per aligned one stray off its columns
 COLUMN_TOLERANCE = 0.3  # elements whose left edges agree within this share of the width stand in one column
+
+
+PHOTO_CANDIDATE = 0.7  # proposals scored at least this by the structure are shown to the photo
+PHOTO_MATCH = 0.8  # NCC against the drawn examples of the class at which the photo confirms a proposal
+PHOTO_CONFIRMED = 0.9  # ... and the score it has at least then
 
 
 class RejectedError(ValueError):
@@ -301,6 +307,26 @@ def _companions(types: list[_Type], props: _Proposals) -> None:
                 props.add(s.label, anchor + offset, round(0.3 + 0.5 * share, 3), f"with {LABELS[a.label]}")
 
 
+def _photo_check(photo: Any, seg: Segmentation, props: _Proposals) -> dict[int, tuple[float, float, np.ndarray]]:
+    """{item: (score, similarity, box)} for the proposals the photo has a say on: each is moved to where it looks
+    most like the drawn elements of its class (`facaid.appearance.refine`); one that looks like them scores at least
+    `PHOTO_CONFIRMED`, one that does not half its structural score; a flat place or class keeps its score."""
+    levels = appearance.grey(photo, seg.width, seg.height)
+    out: dict[int, tuple[float, float]] = {}
+    items = [i for i, item in enumerate(props.items) if item[2] >= PHOTO_CANDIDATE]
+    for label in sorted({props.items[i][0] for i in items}):
+        mine = [i for i in items if props.items[i][0] == label]
+        examples = props.drawn[props.drawn[:, 0] == label, 1:]
+        boxes, sims = appearance.refine(levels, props.boxes[mine], examples)
+        for i, box, sim in zip(mine, boxes, sims.tolist(), strict=True):
+            if np.isnan(sim):
+                continue
+            score = props.items[i][2]
+            score = max(score, PHOTO_CONFIRMED) if sim >= PHOTO_MATCH else 0.5 * score
+            out[i] = (round(float(score), 3), round(float(sim), 3), box)
+    return out
+
+
 def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: list[dict] | None = None,
              min_score: float = DEFAULT_MIN_SCORE) -> list[dict]:
     """Proposed missing elements for a partly drawn segmentation (a `Segmentation` or its JSON object): dicts
@@ -308,7 +334,6 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
     ``rejected`` boxes (the same contract) are not proposed again. See the module's docstring. Raises
     `SegmentationError` (a ValueError) naming the field for a bad segmentation, `RejectedError` (a ValueError)
     for a bad rejected box, ValueError for more than `MAX_DRAWN` rectangles or ``min_score`` outside [0, 1]."""
-    del photo  # the photo check comes with the editor's completion; structure alone proposes for now
     seg = segmentation if isinstance(segmentation, Segmentation) else parse_segmentation(segmentation)
     rows = seg.to_array()
     if len(rows) > MAX_DRAWN:
@@ -330,8 +355,15 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
     for t in types:
         _lattice(t, props)
     _companions(types, props)
-    out = [{"label": LABELS[label], "x0": int(b[0]), "y0": int(b[1]), "x1": int(b[2]), "y1": int(b[3]),
-            "score": round(float(score), 3), "reason": reason} for label, b, score, reason in props.items
-           if score >= min_score]
+    looks = _photo_check(photo, seg, props) if photo is not None else {}
+    out = []
+    for i, (label, b, score, reason) in enumerate(props.items):
+        p = {"label": LABELS[label], "x0": int(b[0]), "y0": int(b[1]), "x1": int(b[2]), "y1": int(b[3]),
+             "score": round(float(score), 3), "reason": reason}
+        if i in looks:
+            p["score"], p["photo"], box = looks[i]
+            p.update(x0=int(box[0]), y0=int(box[1]), x1=int(box[2]), y1=int(box[3]))
+        if p["score"] >= min_score:
+            out.append(p)
     out.sort(key=lambda p: (-p["score"], p["y0"], p["x0"]))
     return out

@@ -1,0 +1,104 @@
+"""Appearance in a photo: how much a place looks like the examples drawn of its class.
+
+Each box is cut out of the photo's grey levels, resized to `PATCH` x `PATCH` and normalized (zero mean, unit
+length), so that its dot product with another is their normalized cross-correlation (NCC): 1 for the same
+picture up to brightness and contrast, about 0 for unrelated ones. A box whose patch is flat (a flat colour, as a
+label map rendered without texture is) has no appearance: its similarity is NaN, which callers read as "the
+photo says nothing here".
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from PIL import Image
+
+PATCH = 12  # side of the patches compared: a window's panes and frame at any size, little of the noise
+FLAT = 0.5  # grey levels: a patch whose spread is below this (a flat colour, a render) has no appearance
+
+
+def grey(photo: Any, width: int, height: int) -> np.ndarray:
+    """The photo (a PIL image, a path, or an (H, W) / (H, W, C) array) as float32 grey levels of the segmentation's
+    size, resized when it has another (the rectified photo a segmentation was drawn on has its size)."""
+    if isinstance(photo, np.ndarray):
+        array = photo.astype(np.float32)
+        if array.ndim == 3:
+            array = array[..., :3].mean(axis=2)
+        if array.ndim != 2:
+            raise ValueError(f"photo must be an (H, W) or (H, W, C) array, got shape {list(photo.shape)}")
+        image = Image.fromarray(array, "F")
+    else:
+        image = photo if isinstance(photo, Image.Image) else Image.open(photo)
+        image = image.convert("L")
+    if image.size != (width, height):
+        image = image.resize((width, height), Image.Resampling.BILINEAR)
+    return np.asarray(image, dtype=np.float32)
+
+
+def patches(grey_levels: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(normalized patches (n, PATCH * PATCH), flat (n,) bool) of the boxes ((n, 4) x0, y0, x1, y1 in pixels)."""
+    h, w = grey_levels.shape
+    image = Image.fromarray(grey_levels, "F")
+    out = np.zeros((len(boxes), PATCH * PATCH), dtype=np.float32)
+    flat = np.ones(len(boxes), dtype=bool)
+    for i, (x0, y0, x1, y1) in enumerate(np.asarray(boxes, dtype=float).tolist()):
+        x0, y0, x1, y1 = max(0, int(x0)), max(0, int(y0)), min(w, int(round(x1))), min(h, int(round(y1)))
+        if x1 - x0 < 1 or y1 - y0 < 1:
+            continue
+        patch = np.asarray(image.resize((PATCH, PATCH), Image.Resampling.BILINEAR, box=(x0, y0, x1, y1)),
+                           dtype=np.float32).ravel()
+        patch = patch - patch.mean()
+        spread = float(np.sqrt((patch**2).mean()))
+        if spread >= FLAT:
+            out[i] = patch / (spread * np.sqrt(patch.size))
+            flat[i] = False
+    return out, flat
+
+
+def similarity(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray) -> np.ndarray:
+    """Each box's best NCC against the example boxes ((m, 4)), in [-1, 1]; NaN where the box or every example
+    is flat, or there is no example."""
+    sims = np.full(len(boxes), np.nan)
+    if not len(boxes) or not len(examples):
+        return sims
+    mine, mine_flat = patches(grey_levels, boxes)
+    theirs, theirs_flat = patches(grey_levels, examples)
+    theirs = theirs[~theirs_flat]
+    if not len(theirs):
+        return sims
+    best = (mine @ theirs.T).max(axis=1)
+    sims[~mine_flat] = best[~mine_flat]
+    return sims
+
+
+SHIFTS = (-0.2, -0.1, 0.0, 0.1, 0.2)  # shares of a box's width (height) that `refine` moves it by
+
+
+def refine(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(boxes moved to where they look most like the examples, their NCC): each box is tried at `SHIFTS` of its
+    size along x and y (25 places) and kept where its best NCC against the examples is highest; NaN and the box
+    unmoved where the photo says nothing."""
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    sims = np.full(len(boxes), np.nan)
+    if not len(boxes) or not len(examples):
+        return boxes, sims
+    theirs, theirs_flat = patches(grey_levels, examples)
+    theirs = theirs[~theirs_flat]
+    if not len(theirs):
+        return boxes, sims
+    h, w = grey_levels.shape
+    size = boxes[:, 2:] - boxes[:, :2]  # (n, 2)
+    steps = np.array([(sx, sy) for sy in SHIFTS for sx in SHIFTS])  # (25, 2)
+    offsets = steps[None, :, :] * size[:, None, :]  # (n, 25, 2)
+    lo = np.clip(boxes[:, None, :2] + offsets, 0, None)
+    lo = np.minimum(lo, np.array([w, h]) - size[:, None, :])  # moved boxes stay whole inside the image
+    tried = np.concatenate([lo, lo + size[:, None, :]], axis=2).reshape(-1, 4)  # (n * 25, 4)
+    mine, flat = patches(grey_levels, np.round(tried))
+    best = np.where(flat, -np.inf, (mine @ theirs.T).max(axis=1)).reshape(len(boxes), len(steps))
+    pick = best.argmax(axis=1)
+    found = np.isfinite(best[np.arange(len(boxes)), pick])
+    moved = tried.reshape(len(boxes), len(steps), 4)[np.arange(len(boxes)), pick]
+    boxes = np.where(found[:, None], np.round(moved), boxes)
+    sims[found] = best[np.arange(len(boxes)), pick][found]
+    return boxes, sims

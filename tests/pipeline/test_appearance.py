@@ -1,0 +1,56 @@
+"""The photo check of completion (`facaid.appearance`, `complete(..., photo)`) on a textured picture made here."""
+
+import numpy as np
+from PIL import Image
+
+from facaid.appearance import refine, similarity
+from facaid.completion import complete
+from facaid.labels import FACADE, LABEL_ID
+from facaid.segmentation import Rect, Segmentation
+
+WINDOW = LABEL_ID["window"]
+
+
+def _photo(windows: list[tuple[int, int, int, int]], seed: int = 0) -> Image.Image:
+    """A noisy wall with the given windows painted as dark glass with a light cross of frames."""
+    rng = np.random.default_rng(seed)
+    pixels = 170 + rng.normal(0, 6, (500, 600))
+    for x0, y0, x1, y1 in windows:
+        pixels[y0:y1, x0:x1] = 50 + rng.normal(0, 6, (y1 - y0, x1 - x0))
+        pixels[y0:y1, (x0 + x1) // 2 - 2:(x0 + x1) // 2 + 2] = 200  # mullion
+        pixels[(y0 + y1) // 2 - 2:(y0 + y1) // 2 + 2, x0:x1] = 200  # transom
+    return Image.fromarray(np.clip(pixels, 0, 255).astype(np.uint8), "L")
+
+
+def _grid() -> list[tuple[int, int, int, int]]:
+    return [(20 + 100 * i, 20 + 100 * j, 80 + 100 * i, 80 + 100 * j) for j in range(5) for i in range(6)]
+
+
+def test_similarity_is_high_for_a_window_low_for_wall_and_nan_for_a_flat_place():
+    boxes = _grid()
+    grey = np.asarray(_photo(boxes), dtype=np.float32)
+    examples = np.array(boxes[:2], dtype=float)
+    sims = similarity(grey, np.array([boxes[7], (25, 85, 85, 100), (85, 20, 115, 80)], float), examples)
+    assert sims[0] > 0.9 and sims[1] < 0.5 and sims[2] < 0.5
+    flat = np.full((500, 600), 128, np.float32)
+    assert np.isnan(similarity(flat, np.array([boxes[7]], float), examples)).all()
+    # a box a fifth of its size off is moved back onto the window
+    moved, best = refine(grey, np.array([[boxes[7][0] + 12, boxes[7][1], boxes[7][2] + 12, boxes[7][3]]], float),
+                         examples)
+    assert tuple(moved[0]) == boxes[7] and best[0] > 0.9
+
+
+def test_the_photo_confirms_a_proposal_where_a_window_is_and_rejects_one_where_the_wall_is():
+    boxes = _grid()
+    where = [b for i, b in enumerate(boxes) if i != 14]  # the photo has no window at 14: a wall there
+    drawn = [Rect(WINDOW, *b) for i, b in enumerate(boxes) if i not in (8, 14)]
+    seg = Segmentation(600, 500, (Rect(FACADE, 0, 0, 600, 500), *drawn))
+    structure = complete(seg)
+    assert {(p["x0"], p["y0"]) for p in structure} == {boxes[8][:2], boxes[14][:2]}
+    checked = complete(seg, _photo(where))
+    assert [(p["x0"], p["y0"], p["x1"], p["y1"]) for p in checked] == [boxes[8]]
+    assert checked[0]["photo"] > 0.9 and checked[0]["score"] >= 0.9
+    others = [p for p in complete(seg, _photo(where), min_score=0.0) if (p["x0"], p["y0"]) != boxes[8][:2]]
+    assert others and all(p["photo"] < 0.8 and p["score"] < 0.5 for p in others)  # the wall at 14 among them
+    # a photo with nothing to see (a flat render) changes nothing
+    assert complete(seg, Image.new("RGB", (600, 500), (200, 180, 150))) == structure
