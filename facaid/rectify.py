@@ -109,25 +109,25 @@ def _work_channels(image: Image.Image) -> list[np.ndarray]:
     """The photo at most `WORK_SIDE` pixels a side as uint8 images to find edges in, whatever its mode: its
     luminance, and for a colour photo two opponent channels (blue-yellow, red-green), for a facade as bright as the
     sky beside it differs in colour. Transparency lies over mid grey; 16-bit and float images are stretched to their
-    range."""
+    range. The photo is shrunk first, so that no full-size copy of it is made but for a palette or bilevel one."""
     w, h = image.size
     scale = min(1.0, WORK_SIDE / max(w, h))
     size = (max(1, round(w * scale)), max(1, round(h * scale)))
-    if image.mode in ("I", "I;16", "I;16B", "I;16L", "I;16N", "F"):
-        small = image.resize(size, Image.Resampling.BILINEAR) if size != (w, h) else image
-        a = np.asarray(small, dtype=np.float64)
+    if image.mode == "P":
+        image = image.convert("RGBA" if "transparency" in image.info else "RGB")
+    elif image.mode in ("1", "I;16B", "I;16L", "I;16N"):
+        image = image.convert("L" if image.mode == "1" else "I")
+    if size != (w, h):
+        image = image.resize(size, Image.Resampling.BILINEAR, reducing_gap=2.0)
+    if image.mode in ("I", "I;16", "F"):
+        a = np.nan_to_num(np.asarray(image, dtype=np.float64))
         lo, hi = float(a.min()), float(a.max())
         return [((a - lo) * (255.0 / (hi - lo)) if hi > lo else np.zeros_like(a)).astype(np.uint8)]
-    if image.mode in ("RGBA", "LA", "PA", "La", "RGBa") or (image.mode == "P" and "transparency" in image.info):
+    if image.mode in ("RGBA", "LA", "PA", "La", "RGBa"):
         image = Image.alpha_composite(Image.new("RGBA", image.size, (128, 128, 128, 255)), image.convert("RGBA"))
-    if image.mode in ("1", "L"):
-        grey = image.convert("L")
-        return [np.asarray(grey.resize(size, Image.Resampling.BILINEAR, reducing_gap=2.0) if size != (w, h)
-                           else grey, dtype=np.uint8)]
-    rgb = image.convert("RGB")
-    if size != (w, h):
-        rgb = rgb.resize(size, Image.Resampling.BILINEAR, reducing_gap=2.0)
-    c = np.asarray(rgb, dtype=np.float32)
+    if image.mode == "L":
+        return [np.asarray(image, dtype=np.uint8)]
+    c = np.asarray(image.convert("RGB"), dtype=np.float32)
     r, g, b = c[..., 0], c[..., 1], c[..., 2]
     luma = 0.299 * r + 0.587 * g + 0.114 * b
     channels = [luma, 128 + (b - (r + g) / 2) / 2, 128 + (r - g) / 2]
