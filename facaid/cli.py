@@ -231,7 +231,7 @@ def cmd_cga(args: argparse.Namespace) -> None:
 
     proc = Procedure.from_dict(_read_json(args.input))
     scale = args.metres_per_pixel if args.metres_per_pixel is not None else default_scale(proc)
-    text = procedure_cga(proc, scale, name=Path(args.input).name)
+    text = procedure_cga(proc, args.metres_per_pixel, name=Path(args.input).name)
     Path(args.out).write_text(text, encoding="utf-8")
     print(f"wrote {args.out} ({text.count(' -->')} rules, {proc.width * scale:.2f} m x {proc.height * scale:.2f} m "
           f"at {scale:.4g} m per pixel)")
