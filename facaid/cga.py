@@ -194,20 +194,28 @@ class _Writer:
         return "{ " + " | ".join(items) + " }"
 
 
-def procedure_cga(proc: Procedure, scale: float | None = None, name: str = "") -> str:
+def _one_line(text: str) -> str:
+    """Text for the header comment: one line that cannot close the comment."""
+    return " ".join(text.replace("*/", "* /").split())[:200]
+
+
+def procedure_cga(proc: Procedure, scale: float | None = None, name: str = "", scale_from: str = "") -> str:
     """The procedure as a CGA rule file (see the module's docstring); ``scale`` in metres per pixel (default
-    `default_scale`), ``name`` goes into the header comment."""
+    `default_scale`), ``name`` goes into the header comment and so does ``scale_from``, where the scale came from
+    (default: "a storey 3 m tall" for the default scale)."""
+    given = scale is not None
     scale = checked_scale(proc, scale)
     writer = _Writer(proc, scale)
     root = writer.rule(proc.root, (False, False))
     width, height = writer.metres(proc.width), writer.metres(proc.height)
-    name = " ".join(name.replace("*/", "* /").split())[:200]  # one line that cannot close the comment
+    name = _one_line(name)
     title = f" {name}" if name else ""
+    source = _one_line(scale_from or ("given" if given else f"a storey {STOREY_M:g} m tall"))
     head = [
         "/**",
         f" * Facade rules written by FaçAID from the procedure{title}.",
         f" * Drawn at {round(proc.width)} x {round(proc.height)} px, {width} m x {height} m at "
-        f"{_number(scale, 6)} m per pixel.",
+        f"{_number(scale, 6)} m per pixel ({source}).",
         " * Apply Facade to a facade shape (scope x along the facade, y up): fixed sizes keep their metres,",
         " * floating ones (~) share the rest, and repeats lay out as many copies as fit.",
         " * Replace the label rules at the end (Window, Door, ...) with your own geometry.",

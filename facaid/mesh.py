@@ -15,7 +15,7 @@ import io
 
 import numpy as np
 
-from facaid.cga import checked_scale
+from facaid.cga import STOREY_M, checked_scale
 from facaid.grammar.execute import leaf_array
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABELS, PALETTE
@@ -62,15 +62,21 @@ def _quads(boxes: np.ndarray, depth: float) -> tuple[np.ndarray, list[int]]:
     return out, normals
 
 
-def procedure_mesh(proc: Procedure, scale: float | None = None, mtl_name: str = "facade.mtl") -> tuple[str, str]:
-    """The OBJ text and the MTL text (the OBJ names it ``mtl_name``); ``scale`` in metres per pixel."""
+def procedure_mesh(proc: Procedure, scale: float | None = None, mtl_name: str = "facade.mtl",
+                   scale_from: str = "") -> tuple[str, str]:
+    """The OBJ text and the MTL text (the OBJ names it ``mtl_name``); ``scale`` in metres per pixel (default
+    `facaid.cga.default_scale`), stated in the OBJ's header with ``scale_from``, where it came from."""
+    given = scale is not None
     scale = checked_scale(proc, scale)
+    source = " ".join((scale_from or ("given" if given else f"a storey {STOREY_M:g} m tall")).split())[:200]
     rows = leaf_array(proc)
     if len(rows) > MAX_MESH_RECTS:
         raise MeshTooLarge(f"the procedure draws {len(rows)} rectangles; a mesh is made of at most {MAX_MESH_RECTS}")
     height = round(proc.height)
     out = io.StringIO()
     out.write("# relief mesh of a facade, written by FaçAID: metres, x right, y up, z towards the viewer\n")
+    out.write(f"# scale: {scale:.6g} m per pixel ({source}): {proc.width * scale:.2f} m x "
+              f"{proc.height * scale:.2f} m\n")
     out.write(f"mtllib {mtl_name}\n")
     out.writelines(f"vn {x} {y} {z}\n" for x, y, z in NORMALS)
     labels = sorted(set(rows[:, 0].tolist()))

@@ -1,5 +1,7 @@
-// The rectification step: four draggable corners on the original photo and a live preview of the warp.
+// The rectification step: four draggable corners on the original photo and a live preview of the warp; "Propose
+// corners" places them where the server finds the facade's outermost lines, for the user to adjust.
 import {applyHomography, homography, isConvexQuad, rectifiedSize} from "./geometry.js";
+import {makeApi} from "./server.js";
 
 const PREVIEW_SIDE = 320;
 
@@ -49,6 +51,33 @@ export class RectifyMode {
   pointerup() {
     if (this.dragging >= 0) this.renderPreview();
     this.dragging = -1;
+  }
+
+  /** Corners from elsewhere (the server's proposal), kept inside the photo as a drag keeps them; false (and the
+   * corners unchanged) when they do not make a convex quadrilateral. */
+  setCorners(corners) {
+    const w = this.image.naturalWidth, h = this.image.naturalHeight;
+    const next = corners.map(([x, y]) => [Math.max(0, Math.min(w, x)), Math.max(0, Math.min(h, y))]);
+    if (next.length !== 4 || !isConvexQuad(next)) return false;
+    this.corners = next;
+    this.draw();
+    this.renderPreview();
+    return true;
+  }
+
+  /** Ask the server for the facade's corners (`POST photos/<code>/corners/propose`) and place the handles there;
+   * `say(text)` tells the user how sure the proposal is and what it guessed. */
+  async propose(api, code, say) {
+    say("Looking for the facade's lines…");
+    try {
+      const found = await api(`/api/v1/photos/${code}/corners/propose`, {method: "POST"});
+      if (!this.setCorners(found.corners)) return say("The proposal was not a quadrilateral; drag the corners.");
+      const notes = found.notes.length ? ` (${found.notes.join("; ")})` : "";
+      say(`Corners proposed, ${Math.round(100 * found.confidence)} % of their sides on lines found${notes}. ` +
+        "Drag them to adjust.");
+    } catch (err) {
+      say(`No proposal: ${err.message}`);
+    }
   }
 
   draw() {
@@ -101,5 +130,12 @@ export async function openRectifyMode(canvas, preview, info) {
   const mode = new RectifyMode({canvas, preview, image: original, corners: info.corners});
   mode.draw();
   mode.renderPreview();
+  const button = document.getElementById("rectify-propose"), note = document.getElementById("rectify-note");
+  if (button) {
+    const api = makeApi(document.querySelector("meta[name=csrf-token]").content);
+    const say = (text) => { if (note) note.textContent = text; };
+    say("");
+    button.onclick = () => mode.propose(api, info.code, say);  // one handler, for the mode open now
+  }
   return mode;
 }

@@ -40,6 +40,21 @@ def facade_png(seed: int = 3) -> tuple[bytes, dict]:
     return out.getvalue(), sample.segmentation.to_dict()
 
 
+def photo_like(seed: int = 7):
+    """A PNG photo of a generated facade seen in perspective on a street (`facaid.photolike`) and its true corners
+    (a (4, 2) array: TL, TR, BR, BL)."""
+    import numpy as np
+
+    from facaid.photolike import facade_box, render_photo, warp
+
+    g = generate(seed)
+    facade = render_photo(g.segmentation, seed).crop(facade_box(g.segmentation))
+    photo, corners = warp(facade, seed)
+    out = io.BytesIO()
+    photo.save(out, "PNG")
+    return out.getvalue(), np.array(corners)
+
+
 def upload(client, data: bytes, name: str = "photo.png", **fields):
     from django.core.files.uploadedfile import SimpleUploadedFile
 

@@ -182,6 +182,18 @@ def photo_rectify(request, code):
     return Response(PhotoSerializer(photo).data)
 
 
+@extend_schema(request=None, responses={200: dict},
+               summary="Propose the facade's four corners from the photo's lines and vanishing points "
+                       "(facaid.rectify.propose_corners): {'corners': [[x, y] x 4] (top-left, top-right, bottom-right, "
+                       "bottom-left, in the original photo's pixels, as rectify takes them), 'confidence' (0..1: the "
+                       "share of the four sides that detected lines cover), 'notes', 'lines'}; nothing is stored")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([IsAuthenticated])
+def photo_propose_corners(request, code):
+    return Response(services.propose_corners(access.get_rw_photo_for_user(request.user, code)))
+
+
 # --- segmentations ------------------------------------------------------------------------------------------------
 
 @extend_schema(methods=["GET"], responses=SegmentationSummarySerializer(many=True),

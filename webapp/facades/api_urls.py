@@ -7,6 +7,7 @@ urlpatterns = [
     path("photos/<str:code>/", api.photo_detail, name="api-photo"),
     path("photos/<str:code>/image", api.photo_image, name="api-photo-image"),
     path("photos/<str:code>/rectify", api.photo_rectify, name="api-photo-rectify"),
+    path("photos/<str:code>/corners/propose", api.photo_propose_corners, name="api-photo-propose-corners"),
     path("photos/<str:code>/segmentations/", api.photo_segmentations, name="api-photo-segmentations"),
     path("photos/<str:code>/segmentation", api.photo_segmentation_file, name="api-photo-segmentation-file"),
     path("photos/<str:code>/complete", api.photo_complete, name="api-photo-complete"),

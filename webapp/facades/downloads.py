@@ -33,10 +33,39 @@ class Download:
     needs_photo: bool = False  # offered only where the procedure's photo is visible to the user
 
 
-def _scale(tree: Tree, params: Params) -> float | None:
+def photo_scale(proc: Procedure) -> tuple[float, str] | None:
+    """The scale the procedure's photo gives (its real width or height over the pixels of the image the procedure
+    was drawn on) and a line saying so; None without a photo or a real size. The image is the rectified one unless
+    the procedure has the original's size (drawn before rectification)."""
+    photo = proc.photo
+    if photo is None or (photo.real_width_m is None and photo.real_height_m is None):
+        return None
+    size = (proc.data.get("width", 0), proc.data.get("height", 0))
+    drawn_on = photo.working_size()
+    if photo.rectified and (round(size[0]), round(size[1])) == (photo.width, photo.height):
+        drawn_on = (photo.width, photo.height)
+    scale = photo.metres_per_pixel(drawn_on)
+    if scale is None:
+        return None
+    what = (f"the photo's real width, {photo.real_width_m:g} m" if photo.real_width_m is not None
+            else f"the photo's real height, {photo.real_height_m:g} m")
+    return scale, what
+
+
+def _scale(proc: Procedure, tree: Tree, params: Params) -> tuple[float | None, str]:
+    """The scale of a download and where it came from: ``metres_per_pixel`` if asked, else the photo's real size,
+    else None (the writers' default: a storey 3 m tall, which they say)."""
     raw = params.get("metres_per_pixel")
+    if raw is None:
+        given = photo_scale(proc)
+        if given is not None:
+            try:
+                return checked_scale(tree, given[0]), given[1]
+            except ValueError:  # a real size over an image of a few pixels: the default rather than a 400
+                pass
+        return None, ""
     try:
-        return checked_scale(tree, None if raw is None else float(raw))
+        return checked_scale(tree, float(raw)), ""  # the writers say "given"
     except ValueError:
         raise ValidationError({"metres_per_pixel": "metres_per_pixel must be a number > 0 and at most "
                                                    f"{MAX_SCALE:g}"}) from None
@@ -47,12 +76,14 @@ def stem(proc: Procedure) -> str:
 
 
 def _cga(proc: Procedure, tree: Tree, params: Params) -> str:
-    return procedure_cga(tree, _scale(tree, params), name=proc.title or stem(proc))
+    scale, source = _scale(proc, tree, params)
+    return procedure_cga(tree, scale, name=proc.title or stem(proc), scale_from=source)
 
 
 def _mesh_zip(proc: Procedure, tree: Tree, params: Params) -> bytes:
     try:
-        obj, mtl = procedure_mesh(tree, _scale(tree, params), mtl_name="facade.mtl")
+        scale, source = _scale(proc, tree, params)
+        obj, mtl = procedure_mesh(tree, scale, mtl_name="facade.mtl", scale_from=source)
     except MeshTooLarge as exc:
         raise ValidationError({"name": str(exc)}) from None
     out = io.BytesIO()

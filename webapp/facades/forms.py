@@ -15,6 +15,14 @@ class VisibilityForm(forms.Form):
     visibility = forms.ChoiceField(choices=Visibility.choices)
 
 
+class RealSizeForm(forms.Form):
+    """The facade's real width or height; its range is checked where the API's is (`PhotoSerializer`)."""
+
+    side = forms.ChoiceField(choices=(("width", "width"), ("height", "height")), initial="width")
+    metres = forms.FloatField(required=False, widget=forms.NumberInput(attrs={"step": "0.01", "style": "width:7rem"}),
+                              help_text="empty: none (a storey is taken to be 3 m tall)")
+
+
 class SegmentationForm(forms.Form):
     file = forms.FileField(required=False, help_text="a segmentation JSON file, or COCO, LabelMe or CVAT XML "
                                                      "annotations (the image of the photo's size)")

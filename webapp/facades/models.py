@@ -19,6 +19,9 @@ class Visibility(models.TextChoices):
     PUBLIC = "public", "Public"  # anyone, and listed in the gallery
 
 
+REAL_SIZE_M = (0.5, 1000.0)  # the real width or height of a facade a user may give, in metres: a shed to a tower
+
+
 def photo_path(photo: Photo, filename: str) -> str:
     return f"photos/{photo.code}/original.{filename.rsplit('.', 1)[-1].lower()}"
 
@@ -37,6 +40,10 @@ class Photo(models.Model):
     # rectification: four corners (x, y) in the original image, top-left, top-right, bottom-right, bottom-left
     corners = models.JSONField(null=True, blank=True)
     rectified = models.ImageField(upload_to=rectified_path, null=True, blank=True)
+    # the facade's real size as the user gave it, its width or its height in metres (one of the two): kept rather
+    # than metres per pixel so that it stays true when the photo is rectified again (another image size)
+    real_width_m = models.FloatField(null=True, blank=True)
+    real_height_m = models.FloatField(null=True, blank=True)
     visibility = models.CharField(max_length=10, choices=Visibility.choices, default=Visibility.PRIVATE)
     created = models.DateTimeField(default=timezone.now)
 
@@ -52,6 +59,19 @@ class Photo(models.Model):
     def working_image(self):
         """The image segmentations are drawn on: the rectified one when there is one."""
         return self.rectified if self.rectified else self.image
+
+    def working_size(self) -> tuple[int, int]:
+        return (self.rectified.width, self.rectified.height) if self.rectified else (self.width, self.height)
+
+    def metres_per_pixel(self, size: tuple[float, float] | None = None) -> float | None:
+        """The real size over the pixels of an image of the facade of ``size`` (by default the working image's):
+        None when no real size is given."""
+        w, h = size or self.working_size()
+        if self.real_width_m is not None and w > 0:
+            return self.real_width_m / w
+        if self.real_height_m is not None and h > 0:
+            return self.real_height_m / h
+        return None
 
     def latest_segmentation(self) -> Segmentation | None:
         return self.segmentations.order_by("-version").first()

@@ -14,7 +14,7 @@ from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access
-from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, Segmentation, Visibility
 
 
 def parse_segmentation(data) -> SegmentationData:
@@ -46,18 +46,67 @@ def title_field() -> TextField:
     return TextField(max_length=200, required=False, allow_blank=True)
 
 
+class FiniteFloatField(serializers.FloatField):
+    """A finite number: DRF's FloatField lets an integer too large for a float raise OverflowError (a 500) and
+    takes infinity."""
+
+    default_error_messages = {"invalid": "A finite number is required."}
+
+    def to_internal_value(self, data):
+        try:
+            value = super().to_internal_value(data)
+        except OverflowError:
+            self.fail("invalid")
+        if not finite(value):
+            self.fail("invalid")
+        return value
+
+
+class MetresField(FiniteFloatField):
+    """A length: a finite number, not a boolean (which DRF's FloatField would take as 0 or 1)."""
+
+    def to_internal_value(self, data):
+        if isinstance(data, bool):
+            self.fail("invalid")
+        return super().to_internal_value(data)
+
+
+def real_size_field(side: str) -> MetresField:
+    lo, hi = REAL_SIZE_M
+    return MetresField(min_value=lo, max_value=hi, required=False, allow_null=True,
+                            help_text=f"the facade's real {side} in metres ({lo:g} to {hi:g}; null: none), "
+                                      "the scale of its CGA rules and mesh; setting one clears the other")
+
+
 class PhotoSerializer(serializers.ModelSerializer):
     owner = serializers.CharField(source="owner.username", read_only=True)
     title = title_field()
     image = serializers.SerializerMethodField()
     rectified = serializers.SerializerMethodField()
     segmentation = serializers.SerializerMethodField()
+    real_width_m = real_size_field("width")
+    real_height_m = real_size_field("height")
+    metres_per_pixel = serializers.SerializerMethodField(
+        help_text="the real size over the working (rectified) image's pixels; null without a real size")
 
     class Meta:
         model = Photo
         fields = ["code", "owner", "title", "width", "height", "visibility", "image", "rectified", "corners",
-                  "segmentation", "created"]
+                  "real_width_m", "real_height_m", "metres_per_pixel", "segmentation", "created"]
         read_only_fields = ["code", "owner", "width", "height", "image", "rectified", "corners", "created"]
+
+    def validate(self, attrs):
+        width, height = attrs.get("real_width_m"), attrs.get("real_height_m")
+        if width is not None and height is not None:
+            raise serializers.ValidationError({"real_height_m": "give the real width or the real height, not both"})
+        if width is not None:  # one real size at a time: the other would contradict it once the photo is cropped
+            attrs["real_height_m"] = None
+        elif height is not None:
+            attrs["real_width_m"] = None
+        return attrs
+
+    def get_metres_per_pixel(self, photo: Photo) -> float | None:
+        return photo.metres_per_pixel()
 
     def get_image(self, photo: Photo) -> str:
         return f"/api/v1/photos/{photo.code}/image"
@@ -77,22 +126,6 @@ class PhotoUploadSerializer(serializers.Serializer):
     image = serializers.FileField(allow_empty_file=True)
     title = title_field()
     visibility = serializers.ChoiceField(Visibility.choices, default=Visibility.PRIVATE)
-
-
-class FiniteFloatField(serializers.FloatField):
-    """A finite number: DRF's FloatField lets an integer too large for a float raise OverflowError (a 500) and
-    takes infinity."""
-
-    default_error_messages = {"invalid": "A finite number is required."}
-
-    def to_internal_value(self, data):
-        try:
-            value = super().to_internal_value(data)
-        except OverflowError:
-            self.fail("invalid")
-        if not finite(value):
-            self.fail("invalid")
-        return value
 
 
 class RectifySerializer(serializers.Serializer):

@@ -9,11 +9,13 @@ from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.db.models import Max
 from django.http import Http404
+from PIL import Image
 from rest_framework.exceptions import APIException, ValidationError
 
 from facaid import interchange
 from facaid.completion import RejectedError, complete
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
+from facaid.rectify import propose_corners_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import jobs
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
@@ -30,6 +32,16 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
     photo.image.save(content.name, content, save=False)
     photo.save()
     return photo
+
+
+def propose_corners(photo: Photo) -> dict:
+    """The facade's four corners proposed from the original photo's lines (`facaid.rectify.propose_corners`), in
+    its pixels, as `rectify` takes them; nothing is stored."""
+    try:
+        with photo.image.open("rb") as f:
+            return propose_corners_file(f)
+    except (OSError, ValueError, Image.DecompressionBombError) as exc:  # a stored file that no longer decodes
+        raise ValidationError({"image": f"the photo cannot be read: {exc}"}) from None
 
 
 def _working_size(photo: Photo) -> tuple[int, int]:

@@ -8,6 +8,7 @@ urlpatterns = [
     path("photos/<str:code>", views.photo, name="photo"),
     path("photos/<str:code>/edit", views.photo_editor, name="photo-editor"),
     path("photos/<str:code>/visibility", views.photo_visibility, name="photo-visibility"),
+    path("photos/<str:code>/real-size", views.photo_real_size, name="photo-real-size"),
     path("photos/<str:code>/segmentation", views.photo_segmentation, name="photo-segmentation"),
     path("photos/<str:code>/reconstruct", views.photo_reconstruct, name="photo-reconstruct"),
     path("jobs/<str:code>", views.job, name="job"),

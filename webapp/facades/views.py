@@ -16,9 +16,17 @@ from rest_framework.exceptions import ValidationError
 from facaid.cga import MAX_SCALE
 from facaid.defaults import DEFAULT_K, MAX_K
 from webapp.facades import access, jsonbody, services, throttling
-from webapp.facades.downloads import DOWNLOADS
-from webapp.facades.forms import PhotoForm, ReconstructForm, RerunForm, SegmentationForm, VisibilityForm
+from webapp.facades.downloads import DOWNLOADS, photo_scale
+from webapp.facades.forms import (
+    PhotoForm,
+    RealSizeForm,
+    ReconstructForm,
+    RerunForm,
+    SegmentationForm,
+    VisibilityForm,
+)
 from webapp.facades.models import Job, Photo, Procedure
+from webapp.facades.serializers import PhotoSerializer
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
 
@@ -76,7 +84,10 @@ def photo(request, code):
                    *access.JOB_WITHOUT)[:10] if owner
                else Job.objects.none(),
                "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
-               "interchange_formats": INTERCHANGE_FORMATS,
+               "interchange_formats": INTERCHANGE_FORMATS, "metres_per_pixel": photo.metres_per_pixel(),
+               "real_size_form": RealSizeForm(initial={
+                   "side": "height" if photo.real_height_m is not None else "width",
+                   "metres": photo.real_height_m if photo.real_height_m is not None else photo.real_width_m}),
                "visibility_form": VisibilityForm(initial={"visibility": photo.visibility})}
     return render(request, "facades/photo.html", context)
 
@@ -85,6 +96,30 @@ def photo(request, code):
 @require_POST
 def photo_visibility(request, code):
     return _set_visibility(request, access.get_rw_photo_for_user(request.user, code), "photo")
+
+
+@login_required
+@require_POST
+def photo_real_size(request, code):
+    """The facade's real width or height (empty: none), validated as the API's PATCH validates it."""
+    photo = access.get_rw_photo_for_user(request.user, code)
+    form = RealSizeForm(request.POST)
+    if not form.is_valid():
+        messages.error(request, "Give the real size as a number of metres.")
+        return redirect(photo)
+    side, metres = form.cleaned_data["side"], form.cleaned_data["metres"]
+    data = {"real_width_m": None, "real_height_m": None}
+    if metres is not None:
+        data[f"real_{side}_m"] = metres
+    change = PhotoSerializer(photo, data=data, partial=True)
+    if not change.is_valid():
+        messages.error(request, _error_text(ValidationError(change.errors)))
+        return redirect(photo)
+    change.save()
+    messages.success(request, f"The facade is {metres:g} m {'wide' if side == 'width' else 'tall'}: its "
+                              "procedures' CGA rules and meshes are at that scale." if metres is not None else
+                     "The real size is cleared: exports take a storey as 3 m tall.")
+    return redirect(photo)
 
 
 @login_required
@@ -155,7 +190,7 @@ def procedure(request, code):
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
         "downloads": [(name, d.help) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
-        "max_scale": MAX_SCALE})
+        "max_scale": MAX_SCALE, "photo_scale": photo_scale(proc)})
 
 
 @login_required

@@ -1,0 +1,60 @@
+"""The editor's rectification step in Debian's Chromium: "Propose corners" moves the four handles onto the facade
+of a photo-like picture, where a drag still adjusts them, and "Apply" rectifies with them."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+from site_helpers import login, photo_like, upload
+
+from webapp.facades.models import Photo
+
+pytestmark = [pytest.mark.django_db(transaction=True),
+              pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
+E = "window.facaidEditor"
+
+
+def test_propose_corners_moves_the_handles_onto_the_facade(live_server, as_alice, browser):
+    data, true = photo_like()
+    photo = upload(as_alice, data, title="Street").json()
+    w, h = photo["width"], photo["height"]
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
+    page.wait_for_function(f"{E}?.seg !== null && {E}?.seg !== undefined")
+    page.click("#rectify")
+    page.wait_for_function(f"{E}.rectifying")
+    assert page.evaluate(f"{E}.rectifying.corners") == [[0, 0], [w, 0], [w, h], [0, h]]
+
+    page.click("#rectify-propose")
+    page.wait_for_function("document.querySelector('#rectify-note').textContent.startsWith('Corners proposed')")
+    corners = np.array(page.evaluate(f"{E}.rectifying.corners"))
+    diag = np.hypot(*(true.max(axis=0) - true.min(axis=0)))
+    assert np.linalg.norm(corners - true, axis=1).max() < 0.01 * diag, corners
+
+    # the handles are drawn where the corners now are: the canvas is the handles' yellow there
+    r = page.evaluate(f"({{s: {E}.rectifying.scale, ox: {E}.rectifying.ox, oy: {E}.rectifying.oy}})")
+    for x, y in corners:
+        sx, sy = r["ox"] + x * r["s"], r["oy"] + y * r["s"]
+        pixel = page.evaluate(f"[...document.querySelector('#canvas').getContext('2d')"
+                              f".getImageData({sx + 4:.0f}, {sy + 4:.0f}, 1, 1).data]")
+        assert pixel[:3] == [0xff, 0xeb, 0x3b], (x, y, pixel)
+
+    # a proposal is for adjusting: drag the top-left handle 15 px right, then apply
+    box = page.locator("#canvas").bounding_box()
+    tl = (box["x"] + r["ox"] + corners[0][0] * r["s"], box["y"] + r["oy"] + corners[0][1] * r["s"])
+    page.mouse.move(*tl)
+    page.mouse.down()
+    page.mouse.move(tl[0] + 15 * r["s"], tl[1], steps=4)
+    page.mouse.up()
+    moved = page.evaluate(f"{E}.rectifying.corners")
+    assert abs(moved[0][0] - corners[0][0] - 15) <= 2 and moved[1:] == corners[1:].tolist()
+    page.click("#rectify-apply")
+    page.wait_for_function(f"{E}?.seg && {E}.seg.width > 0 && !{E}.rectifying")
+    stored = Photo.objects.get(code=photo["code"])
+    assert stored.rectified and np.allclose(stored.corners, moved)
+    assert errors == []
