@@ -233,12 +233,12 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
     url = f"/api/v1/photos/{photo['code']}/complete"
     w, h = photo["width"], photo["height"]
     full = _drawn_grid(w, h)["rects"]
-    body = _drawn_grid(w, h, missing=(5,))
+    body = {**_drawn_grid(w, h, missing=(5,)), "use_photo": False}  # the photo shows another facade than drawn
     r = as_alice.post(url, body, format="json")
     assert r.status_code == 200, r.content
     (p,) = r.json()["proposals"]
     assert {k: p[k] for k in ("label", "x0", "y0", "x1", "y1")} == full[1 + 5]
-    assert p["score"] >= 0.85 and p["reason"] == "grid"
+    assert p["score"] >= 0.85 and p["reason"] in ("grid", "floor")
     body["rejected"] = [{k: p[k] for k in ("label", "x0", "y0", "x1", "y1")}]
     assert as_alice.post(url, body, format="json").json()["proposals"] == []
     assert as_alice.get(seg_url(photo)).json()["count"] == 1  # nothing stored
@@ -250,6 +250,7 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
         ({**_drawn_grid(w, h), "rejected": [{"label": "window", "x0": 5, "y0": 5, "x1": 2, "y1": 9}]}, "rejected",
          "rejected[0]"),
         ({**_drawn_grid(w, h), "rejected": [7]}, "rejected", "rejected[0]"),
+        ({**_drawn_grid(w, h), "use_photo": "yes"}, "use_photo", "true or false"),
         ({"width": w, "height": h, "rects": [{"label": "window", "x0": 0, "y0": 0, "x1": 1, "y1": 1}] * 2001},
          "segmentation", "too many rectangles for completion"),
     ):
@@ -257,6 +258,8 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
         assert r.status_code == 400, (bad.keys(), r.content)
         assert field in r.json() and message in json.dumps(r.json()), r.json()
     assert as_alice.post(url, {**_drawn_grid(w, h), "rejected": None}, format="json").status_code == 200
+    checked = as_alice.post(url, _drawn_grid(w, h, missing=(5,)), format="json")  # the photo is read by default
+    assert checked.status_code == 200 and any("photo" in p for p in checked.json()["proposals"])
     r = as_alice.post(url, [1, 2], format="json")
     assert r.status_code == 400 and "JSON object" in json.dumps(r.json())
     assert as_bob.post(url, _drawn_grid(w, h), format="json").status_code == 404  # Alice's private photo

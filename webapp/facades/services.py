@@ -124,16 +124,28 @@ def segmentation_file(photo: Photo, format: str, version: str | None = None) -> 
 
 def complete_segmentation(photo: Photo, data) -> list[dict]:
     """Proposals for what is not drawn yet (`facaid.complete`) in a segmentation of the photo: the body is the
-    segmentation JSON, optionally with ``rejected`` (rectangles not to propose again) and ``min_score``."""
+    segmentation JSON, optionally with ``rejected`` (rectangles not to propose again), ``min_score`` and
+    ``use_photo`` (default true: the photo the segmentation is drawn on confirms or rejects each proposal)."""
     seg = _segmentation_of(photo, data, "segmentation").segmentation
     rejected = data.get("rejected") or []
     min_score = data.get("min_score", DEFAULT_MIN_SCORE)
+    use_photo = data.get("use_photo", True)
     if not isinstance(rejected, list):
         raise ValidationError({"rejected": "give a list of rectangles"})
     if isinstance(min_score, bool) or not isinstance(min_score, int | float) or not 0 <= min_score <= 1:
         raise ValidationError({"min_score": f"give a number in [0, 1], got {min_score!r}"})
+    if not isinstance(use_photo, bool):
+        raise ValidationError({"use_photo": f"give true or false, got {use_photo!r}"})
+    picture = None
+    if use_photo:
+        try:
+            with photo.working_image().open("rb") as f:
+                picture = Image.open(f)
+                picture.load()
+        except (OSError, ValueError, Image.DecompressionBombError) as exc:  # a stored file that no longer decodes
+            raise ValidationError({"image": f"the photo cannot be read: {exc}"}) from None
     try:
-        return complete(seg, rejected=rejected, min_score=float(min_score))
+        return complete(seg, picture, rejected=rejected, min_score=float(min_score))
     except RejectedError as exc:
         raise ValidationError({"rejected": str(exc)}) from None
     except ValueError as exc:  # too many rectangles
