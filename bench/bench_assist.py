@@ -1,13 +1,16 @@
 """Assisted segmentation on the CMP annotations: how much drawing completion saves (issue 43's benchmark).
 
     .venv/bin/python bench/bench_assist.py [--stride 1] [--limit N] [--min-score S] [--json F]
+    .venv/bin/python bench/bench_assist.py --generated 12      # + photo-like renders of generated facades
 
 A simulated annotator (`facaid.evaluation.assist.simulate`) draws each facade's true elements in reading order,
 asks `facaid.completion.complete` for proposals after every third, accepts at no cost each proposal that matches
 a true element not drawn yet (same class, IoU >= 0.7) and pays one action for every other one, and stops at
 95 % pixel accuracy. Effort = actions / elements (1.0: drawing everything). Printed for the dev half (facades
 1-189) and the test half (190-378) apart, beside the effort without completion (the 95 % stop alone), with the
-median time of a completion call. CMP is evaluation data: nothing here trains.
+median time of a completion call. CMP is evaluation data: nothing here trains. CMP's photos are not in the repo:
+``--generated N`` runs the same annotator on N held-out generated facades (seeds 5000 on) drawn on photo-like
+renders of themselves (`facaid.photolike.render_photo`), without and with the photo check.
 """
 
 from __future__ import annotations
@@ -31,7 +34,10 @@ def main() -> None:
     ap.add_argument("--limit", type=int, default=None, help="at most N facades of each half")
     ap.add_argument("--min-score", type=float, default=DEFAULT_MIN_SCORE)
     ap.add_argument("--json", default=None)
+    ap.add_argument("--generated", type=int, default=0, help="N generated facades with photo-like renders instead")
     args = ap.parse_args()
+    if args.generated:
+        return generated(args)
     records = load_records(args.data)
     halves = {"dev": records[:DEV_FACADES], "test": records[DEV_FACADES:]}
     calls: list[float] = []
@@ -57,6 +63,36 @@ def main() -> None:
     if calls:
         result["call_seconds_median"] = statistics.median(calls)
         print(f"completion call: median {1000 * statistics.median(calls):.1f} ms ({len(calls)} calls)")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=1)
+
+
+def generated(args) -> None:
+    from facaid.generator import generate
+    from facaid.photolike import render_photo
+
+    cases = [(g.segmentation, render_photo(g.segmentation, seed)) for seed in range(5000, 5000 + args.generated)
+             for g in [generate(seed)]]
+    result = {"min_score": args.min_score, "facades": len(cases)}
+    for name, propose in (("alone", lambda seg, photo: (lambda s, rejected: [])),
+                          ("structure", lambda seg, photo: functools.partial(complete, min_score=args.min_score)),
+                          ("photo", lambda seg, photo: functools.partial(complete, photo=photo,
+                                                                         min_score=args.min_score))):
+        calls: list[float] = []
+
+        def timed(s, _p=None, _calls=calls, **kw):
+            t0 = time.perf_counter()
+            out = _p(s, **kw)
+            _calls.append(time.perf_counter() - t0)
+            return out
+
+        sessions = [simulate(seg, functools.partial(timed, _p=propose(seg, photo))) for seg, photo in cases]
+        result[name] = summary(sessions) | {"call_seconds_median": statistics.median(calls) if calls else None}
+        s = result[name]
+        ms = f", {1000 * s['call_seconds_median']:.1f} ms a call" if name != "alone" else ""
+        print(f"generated, {name}: median effort {s['effort_median']:.3f} ({s['accepted']} accepted, "
+              f"{s['rejected']} rejected, {s['drawn']} drawn of {s['elements']}){ms}")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
