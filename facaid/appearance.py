@@ -60,16 +60,21 @@ def similarity(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray)
     """Each box's best NCC against the example boxes ((m, 4)), in [-1, 1]; NaN where the box or every example
     is flat, or there is no example."""
     sims = np.full(len(boxes), np.nan)
-    if not len(boxes) or not len(examples):
+    theirs = _examples(grey_levels, examples)
+    if not len(boxes) or not len(theirs):
         return sims
     mine, mine_flat = patches(grey_levels, boxes)
-    theirs, theirs_flat = patches(grey_levels, examples)
-    theirs = theirs[~theirs_flat]
-    if not len(theirs):
-        return sims
     best = (mine @ theirs.T).max(axis=1)
     sims[~mine_flat] = best[~mine_flat]
     return sims
+
+
+def _examples(grey_levels: np.ndarray, examples: np.ndarray) -> np.ndarray:
+    """The normalized patches of the examples that are not flat."""
+    if not len(examples):
+        return np.zeros((0, PATCH * PATCH), dtype=np.float32)
+    theirs, flat = patches(grey_levels, examples)
+    return theirs[~flat]
 
 
 SHIFTS = (-0.2, -0.1, 0.0, 0.1, 0.2)  # shares of a box's width (height) that `refine` moves it by
@@ -81,11 +86,8 @@ def refine(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray) -> 
     unmoved where the photo says nothing."""
     boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
     sims = np.full(len(boxes), np.nan)
-    if not len(boxes) or not len(examples):
-        return boxes, sims
-    theirs, theirs_flat = patches(grey_levels, examples)
-    theirs = theirs[~theirs_flat]
-    if not len(theirs):
+    theirs = _examples(grey_levels, examples)
+    if not len(boxes) or not len(theirs):
         return boxes, sims
     h, w = grey_levels.shape
     size = boxes[:, 2:] - boxes[:, :2]  # (n, 2)

@@ -40,14 +40,21 @@ def open_editor(live_server, as_alice, browser, viewport=(1400, 1000)):
         {"label": "window", "x0": x, "y0": y, "x1": x + WIN_W, "y1": y + WIN_H}]}
     r = as_alice.post(f"/api/v1/photos/{photo['code']}/segmentations/", seg, format="json")
     assert r.status_code == 201, r.content
-    context = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}, has_touch=True)
+    page, context = open_page(live_server, browser, photo["code"], f"{E}?.seg?.size === 2", viewport, has_touch=True)
+    page.photo = photo
+    return page, context
+
+
+def open_page(live_server, browser, code: str, ready: str, viewport=(1400, 1000), has_touch=False):
+    """(page, context): Alice logged in and the editor of her photo ``code`` open, once the JavaScript ``ready``
+    holds; the page's uncaught errors collect in `page.errors`."""
+    context = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}, has_touch=has_touch)
     page = context.new_page()
     page.errors = []
     page.on("pageerror", lambda e: page.errors.append(str(e)))
     login(page, live_server.url, "alice", "alice-password-1")
-    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
-    page.wait_for_function(f"{E}?.seg?.size === 2")
-    page.photo = photo
+    page.goto(f"{live_server.url}/photos/{code}/edit")
+    page.wait_for_function(ready)
     return page, context
 
 

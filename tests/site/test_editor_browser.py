@@ -7,7 +7,7 @@ import json
 import shutil
 
 import pytest
-from site_helpers import login
+from editor_helpers import E, open_page
 
 from webapp.facades.models import Segmentation
 
@@ -15,17 +15,10 @@ pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
 
 
-E = "window.facaidEditor"
-
-
 def test_editor_draw_undo_repeat_save_export(live_server, facade_photo, browser, tmp_path):
     photo, seg = facade_photo
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    login(page, live_server.url, "alice", "alice-password-1")
-    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
-    page.wait_for_function(f"{E}?.seg?.size > 0")
+    page, _ = open_page(live_server, browser, photo["code"], f"{E}?.seg?.size > 0")
+    errors = page.errors
     n0 = page.evaluate(f"{E}.seg.size")
     assert n0 == seg["rect_count"]
     view = page.evaluate(f"({{s: {E}.view.scale, ox: {E}.view.ox, oy: {E}.view.oy}})")
@@ -104,12 +97,8 @@ def test_editor_imports_a_coco_file_of_several_images(live_server, facade_photo,
     doc["annotations"].append({"id": 9, "image_id": 2, "category_id": 4, "bbox": [1, 1, 5, 5], "area": 25})
     path = tmp_path / "facades.coco.json"
     path.write_text(json.dumps(doc))
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    login(page, live_server.url, "alice", "alice-password-1")
-    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
-    page.wait_for_function(f"{E}?.seg?.size > 0")
+    page, _ = open_page(live_server, browser, photo["code"], f"{E}?.seg?.size > 0")
+    errors = page.errors
     n0 = page.evaluate(f"{E}.seg.size")
     page.set_input_files("#import", str(path))
     page.wait_for_function("document.querySelector('#status').textContent.startsWith('Imported')")

@@ -7,25 +7,21 @@ import shutil
 
 import numpy as np
 import pytest
-from site_helpers import login, photo_like, upload
+from editor_helpers import E, open_page
+from site_helpers import photo_like, upload
 
 from webapp.facades.models import Photo
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
-E = "window.facaidEditor"
 
 
 def test_propose_corners_moves_the_handles_onto_the_facade(live_server, as_alice, browser):
     data, true = photo_like()
     photo = upload(as_alice, data, title="Street").json()
     w, h = photo["width"], photo["height"]
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    login(page, live_server.url, "alice", "alice-password-1")
-    page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
-    page.wait_for_function(f"{E}?.seg !== null && {E}?.seg !== undefined")
+    page, _ = open_page(live_server, browser, photo["code"], f"{E}?.seg !== null && {E}?.seg !== undefined")
+    errors = page.errors
     page.click("#rectify")
     page.wait_for_function(f"{E}.rectifying")
     assert page.evaluate(f"{E}.rectifying.corners") == [[0, 0], [w, 0], [w, h], [0, h]]

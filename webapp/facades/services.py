@@ -4,6 +4,8 @@ versions, reconstruction jobs (with their per-user cap), procedures re-measured 
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 from django.conf import settings
 from django.contrib.auth import get_user_model
 from django.db import transaction
@@ -37,10 +39,17 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
 def propose_corners(photo: Photo) -> dict:
     """The facade's four corners proposed from the original photo's lines (`facaid.rectify.propose_corners`), in
     its pixels, as `rectify` takes them; nothing is stored."""
+    with _readable(photo.image) as f:
+        return propose_corners_file(f)
+
+
+@contextmanager
+def _readable(field):
+    """The stored image file, open; a file that no longer decodes while it is read is a 400 naming ``image``."""
     try:
-        with photo.image.open("rb") as f:
-            return propose_corners_file(f)
-    except (OSError, ValueError, Image.DecompressionBombError) as exc:  # a stored file that no longer decodes
+        with field.open("rb") as f:
+            yield f
+    except (OSError, ValueError, Image.DecompressionBombError) as exc:
         raise ValidationError({"image": f"the photo cannot be read: {exc}"}) from None
 
 
@@ -138,12 +147,9 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
         raise ValidationError({"use_photo": f"give true or false, got {use_photo!r}"})
     picture = None
     if use_photo:
-        try:
-            with photo.working_image().open("rb") as f:
-                picture = Image.open(f)
-                picture.load()
-        except (OSError, ValueError, Image.DecompressionBombError) as exc:  # a stored file that no longer decodes
-            raise ValidationError({"image": f"the photo cannot be read: {exc}"}) from None
+        with _readable(photo.working_image()) as f:
+            picture = Image.open(f)
+            picture.load()
     try:
         return complete(seg, picture, rejected=rejected, min_score=float(min_score))
     except RejectedError as exc:
