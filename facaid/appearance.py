@@ -104,3 +104,59 @@ def refine(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray) -> 
     boxes = np.where(found[:, None], np.round(moved), boxes)
     sims[found] = best[np.arange(len(boxes)), pick][found]
     return boxes, sims
+
+
+SEARCH_SIDE = 16  # pixels: the photo is searched scaled so that the examples' smaller side is about this long
+SEARCH_TEMPLATES = 4  # examples matched at most per search (the first drawn)
+CONTEXT = 0.25  # share of its size around each example that is matched with it (a window in its wall)
+
+
+def search(grey_levels: np.ndarray, examples: np.ndarray, size: tuple[float, float], threshold: float,
+           limit: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    """(boxes (n, 4) of ``size`` = (width, height), their NCC) where the photo looks like the examples ((m, 4)
+    boxes) at ``threshold`` or more, anywhere in it. Each example with `CONTEXT` of its size around it (what is
+    beside a window tells it from a pane of a shop's glass), scaled to ``size``, is slid over the photo (OpenCV's
+    normalized cross-correlation, on a copy scaled so that the size's smaller side is `SEARCH_SIDE` pixels);
+    the peaks of the best response, each the best within an element's size, are kept, the highest first, at
+    most ``limit``. Flat places and flat examples have no say; none found: empty arrays."""
+    import cv2
+
+    none = np.zeros((0, 4)), np.zeros(0)
+    w, h = float(size[0]), float(size[1])
+    if not len(examples) or w < 2 or h < 2:
+        return none
+    f = min(1.0, SEARCH_SIDE / min(w, h))
+    small = cv2.resize(grey_levels, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if f < 1 else grey_levels
+    mx, my = CONTEXT * w, CONTEXT * h
+    tw, th = max(3, round((w + 2 * mx) * f)), max(3, round((h + 2 * my) * f))
+    if tw >= small.shape[1] or th >= small.shape[0]:
+        return none
+    image = Image.fromarray(grey_levels, "F")
+    gh, gw = grey_levels.shape
+    response = None
+    for x0, y0, x1, y1 in np.asarray(examples, dtype=float)[:SEARCH_TEMPLATES].tolist():
+        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2  # the example's middle, with the searched size and context around
+        box = (cx - w / 2 - mx, cy - h / 2 - my, cx + w / 2 + mx, cy + h / 2 + my)
+        if box[0] < 0 or box[1] < 0 or box[2] > gw or box[3] > gh:
+            continue  # its context is cut by the image's edge
+        template = np.asarray(image.resize((tw, th), Image.Resampling.BILINEAR, box=box), dtype=np.float32)
+        if template.std() < FLAT:
+            continue
+        r = cv2.matchTemplate(small, template, cv2.TM_CCOEFF_NORMED)
+        response = r if response is None else np.maximum(response, r)
+    if response is None:
+        return none
+    rh, rw = response.shape
+    mean = cv2.blur(small, (tw, th), anchor=(0, 0))[:rh, :rw]
+    square = cv2.blur(small * small, (tw, th), anchor=(0, 0))[:rh, :rw]
+    flat = np.sqrt(np.maximum(square - mean * mean, 0)) < FLAT  # places of the photo with no appearance
+    response = np.where(flat | ~np.isfinite(response), -1.0, response)
+    ew, eh = max(1, round(w * f)), max(1, round(h * f))  # an element's size in the searched copy
+    peak = cv2.dilate(response, np.ones((2 * eh - 1, 2 * ew - 1), np.uint8))  # no two kept places overlap
+    ys, xs = np.nonzero((response >= peak) & (response >= threshold))
+    if not len(xs):
+        return none
+    sims = response[ys, xs]
+    order = np.argsort(-sims, kind="stable")[:limit]
+    x, y = xs[order] / f + mx, ys[order] / f + my
+    return np.stack([x, y, x + w, y + h], axis=1), sims[order].astype(float)

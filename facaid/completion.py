@@ -69,6 +69,7 @@ COLUMN_TOLERANCE = 0.3  # elements whose left edges agree within this share of t
 PHOTO_CANDIDATE = 0.7  # proposals scored at least this by the structure are shown to the photo
 PHOTO_MATCH = 0.8  # NCC against the drawn examples of the class at which the photo confirms a proposal
 PHOTO_CONFIRMED = 0.9  # ... and the score it has at least then
+SEARCH_MATCH = 0.9  # NCC at which a place anywhere in the photo that looks like a type's elements is proposed
 
 
 class RejectedError(ValueError):
@@ -314,11 +315,19 @@ def _companions(types: list[_Type], props: _Proposals) -> None:
                 props.add(s.label, anchor + offset, round(0.3 + 0.5 * share, 3), f"with {LABELS[a.label]}")
 
 
-def _photo_check(photo: Any, seg: Segmentation, props: _Proposals) -> dict[int, tuple[float, float, np.ndarray]]:
+def _search(levels: np.ndarray, types: list[_Type], props: _Proposals) -> None:
+    """Where the photo looks like a type's drawn elements (`facaid.appearance.search`, NCC at least
+    `SEARCH_MATCH`), anywhere in the facade: each such place is proposed at the type's size (``looks like``)."""
+    for t in types:
+        boxes, _ = appearance.search(levels, t.boxes, (t.width, t.height), SEARCH_MATCH)
+        for box in boxes:
+            props.add(t.label, box, PHOTO_CONFIRMED, f"looks like {LABELS[t.label]}")
+
+
+def _photo_check(levels: np.ndarray, props: _Proposals) -> dict[int, tuple[float, float, np.ndarray]]:
     """{item: (score, similarity, box)} for the proposals the photo has a say on: each is moved to where it looks
     most like the drawn elements of its class (`facaid.appearance.refine`); one that looks like them scores at least
     `PHOTO_CONFIRMED`, one that does not half its structural score; a flat place or class keeps its score."""
-    levels = appearance.grey(photo, seg.width, seg.height)
     out: dict[int, tuple[float, float]] = {}
     items = [i for i, item in enumerate(props.items) if item[2] >= PHOTO_CANDIDATE]
     for label in sorted({props.items[i][0] for i in items}):
@@ -362,7 +371,11 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
     for t in types:
         _lattice(t, props)
     _companions(types, props)
-    looks = _photo_check(photo, seg, props) if photo is not None else {}
+    looks = {}
+    if photo is not None:
+        levels = appearance.grey(photo, seg.width, seg.height)
+        _search(levels, types, props)
+        looks = _photo_check(levels, props)
     out = []
     for i, (label, b, score, reason) in enumerate(props.items):
         p = {"label": LABELS[label], "x0": int(b[0]), "y0": int(b[1]), "x1": int(b[2]), "y1": int(b[3]),

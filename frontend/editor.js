@@ -13,7 +13,7 @@ import {buildPalette, markActive} from "./panel.js";
 import {openRectifyMode} from "./rectify-mode.js";
 import {drawScene, grayPixels} from "./render.js";
 import {download, makeApi} from "./server.js";
-import {keepDraft, loadPhoto, readSegmentationFile, rectify, save, submit} from "./session.js";
+import {DraftKeeper, loadPhoto, readSegmentationFile, rectify, save, submit} from "./session.js";
 import {PinchGesture, clampScale, fitView, photoFilter, reveal} from "./tools/view.js";
 import {press} from "./tools/select.js";
 
@@ -31,6 +31,7 @@ const ui = {tool: "draw", label: "window", selection: new Set(), drag: null, gui
 // the photo's API record and image, the segmentation and its history, the photo's gray levels once asked for,
 // and the RectifyMode (rectify-mode.js) while the rectification step is open
 let info = null, photo = null, seg = null, history = null, gray = null, rectifying = null;
+const drafts = new DraftKeeper(api, photoCode, (text) => { $("#draft-note").textContent = text; });
 const status = (text, kind = "") => Object.assign($("#status"), {textContent: text, className: `msg ${kind}`});
 
 // --- loading and the state's echo in the page ----------------------------------------------------------------
@@ -46,7 +47,7 @@ async function load() {
 
 function changed() {
   for (const id of [...ui.selection]) if (!seg.rects.has(id)) ui.selection.delete(id);
-  keepDraft(photoCode, seg, history);
+  drafts.keep(seg, history);
   $("#undo").disabled = !history.canUndo;
   $("#redo").disabled = !history.canRedo;
   $("#dirty").textContent = history.dirty ? "unsaved changes" : "saved";

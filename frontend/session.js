@@ -28,22 +28,76 @@ export async function loadPhoto(api, photoCode, {status, forget}) {
         "start a new one on the rectified photo.");
     }
   }
-  const draft = localStorage.getItem(draftKey(photoCode));
+  const draft = await newestDraft(api, photoCode, seg);
   if (draft) {
-    const {json, when} = JSON.parse(draft);
-    if (confirm(`Restore the unsaved changes from ${new Date(when).toLocaleString()}?`)) {
-      history.execute(new ReplaceAll(Segmentation.fromJSON(json).toJSON().rects));
+    if (confirm(`Restore the unsaved changes from ${new Date(draft.when).toLocaleString()} (kept ${draft.where})?`)) {
+      history.execute(new ReplaceAll(Segmentation.fromJSON(draft.json).toJSON().rects));
     } else {
-      localStorage.removeItem(draftKey(photoCode));
+      dropDrafts(api, photoCode);
     }
   }
   return {info, photo, seg, history};
 }
 
-/** Keep the unsaved state in the browser (or drop it once saved). */
-export function keepDraft(photoCode, seg, history) {
-  if (history.dirty) localStorage.setItem(draftKey(photoCode), JSON.stringify({json: seg.toJSON(), when: Date.now()}));
-  else localStorage.removeItem(draftKey(photoCode));
+/** The newer of the drafts kept in this browser and on the server, {json, when, where}, if it fits the photo;
+ * the server's is left out when it cannot be read (the browser's still counts). */
+async function newestDraft(api, photoCode, seg) {
+  const found = [];
+  const local = localStorage.getItem(draftKey(photoCode));
+  if (local) found.push({...JSON.parse(local), where: "in this browser"});
+  try {
+    const {draft} = await api(`/api/v1/photos/${photoCode}/draft`);
+    if (draft) found.push({json: draft.data, when: Date.parse(draft.updated), where: "on the server"});
+  } catch {
+    // the server's draft is a second copy: without it the browser's is offered
+  }
+  const fits = found.filter((d) => d.json.width === seg.width && d.json.height === seg.height);
+  return fits.sort((a, b) => b.when - a.when)[0] || null;
+}
+
+function dropDrafts(api, photoCode) {
+  localStorage.removeItem(draftKey(photoCode));
+  api(`/api/v1/photos/${photoCode}/draft`, {method: "DELETE"}).catch(() => {});
+}
+
+/** Keeps the unsaved state in this browser at once and on the server `delay` ms after the last change (one
+ * upload at a time, in order), and drops them once it is saved; `report(text)` says where the draft stands. */
+export class DraftKeeper {
+  constructor(api, photoCode, report, delay = 2000) {
+    Object.assign(this, {api, photoCode, report, delay, timer: null, sent: false, queue: Promise.resolve()});
+  }
+
+  keep(seg, history) {
+    if (history.dirty) {
+      localStorage.setItem(draftKey(this.photoCode), JSON.stringify({json: seg.toJSON(), when: Date.now()}));
+    } else {
+      localStorage.removeItem(draftKey(this.photoCode));
+    }
+    clearTimeout(this.timer);
+    this.timer = setTimeout(() => this.upload(seg, history), this.delay);
+  }
+
+  /** Send the state now (or drop the server's copy once saved); resolves when the server has answered. */
+  upload(seg, history) {
+    clearTimeout(this.timer);
+    const dirty = history.dirty, json = dirty ? JSON.stringify(seg.toJSON()) : null;
+    const url = `/api/v1/photos/${this.photoCode}/draft`;
+    this.queue = this.queue.then(async () => {
+      try {
+        if (dirty) {
+          await this.api(url, {method: "PUT", body: json});
+          this.report(`draft kept on the server at ${new Date().toLocaleTimeString()}`);
+        } else if (this.sent) {
+          await this.api(url, {method: "DELETE"});  // back to the saved version (a save drops it there too)
+          this.report("");
+        }
+        this.sent = dirty;
+      } catch (e) {
+        this.report(`the draft is not kept on the server (${e.message}); it is kept in this browser`);
+      }
+    });
+    return this.queue;
+  }
 }
 
 export async function save(api, photoCode, seg, history) {
@@ -86,5 +140,5 @@ export async function readSegmentationFile(file, width, height, api) {
 
 export async function rectify(api, photoCode, corners) {
   await api(`/api/v1/photos/${photoCode}/rectify`, {method: "POST", body: JSON.stringify({corners})});
-  localStorage.removeItem(draftKey(photoCode));
+  dropDrafts(api, photoCode);  // drawn on the image before: it no longer fits
 }

@@ -3,7 +3,7 @@
 import numpy as np
 from PIL import Image
 
-from facaid.appearance import refine, similarity
+from facaid.appearance import refine, search, similarity
 from facaid.completion import complete
 from facaid.labels import FACADE, LABEL_ID
 from facaid.segmentation import Rect, Segmentation
@@ -54,3 +54,30 @@ def test_the_photo_confirms_a_proposal_where_a_window_is_and_rejects_one_where_t
     assert others and all(p["photo"] < 0.8 and p["score"] < 0.5 for p in others)  # the wall at 14 among them
     # a photo with nothing to see (a flat render) changes nothing
     assert complete(seg, Image.new("RGB", (600, 500), (200, 180, 150))) == structure
+
+
+SCATTERED = [(30, 40, 90, 100), (250, 60, 310, 120), (420, 30, 480, 90), (100, 300, 160, 360), (380, 280, 440, 340)]
+
+
+def test_search_finds_every_window_of_the_photo_from_one_example_and_nothing_on_the_wall():
+    grey = np.asarray(_photo(SCATTERED), dtype=np.float32)
+    grey[400:490, 150:590] = 50  # a shop's dark glass: no window there, though its panes are as dark
+    boxes, sims = search(grey, np.array([SCATTERED[0]], float), (60, 60), 0.9)
+    found = sorted(tuple(int(round(v)) for v in b) for b in boxes)
+    assert len(found) == len(SCATTERED) and (sims >= 0.9).all()
+    for got, want in zip(found, sorted(SCATTERED), strict=True):
+        assert max(abs(g - w) for g, w in zip(got, want, strict=True)) <= 4  # within the searched copy's pixel
+    flat = np.full((500, 600), 128, np.float32)
+    assert len(search(flat, np.array([SCATTERED[0]], float), (60, 60), 0.9)[0]) == 0
+    assert len(search(grey, np.zeros((0, 4)), (60, 60), 0.9)[0]) == 0
+
+
+def test_with_a_photo_completion_proposes_windows_no_structure_implies():
+    drawn = (Rect(FACADE, 0, 0, 600, 500), Rect(WINDOW, *SCATTERED[0]))
+    seg = Segmentation(600, 500, drawn)
+    assert complete(seg) == []  # one window: no row, no column, no pitch
+    proposals = complete(seg, _photo(SCATTERED))
+    assert len(proposals) == len(SCATTERED) - 1
+    assert all(p["reason"] == "looks like window" and p["score"] >= 0.9 and p["photo"] >= 0.8 for p in proposals)
+    for p in proposals:
+        assert any(abs(p["x0"] - b[0]) <= 4 and abs(p["y0"] - b[1]) <= 4 for b in SCATTERED[1:])

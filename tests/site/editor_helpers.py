@@ -45,13 +45,15 @@ def open_editor(live_server, as_alice, browser, viewport=(1400, 1000)):
     return page, context
 
 
-def open_page(live_server, browser, code: str, ready: str, viewport=(1400, 1000), has_touch=False):
+def open_page(live_server, browser, code: str, ready: str, viewport=(1400, 1000), has_touch=False, dialog=None):
     """(page, context): Alice logged in and the editor of her photo ``code`` open, once the JavaScript ``ready``
-    holds; the page's uncaught errors collect in `page.errors`."""
+    holds; the page's uncaught errors collect in `page.errors`; ``dialog`` answers the page's dialogs."""
     context = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}, has_touch=has_touch)
     page = context.new_page()
     page.errors = []
     page.on("pageerror", lambda e: page.errors.append(str(e)))
+    if dialog is not None:
+        page.on("dialog", dialog)
     login(page, live_server.url, "alice", "alice-password-1")
     page.goto(f"{live_server.url}/photos/{code}/edit")
     page.wait_for_function(ready)

@@ -263,3 +263,32 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
     r = as_alice.post(url, [1, 2], format="json")
     assert r.status_code == 400 and "JSON object" in json.dumps(r.json())
     assert as_bob.post(url, _drawn_grid(w, h), format="json").status_code == 404  # Alice's private photo
+
+
+def test_the_draft_is_kept_for_the_owner_replaced_and_dropped_by_a_save(facade_photo, as_alice, as_bob):
+    photo, seg = facade_photo
+    url = f"/api/v1/photos/{photo['code']}/draft"
+    assert as_alice.get(url).json() == {"draft": None}
+    fewer = {**seg["data"], "rects": seg["data"]["rects"][:5]}
+    r = as_alice.put(url, fewer, format="json")
+    assert r.status_code == 200, r.content
+    kept = as_alice.get(url).json()["draft"]
+    assert kept["rect_count"] == 5 and kept["data"]["rects"] == fewer["rects"] and kept["updated"]
+    more = {**seg["data"], "rects": seg["data"]["rects"][:7]}
+    assert as_alice.put(url, more, format="json").json()["draft"]["rect_count"] == 7  # one draft, replaced
+    assert as_alice.get(seg_url(photo)).json()["count"] == 1  # a draft is no version
+    # others see nothing of it and change nothing, whatever the photo's visibility
+    as_alice.patch(f"/api/v1/photos/{photo['code']}/", {"visibility": "public"}, format="json")
+    assert as_bob.get(url).status_code == 403 and as_bob.put(url, fewer, format="json").status_code == 403
+    assert as_alice.get(url).json()["draft"]["rect_count"] == 7
+    # a bad draft is a 400 naming the problem, and the kept one stays
+    for bad, message in (({**fewer, "width": fewer["width"] + 3}, "but the photo is"),
+                         ({**fewer, "rects": [{"label": "tower", "x0": 0, "y0": 0, "x1": 2, "y1": 2}]}, "tower")):
+        r = as_alice.put(url, bad, format="json")
+        assert r.status_code == 400 and message in r.content.decode(), r.content
+    assert as_alice.get(url).json()["draft"]["rect_count"] == 7
+    # saving a version drops the draft; DELETE drops one too
+    as_alice.post(seg_url(photo), more, format="json")
+    assert as_alice.get(url).json() == {"draft": None}
+    as_alice.put(url, fewer, format="json")
+    assert as_alice.delete(url).status_code == 204 and as_alice.get(url).json() == {"draft": None}

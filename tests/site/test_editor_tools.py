@@ -8,7 +8,7 @@ import os
 import shutil
 
 import pytest
-from editor_helpers import WINDOWS, E, drag, open_editor, rects, screen, selected
+from editor_helpers import WINDOWS, E, drag, open_editor, open_page, rects, screen, selected
 from site_helpers import login
 
 from webapp.facades.models import Segmentation
@@ -386,3 +386,26 @@ def test_repeat_to_the_edge_from_two_examples_and_split_into_columns_each_one_un
     page.click("#split")
     assert page.text_content("#status") == "40 columns with gaps of 3 px do not fit in 60 px."
     assert len(rects(page)) == 3
+
+
+def test_the_draft_is_kept_on_the_server_offered_in_another_browser_and_dropped_by_a_save(editor, live_server,
+                                                                                          as_alice, browser):
+    page, code = editor, editor.photo["code"]
+    x, y = WINDOWS[1]
+    drag(page, (x, y), (x + 60, y + 90))  # the second window, drawn
+    assert len(rects(page)) == 3
+    page.wait_for_function("document.querySelector('#draft-note').textContent.includes('kept on the server')",
+                           timeout=15_000)
+    draft = as_alice.get(f"/api/v1/photos/{code}/draft").json()["draft"]
+    assert draft["rect_count"] == 3
+    # another browser, with nothing kept of its own, is offered the server's draft and restores it
+    asked = []
+    other, context = open_page(live_server, browser, code, f"{E}?.seg?.size === 3",
+                               dialog=lambda d: (asked.append(d.message), d.accept()))
+    assert len(asked) == 1 and "kept on the server" in asked[0]
+    other.click("#save")
+    other.wait_for_function("document.querySelector('#dirty').textContent === 'saved'")
+    assert as_alice.get(f"/api/v1/photos/{code}/draft").json() == {"draft": None}
+    assert Segmentation.objects.filter(photo__code=code).count() == 2
+    assert other.errors == []
+    context.close()

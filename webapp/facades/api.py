@@ -36,7 +36,7 @@ from facaid.variation import vary
 from webapp.facades import access, downloads, pictures, rendering, services
 from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.jsonbody import JSONParser
-from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.paging import Pagination
 from webapp.facades.serializers import (
     ConvertSerializer,
@@ -218,6 +218,31 @@ def photo_segmentations(request, code):
     seg, warnings = services.add_segmentation(photo, request.data, request.query_params.get("format"),
                                               request.query_params.get("image"))
     return Response({**SegmentationSerializer(seg).data, "warnings": list(warnings)}, status=status.HTTP_201_CREATED)
+
+
+def _draft(draft) -> dict:
+    return {"draft": None if draft is None else {"data": draft.data, "rect_count": draft.rect_count,
+                                                 "updated": draft.updated.isoformat()}}
+
+
+@extend_schema(methods=["GET"], responses={200: dict},
+               summary="The owner's unsaved draft of the photo's segmentation: {'draft': {data, rect_count, updated}} "
+                       "or {'draft': null}")
+@extend_schema(methods=["PUT"], request={"application/json": dict}, responses={200: dict},
+               summary="Keep the editor's unsaved segmentation (the contract's JSON, of the photo's size) as the "
+                       "photo's draft, replacing the last one; saving a version removes it")
+@extend_schema(methods=["DELETE"], responses={204: None}, summary="Drop the photo's draft")
+@api_view(["GET", "PUT", "DELETE"])
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def photo_draft(request, code):
+    photo = access.get_rw_photo_for_user(request.user, code)  # the owner's: a draft is no one else's business
+    if request.method == "PUT":
+        return Response(_draft(services.save_draft(photo, request.data)))
+    if request.method == "DELETE":
+        Draft.objects.filter(photo=photo).delete()
+        return Response(status=status.HTTP_204_NO_CONTENT)
+    return Response(_draft(Draft.objects.filter(photo=photo).first()))
 
 
 @extend_schema(parameters=[OpenApiParameter("format", str, enum=interchange.FORMATS,

@@ -10,6 +10,7 @@ urlpatterns = [
     path("photos/<str:code>/corners/propose", api.photo_propose_corners, name="api-photo-propose-corners"),
     path("photos/<str:code>/segmentations/", api.photo_segmentations, name="api-photo-segmentations"),
     path("photos/<str:code>/segmentation", api.photo_segmentation_file, name="api-photo-segmentation-file"),
+    path("photos/<str:code>/draft", api.photo_draft, name="api-photo-draft"),
     path("photos/<str:code>/complete", api.photo_complete, name="api-photo-complete"),
     path("segmentations/<str:code>/", api.segmentation_detail, name="api-segmentation"),
     path("jobs/", api.job_list, name="api-jobs"),

@@ -95,6 +95,19 @@ class Segmentation(models.Model):
         return f"{self.photo} v{self.version}"
 
 
+class Draft(models.Model):
+    """The owner's unsaved segmentation of a photo as the editor last sent it (one a photo): kept so that work
+    survives another browser or a lost tab; saving a version removes it."""
+
+    photo = models.OneToOneField(Photo, on_delete=models.CASCADE, related_name="draft")
+    data = models.JSONField()
+    rect_count = models.PositiveIntegerField(default=0)
+    updated = models.DateTimeField(default=timezone.now)
+
+    def __str__(self) -> str:
+        return f"{self.photo} draft"
+
+
 def tree_digest(data: dict) -> str:
     """16 hex digits naming a procedure JSON (its keys sorted); migration 0003 writes the same out."""
     text = json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False)

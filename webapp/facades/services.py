@@ -11,6 +11,7 @@ from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.db.models import Max
 from django.http import Http404
+from django.utils import timezone
 from PIL import Image
 from rest_framework.exceptions import APIException, ValidationError
 
@@ -20,7 +21,7 @@ from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
 from facaid.rectify import propose_corners_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import jobs
-from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.serializers import parse_procedure, parse_segmentation
 from webapp.facades.uploads import UploadError, normalize_photo
 
@@ -105,7 +106,17 @@ def add_segmentation(photo: Photo, data, format: str | None = None,
         last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
         version = Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
                                               rect_count=len(seg.rects))
+        Draft.objects.filter(photo=photo).delete()  # saved: the draft it was is the version now
     return version, loaded.warnings
+
+
+def save_draft(photo: Photo, data) -> Draft:
+    """Keep (replace) the photo's draft: the segmentation contract's JSON of the photo's size (the rectified
+    image's once there is one), validated as a version would be."""
+    seg = _segmentation_of(photo, data).segmentation
+    draft, _ = Draft.objects.update_or_create(photo=photo, defaults={
+        "data": seg.to_dict(), "rect_count": len(seg.rects), "updated": timezone.now()})
+    return draft
 
 
 def segmentation_file(photo: Photo, format: str, version: str | None = None) -> tuple[str, str, bytes]:
