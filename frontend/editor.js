@@ -413,12 +413,32 @@ async function submitNow() {
 async function openRectify() {
   rectifying = await openRectifyMode(canvas, $("#rectify-preview"), info);
   $("#rectify-panel").hidden = false;
+  const side = info.real_height_m != null ? "height" : "width";
+  $("#real-side").value = side;
+  $("#real-metres").value = info[`real_${side}_m`] ?? "";
   status("Drag the four corners onto the facade's corners; the preview shows the result.");
+}
+
+/** The real size typed in the rectification panel, as the photo's fields ({real_width_m: 12.5}: the other side
+ * cleared; both null when the field is empty); throws a message for what is not a size. */
+function typedRealSize() {
+  const input = $("#real-metres"), side = $("#real-side").value;
+  const size = {real_width_m: null, real_height_m: null};
+  if (input.value === "" && !input.validity.badInput) return size;
+  const metres = Number(input.value);
+  if (!Number.isFinite(metres) || metres < Number(input.min) || metres > Number(input.max)) {
+    throw new Error(`the real ${side} must be a number of metres from ${input.min} to ${input.max}`);
+  }
+  return {...size, [`real_${side}_m`]: metres};
 }
 
 async function applyRectify() {
   if (seg.size && !confirm("Rectifying changes the image: the rectangles drawn so far do not carry over. Go on?")) return;
   try {
+    const size = typedRealSize();
+    if (size.real_width_m !== info.real_width_m || size.real_height_m !== info.real_height_m) {
+      Object.assign(info, await api(`/api/v1/photos/${photoCode}/`, {method: "PATCH", body: JSON.stringify(size)}));
+    }
     await rectify(api, photoCode, rectifying.corners);
     history.markSaved();
     location.reload();

@@ -49,8 +49,20 @@ def test_propose_corners_moves_the_handles_onto_the_facade(live_server, as_alice
     page.mouse.up()
     moved = page.evaluate(f"{E}.rectifying.corners")
     assert abs(moved[0][0] - corners[0][0] - 15) <= 2 and moved[1:] == corners[1:].tolist()
+    # the facade's real size goes with it: a size out of range stops it, with a message, and rectifies nothing
+    page.fill("#real-metres", "0.01")
+    page.click("#rectify-apply")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Not rectified')")
+    assert "real width must be a number of metres from 0.5 to 1000" in page.text_content("#status")
+    assert not Photo.objects.get(code=photo["code"]).rectified
+    page.select_option("#real-side", "height")
+    page.fill("#real-metres", "14.5")
     page.click("#rectify-apply")
     page.wait_for_function(f"{E}?.seg && {E}.seg.width > 0 && !{E}.rectifying")
     stored = Photo.objects.get(code=photo["code"])
     assert stored.rectified and np.allclose(stored.corners, moved)
+    assert (stored.real_width_m, stored.real_height_m) == (None, 14.5)
+    page.click("#rectify")  # shown again as it is kept
+    page.wait_for_function(f"{E}.rectifying")
+    assert page.input_value("#real-side") == "height" and page.input_value("#real-metres") == "14.5"
     assert errors == []

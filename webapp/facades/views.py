@@ -25,7 +25,7 @@ from webapp.facades.forms import (
     SegmentationForm,
     VisibilityForm,
 )
-from webapp.facades.models import Job, Photo, Procedure
+from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure
 from webapp.facades.serializers import PhotoSerializer
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
@@ -174,7 +174,8 @@ def photo_editor(request, code):
     photo = access.get_rw_photo_for_user(request.user, code)
     segmentation = photo.latest_segmentation()
     return render(request, "facades/editor.html", {"photo": photo, "segmentation": segmentation,
-                                                   "default_k": DEFAULT_K, "max_k": MAX_K})
+                                                   "default_k": DEFAULT_K, "max_k": MAX_K,
+                                                   "real_size_min": REAL_SIZE_M[0], "real_size_max": REAL_SIZE_M[1]})
 
 
 def job(request, code):
