@@ -140,5 +140,5 @@ export async function readSegmentationFile(file, width, height, api) {
 
 export async function rectify(api, photoCode, corners) {
   await api(`/api/v1/photos/${photoCode}/rectify`, {method: "POST", body: JSON.stringify({corners})});
-  dropDrafts(api, photoCode);  // drawn on the image before: it no longer fits
+  localStorage.removeItem(draftKey(photoCode));  // drawn on the image before (the server drops its copy too)
 }

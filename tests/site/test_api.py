@@ -292,3 +292,10 @@ def test_the_draft_is_kept_for_the_owner_replaced_and_dropped_by_a_save(facade_p
     assert as_alice.get(url).json() == {"draft": None}
     as_alice.put(url, fewer, format="json")
     assert as_alice.delete(url).status_code == 204 and as_alice.get(url).json() == {"draft": None}
+    # rectifying drops it: it was drawn on the image before
+    as_alice.put(url, fewer, format="json")
+    w, h = photo["width"], photo["height"]
+    r = as_alice.post(f"/api/v1/photos/{photo['code']}/rectify", {"corners": [[0, 0], [w, 0], [w, h], [0, h]]},
+                      format="json")
+    assert r.status_code == 200, r.content
+    assert as_alice.get(url).json() == {"draft": None}

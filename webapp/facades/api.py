@@ -179,6 +179,7 @@ def photo_rectify(request, code):
     photo.rectified.save("rectified.png", ContentFile(buf.getvalue()), save=False)
     photo.corners = corners
     photo.save()
+    Draft.objects.filter(photo=photo).delete()  # drawn on the image before: it no longer fits
     return Response(PhotoSerializer(photo).data)
 
 
