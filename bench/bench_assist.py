@@ -10,7 +10,7 @@ a true element not drawn yet (same class, IoU >= 0.7) and pays one action for ev
 1-189) and the test half (190-378) apart, beside the effort without completion (the 95 % stop alone), with the
 median time of a completion call. CMP is evaluation data: nothing here trains. CMP's photos are not in the repo:
 ``--generated N`` runs the same annotator on N held-out generated facades (seeds 5000 on) drawn on photo-like
-renders of themselves (`facaid.photolike.render_photo`), without and with the photo check.
+renders of themselves (`facaid.photolike.render_photo`), without and with the photo (searched and checking).
 """
 
 from __future__ import annotations

@@ -20,11 +20,15 @@ a drawn one:
 4. **Companions**: an element drawn on or against every one of at least `COMPANION_MIN` drawn elements of
    another type (a sill under each window) is proposed at the same offset for the rest of them (``with
    window``; at most 0.8: right 7 times in 70 on CMP's dev half).
-5. **The photo** (when given: the image the segmentation is drawn on, resized to its size): each proposal scored
-   at least `PHOTO_CANDIDATE` is moved to the best of 25 nearby places and compared with the drawn elements of
-   its class (`facaid.appearance`: normalized cross-correlation of 12 x 12 grey patches); at `PHOTO_MATCH` or
-   more it scores at least `PHOTO_CONFIRMED`, below that half its structural score, and ``photo`` holds the
-   similarity. Where the photo is flat (a rendered label map) it has no say.
+5. **The photo** (when given: the image the segmentation is drawn on, resized to its size) proposes: every place
+   that looks like a type's drawn elements with the wall around them (`facaid.appearance.search`, NCC at least
+   `SEARCH_MATCH`, anywhere in the facade, rows and lattices or not) is proposed at the type's size (score
+   `PHOTO_CONFIRMED`, reason ``looks like window``). On photo-like renders of 12 held-out generated facades this
+   takes the effort from 0.785 (the structure, checked by the photo) to 0.701.
+6. **The photo checks**: each proposal scored at least `PHOTO_CANDIDATE` is moved to the best of 25 nearby places
+   and compared with the drawn elements of its class (`facaid.appearance`: normalized cross-correlation of 12 x 12
+   grey patches); at `PHOTO_MATCH` or more it scores at least `PHOTO_CONFIRMED`, below that half its structural
+   score, and ``photo`` holds the similarity. Where the photo is flat (a rendered label map) it has no say.
 
 Proposals outside the drawn facade rectangles' bounds (the image when none is drawn), cut by the image's edge, over
 a drawn element of the same class, mostly under a drawn element of a class that paints over them, or near a

@@ -52,7 +52,7 @@ def oracle(truth, kind):
                 else:  # copy: a drawn size at the element's centre
                     w, h = a[:, 2] - a[:, 0], a[:, 3] - a[:, 1]
                     cx, cy = (r.x0 + r.x1) / 2, (r.y0 + r.y1) / 2
-                    cands = [(cx - wi / 2, cy - hi / 2, cx + wi / 2, cy + hi / 2) for wi, hi in zip(w, h)]
+                    cands = [(cx - wi / 2, cy - hi / 2, cx + wi / 2, cy + hi / 2) for wi, hi in zip(w, h, strict=True)]
                     box = max(cands, key=lambda b: _box_iou(b, r))
             box = tuple(int(round(float(v))) for v in box)
             if box[2] > box[0] and box[3] > box[1] and _box_iou(box, r) >= 0.7:
