@@ -108,6 +108,8 @@ def refine(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray) -> 
 
 SEARCH_SIDE = 16  # pixels: the photo is searched scaled so that the examples' smaller side is about this long
 SEARCH_TEMPLATES = 4  # examples matched at most per search (the first drawn)
+SEARCH_PIXELS = 400_000  # the searched copy has at most this many pixels (a big photo is scaled down to it) ...
+SEARCH_SMALLEST = 4  # ... and elements whose smaller side is shorter than this in it are not searched for
 CONTEXT = 0.25  # share of its size around each example that is matched with it (a window in its wall)
 
 
@@ -116,8 +118,9 @@ def search(grey_levels: np.ndarray, examples: np.ndarray, size: tuple[float, flo
     """(boxes (n, 4) of ``size`` = (width, height), their NCC) where the photo looks like the examples ((m, 4)
     boxes) at ``threshold`` or more, anywhere in it. Each example with `CONTEXT` of its size around it (what is
     beside a window tells it from a pane of a shop's glass), scaled to ``size``, is slid over the photo (OpenCV's
-    normalized cross-correlation, on a copy scaled so that the size's smaller side is `SEARCH_SIDE` pixels);
-    the peaks of the best response, each the best within an element's size, are kept, the highest first, at
+    normalized cross-correlation, on a copy scaled so that the size's smaller side is `SEARCH_SIDE` pixels, or
+    less to keep the copy within `SEARCH_PIXELS`; a size whose smaller side is then under `SEARCH_SMALLEST` is not
+    searched for); the peaks of the best response, each the best within an element's size, are kept, the highest first, at
     most ``limit``. Flat places and flat examples have no say; none found: empty arrays."""
     import cv2
 
@@ -125,7 +128,9 @@ def search(grey_levels: np.ndarray, examples: np.ndarray, size: tuple[float, flo
     w, h = float(size[0]), float(size[1])
     if not len(examples) or w < 2 or h < 2:
         return none
-    f = min(1.0, SEARCH_SIDE / min(w, h))
+    f = min(1.0, SEARCH_SIDE / min(w, h), float(np.sqrt(SEARCH_PIXELS / grey_levels.size)))
+    if min(w, h) * f < SEARCH_SMALLEST:
+        return none
     small = cv2.resize(grey_levels, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if f < 1 else grey_levels
     mx, my = CONTEXT * w, CONTEXT * h
     tw, th = max(3, round((w + 2 * mx) * f)), max(3, round((h + 2 * my) * f))

@@ -24,7 +24,7 @@ a drawn one:
    that looks like a type's drawn elements with the wall around them (`facaid.appearance.search`, NCC at least
    `SEARCH_MATCH`, anywhere in the facade, rows and lattices or not) is proposed at the type's size (score
    `PHOTO_CONFIRMED`, reason ``looks like window``). On photo-like renders of 12 held-out generated facades this
-   takes the effort from 0.785 (the structure, checked by the photo) to 0.701.
+   takes the effort from 0.785 (the structure, checked by the photo) to 0.700.
 6. **The photo checks**: each proposal scored at least `PHOTO_CANDIDATE` is moved to the best of 25 nearby places
    and compared with the drawn elements of its class (`facaid.appearance`: normalized cross-correlation of 12 x 12
    grey patches); at `PHOTO_MATCH` or more it scores at least `PHOTO_CONFIRMED`, below that half its structural
