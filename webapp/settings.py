@@ -61,6 +61,7 @@ INSTALLED_APPS = [
     "rest_framework",
     "rest_framework.authtoken",
     "drf_spectacular",
+    "drf_spectacular_sidecar",  # Swagger UI's JS and CSS as static files, for the API docs page
     "axes",
     "webapp.accounts",
     "webapp.facades",
@@ -192,6 +193,12 @@ SPECTACULAR_SETTINGS = {
     "DESCRIPTION": "Photos, segmentations, reconstruction jobs and procedures of the FaçAID site.",
     "VERSION": "1",
     "SERVE_INCLUDE_SCHEMA": False,
+    # the docs page (/api/v1/docs) loads Swagger UI from our static files and asks no other site for anything: no
+    # validator badge, which would send the schema's address to swagger.io
+    "SWAGGER_UI_DIST": "SIDECAR",
+    "SWAGGER_UI_FAVICON_HREF": "SIDECAR",
+    "SWAGGER_UI_SETTINGS": {"deepLinking": True, "validatorUrl": None, "docExpansion": "list",
+                            "defaultModelsExpandDepth": 0},
 }
 
 LOGGING = {

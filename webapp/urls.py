@@ -1,12 +1,15 @@
 from django.conf import settings
 from django.contrib import admin
 from django.urls import include, path
-from drf_spectacular.views import SpectacularAPIView
+from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerView
 
 urlpatterns = [
     path("admin/", admin.site.urls),
     path("accounts/", include("webapp.accounts.urls")),
     path("api/v1/schema", SpectacularAPIView.as_view(), name="schema"),
+    # the schema as a page (Swagger UI from drf-spectacular-sidecar's static files: nothing from another site)
+    path("api/v1/docs", SpectacularSwaggerView.as_view(url_name="schema", template_name="api_docs.html"),
+         name="api-docs"),
     path("api/v1/", include("webapp.facades.api_urls")),
     path("", include("webapp.facades.urls")),
 ]

@@ -71,3 +71,28 @@ def test_procedure_page_for_owner_and_visitor(alice):
     assert "download/labels.svg" in visitor and "download/labels.png" in visitor and "overlay.png" not in visitor
     assert "download/procedure.cga" in visitor and "download/mesh.zip" in visitor
     assert "CityEngine CGA rules" in visitor and "for Blender and other 3D tools" in visitor  # each says what it is
+
+
+def test_the_api_docs_page_names_only_files_of_this_site():
+    import re
+
+    from django.contrib.staticfiles import finders
+
+    r = Client().get("/api/v1/docs")
+    assert r.status_code == 200 and r["Content-Type"].startswith("text/html")
+    html = r.content.decode()
+    assert '<header class="top">' in html and "SwaggerUIBundle" in html
+    urls = re.findall(r'(?:src|href)="([^"]*)"', html) + re.findall(r'url: "([^"]*)"', html)
+    assert len(urls) > 5
+    for url in urls:
+        assert url.startswith("/") and not url.startswith("//") or url.startswith("data:"), url
+    assert not re.search(r"https?://|//cdn|jsdelivr|unpkg|googleapis", html.replace("http://www.w3.org/2000/svg", ""))
+    statics = [u for u in urls if u.startswith("/static/drf_spectacular_sidecar/")]
+    assert len(statics) == 2  # Swagger UI's CSS and JS
+    for url in statics:
+        assert finders.find(url.removeprefix("/static/")), url
+    # the footer's link goes to the page; the schema it reads stays a YAML file
+    assert 'href="/api/v1/docs">API docs</a>' in Client().get("/").content.decode()
+    r = Client().get("/api/v1/schema")
+    assert r.status_code == 200 and r["Content-Type"].startswith("application/vnd.oai.openapi")
+    assert r.content.startswith(b"openapi:")

@@ -1,0 +1,66 @@
+"""The site's own pages in Debian's Chromium through Playwright, offline (every request to another site is refused
+and counted): the API docs list the operations from the schema with Swagger UI served from our static files. With
+FACAID_SCREENSHOT_DIR set, the pictures of docs/img are written there (api-docs.png)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import pytest
+from site_helpers import login
+
+pytestmark = [pytest.mark.django_db(transaction=True),
+              pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
+
+
+def offline_page(browser, base: str, viewport=(1280, 900)):
+    """A page whose requests to anything but ``base`` are refused and listed in `page.elsewhere`; its uncaught
+    errors collect in `page.errors`."""
+    page = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}).new_page()
+    page.elsewhere, page.errors = [], []
+
+    def route(r):
+        if r.request.url.startswith(base) or r.request.url.startswith("data:"):
+            r.continue_()
+        else:
+            page.elsewhere.append(r.request.url)
+            r.abort()
+
+    page.route("**/*", route)
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    return page
+
+
+def screenshot(page, name: str, tmp_path) -> None:
+    folder = os.environ.get("FACAID_SCREENSHOT_DIR") or str(tmp_path)
+    page.screenshot(path=os.path.join(folder, name), full_page=False)
+
+
+def test_the_api_docs_list_the_operations_offline(live_server, alice, browser, tmp_path):
+    page = offline_page(browser, live_server.url, viewport=(1280, 1100))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/")
+    page.click("footer >> text=API docs")
+    page.wait_for_url(f"{live_server.url}/api/v1/docs")
+    page.wait_for_selector(".opblock")
+    paths = page.eval_on_selector_all(".opblock-summary-path", "els => els.map(e => e.dataset.path || e.textContent)")
+    methods = page.eval_on_selector_all(".opblock-summary-method", "els => els.map(e => e.textContent)")
+    for expected in ("/api/v1/photos/", "/api/v1/procedures/{code}/fork", "/api/v1/jobs/{code}/"):
+        assert expected in paths, paths
+    assert len(paths) >= 20 and {"GET", "POST", "PATCH", "DELETE"} <= set(methods)
+    assert page.elsewhere == [] and page.errors == []
+    assert page.locator("header.top .who").inner_text() == "alice"  # the site's header over Swagger UI
+    # an operation opens with its parameters and answers
+    one = page.locator(".opblock-get:has(.opblock-summary-path[data-path='/api/v1/procedures/{code}/'])")
+    one.locator(".opblock-summary-control").click()
+    one.locator(".parameters-container").wait_for()
+    assert "code" in one.locator(".parameters-container").inner_text()
+    one.locator(".opblock-summary-control").click()  # closed again for the picture
+    one.locator(".parameters-container").wait_for(state="detached")
+    page.evaluate("scrollTo(0, 0)")
+    screenshot(page, "api-docs.png", tmp_path)
+    # the YAML the page is read from stays a link away
+    href = page.get_attribute("#schema-yaml", "href")
+    assert href == "/api/v1/schema"
+    assert page.request.get(f"{live_server.url}{href}").text().startswith("openapi:")
