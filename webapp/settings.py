@@ -46,6 +46,7 @@ SECURE_CONTENT_TYPE_NOSNIFF = True
 SECURE_REFERRER_POLICY = "same-origin"
 SECURE_CROSS_ORIGIN_OPENER_POLICY = "same-origin"
 X_FRAME_OPTIONS = "DENY"
+CSRF_FAILURE_VIEW = "webapp.errors.csrf_failure"  # the site's 403 page, saying to reload the form
 # proxies in front of the site that append the client's address to X-Forwarded-For: the address that the login
 # lockouts and the API's anonymous throttle count is the one the outermost of them saw (0: REMOTE_ADDR, and a
 # client's own X-Forwarded-For is ignored)

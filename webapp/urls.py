@@ -14,6 +14,12 @@ urlpatterns = [
     path("", include("webapp.facades.urls")),
 ]
 
+# the site's error pages, and JSON under /api/ (webapp/errors.py)
+handler400 = "webapp.errors.bad_request"
+handler403 = "webapp.errors.permission_denied"
+handler404 = "webapp.errors.page_not_found"
+handler500 = "webapp.errors.server_error"
+
 if settings.DEBUG:
     from django.conf.urls.static import static
 

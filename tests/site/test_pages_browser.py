@@ -1,11 +1,13 @@
 """The site's own pages in Debian's Chromium through Playwright, offline (every request to another site is refused
-and counted): the API docs list the operations from the schema with Swagger UI served from our static files. With
-FACAID_SCREENSHOT_DIR set, the pictures of docs/img are written there (api-docs.png)."""
+and counted): the API docs list the operations from the schema with Swagger UI served from our static files; the
+404 page. With FACAID_SCREENSHOT_DIR set, the pictures of docs/img are written there (api-docs.png,
+not-found.png)."""
 
 from __future__ import annotations
 
 import os
 import shutil
+import uuid
 
 import pytest
 from site_helpers import login
@@ -64,3 +66,16 @@ def test_the_api_docs_list_the_operations_offline(live_server, alice, browser, t
     href = page.get_attribute("#schema-yaml", "href")
     assert href == "/api/v1/schema"
     assert page.request.get(f"{live_server.url}{href}").text().startswith("openapi:")
+
+
+def test_the_404_page_offline(live_server, alice, browser, tmp_path):
+    page = offline_page(browser, live_server.url)
+    login(page, live_server.url, "alice", "alice-password-1")
+    r = page.goto(f"{live_server.url}/photos/{uuid.uuid4()}")
+    assert r.status == 404
+    assert page.locator("h1").inner_text() == "Not found"
+    assert page.locator("header.top .who").inner_text() == "alice"
+    assert page.elsewhere == [] and page.errors == []
+    screenshot(page, "not-found.png", tmp_path)
+    page.click("text=Go to the gallery")
+    page.wait_for_url(f"{live_server.url}/")
