@@ -1,7 +1,7 @@
 """The site's own pages in Debian's Chromium through Playwright, offline (every request to another site is refused
 and counted): the API docs list the operations from the schema with Swagger UI served from our static files; the
-404 page. With FACAID_SCREENSHOT_DIR set, the pictures of docs/img are written there (api-docs.png,
-not-found.png)."""
+404 page; disabled controls look disabled. With FACAID_SCREENSHOT_DIR set, the pictures of docs/img are written
+there (api-docs.png, not-found.png)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import shutil
 import uuid
 
 import pytest
+from editor_helpers import open_editor
 from site_helpers import login
 
 pytestmark = [pytest.mark.django_db(transaction=True),
@@ -79,3 +80,39 @@ def test_the_404_page_offline(live_server, alice, browser, tmp_path):
     screenshot(page, "not-found.png", tmp_path)
     page.click("text=Go to the gallery")
     page.wait_for_url(f"{live_server.url}/")
+
+
+def test_disabled_controls_look_disabled(live_server, as_alice, browser):
+    """In the editor, every kind of control, disabled, is greyed or faded and shows the not-allowed cursor, whatever
+    colours its own rule gives it (the palette's white buttons, a pressed layer toggle, a link styled as a button)."""
+    page, context = open_editor(live_server, as_alice, browser)
+    page.wait_for_selector("#objects button.layer")
+    page.evaluate("""() => {
+      document.querySelector('#result').hidden = false;
+      document.querySelector('#result-link').setAttribute('aria-disabled', 'true');
+      document.querySelector('#objects button.layer').setAttribute('aria-pressed', 'true');
+      for (const s of ['#palette button', '#objects button.layer', '#split-dir', '#snap', '#fill', '#import']) {
+        document.querySelector(s).disabled = true;
+      }
+    }""")
+    look = """el => { const s = getComputedStyle(el);
+      return {background: s.backgroundColor, color: s.color, cursor: s.cursor, opacity: s.opacity,
+              events: s.pointerEvents}; }"""
+    assert page.eval_on_selector("#undo", "b => b.disabled")  # nothing to undo yet: the toolbar's own state
+    assert page.eval_on_selector("#sel-x0", "i => i.disabled")  # nothing selected
+    greyed = ("#undo", "#palette button", "#objects button.layer", "#result-link", "label.button:has(#import)")
+    faded = ("#sel-x0", "#split-dir", "#snap", "#fill")
+    for selector in greyed:
+        style = page.eval_on_selector(selector, look)
+        assert (style["background"], style["color"], style["cursor"]) == (
+            "rgb(201, 204, 209)", "rgb(95, 102, 112)", "not-allowed"), (selector, style)
+    for selector in faded:
+        style = page.eval_on_selector(selector, look)
+        assert float(style["opacity"]) < 1 and style["cursor"] == "not-allowed", (selector, style)
+    assert page.eval_on_selector("#result-link", look)["events"] == "none"  # a disabled link is not followed
+    for selector, background in (("#save", "rgb(31, 111, 235)"), ("#duplicate", "rgb(31, 111, 235)"),
+                                 ("#palette button:enabled", "rgb(255, 255, 255)")):  # enabled ones keep theirs
+        style = page.eval_on_selector(selector, look)
+        assert style["background"] == background and style["cursor"] == "pointer", (selector, style)
+    assert page.errors == []
+    context.close()
