@@ -53,8 +53,8 @@ def home(request):
     if request.user.is_authenticated:
         context.update(photos=Photo.objects.filter(owner=request.user)[:12],
                        procedures=access.listed(Procedure.objects.filter(owner=request.user))[:12],
-                       jobs=Job.objects.filter(owner=request.user).select_related("result").defer(
-                           *access.JOB_WITHOUT)[:8])
+                       jobs=Job.objects.filter(owner=request.user).select_related(
+                           "result", "segmentation__photo").defer(*access.JOB_WITHOUT)[:8])
     return render(request, "facades/home.html", context)
 
 
@@ -80,8 +80,8 @@ def photo(request, code):
     context = {"photo": photo, "owner": owner, "segmentation": segmentation,
                "procedures": access.listed(photo.procedures.filter(owner=photo.owner) if owner else
                                            photo.procedures.filter(visibility="public")),
-               "jobs": Job.objects.filter(segmentation__photo=photo).select_related("result").defer(
-                   *access.JOB_WITHOUT)[:10] if owner
+               "jobs": Job.objects.filter(segmentation__photo=photo).select_related(
+                   "result", "segmentation__photo").defer(*access.JOB_WITHOUT)[:10] if owner
                else Job.objects.none(),
                "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
                "interchange_formats": INTERCHANGE_FORMATS, "metres_per_pixel": photo.metres_per_pixel(),
@@ -178,7 +178,9 @@ def photo_editor(request, code):
 
 
 def job(request, code):
-    return render(request, "facades/job.html", {"job": access.get_job_for_user(request.user, code)})
+    job = access.get_job_for_user(request.user, code)
+    return render(request, "facades/job.html", {
+        "job": job, "photo_visible": access.photo_visible_to(request.user, job.segmentation.photo)})
 
 
 def procedure(request, code):
