@@ -80,6 +80,7 @@ def test_the_api_docs_page_names_only_files_of_this_site():
 
     r = Client().get("/api/v1/docs")
     assert r.status_code == 200 and r["Content-Type"].startswith("text/html")
+    assert r["Cross-Origin-Opener-Policy"] == "same-origin"  # the site's, not drf-spectacular's unsafe-none
     html = r.content.decode()
     assert '<header class="top">' in html and "SwaggerUIBundle" in html
     urls = re.findall(r'(?:src|href)="([^"]*)"', html) + re.findall(r'url: "([^"]*)"', html)
