@@ -120,8 +120,8 @@ def search(grey_levels: np.ndarray, examples: np.ndarray, size: tuple[float, flo
     beside a window tells it from a pane of a shop's glass), scaled to ``size``, is slid over the photo (OpenCV's
     normalized cross-correlation, on a copy scaled so that the size's smaller side is `SEARCH_SIDE` pixels, or
     less to keep the copy within `SEARCH_PIXELS`; a size whose smaller side is then under `SEARCH_SMALLEST` is not
-    searched for); the peaks of the best response, each the best within an element's size, are kept, the highest first, at
-    most ``limit``. Flat places and flat examples have no say; none found: empty arrays."""
+    searched for); the peaks of the best response, each the best within an element's size, are kept, the highest
+    first, at most ``limit``. Flat places and flat examples have no say; none found: empty arrays."""
     import cv2
 
     none = np.zeros((0, 4)), np.zeros(0)

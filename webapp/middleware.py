@@ -1,6 +1,7 @@
 """Site-wide guards that answer before a view runs or when the database cannot: a request body larger than any
 the site accepts is refused from its Content-Length (413) before a byte of it is read, and a database that is
-locked or unreachable is a 503 that says so instead of a 500."""
+locked or unreachable is a 503 that says so instead of a 500. Both answer JSON under /api/ and the site's error page
+elsewhere (`webapp.errors`), drawn without the session or the database."""
 
 from __future__ import annotations
 
@@ -8,7 +9,8 @@ import logging
 
 from django.conf import settings
 from django.db import OperationalError
-from django.http import HttpResponse, JsonResponse
+
+from webapp.errors import error_response
 
 log = logging.getLogger(__name__)
 
@@ -23,16 +25,6 @@ def max_request_bytes(content_type: str) -> tuple[int, str]:
     return settings.DATA_UPLOAD_MAX_MEMORY_SIZE, "JSON and form bodies"
 
 
-def _answer(request, status: int, message: str, **headers: str) -> HttpResponse:
-    if request.path.startswith("/api/"):
-        response = JsonResponse({"detail": message}, status=status)
-    else:
-        response = HttpResponse(f"{message}\n", status=status, content_type="text/plain; charset=utf-8")
-    for name, value in headers.items():
-        response[name] = value
-    return response
-
-
 class RequestSizeLimitMiddleware:
     """413 for a declared body over the largest the site accepts of its kind (a photo upload, or a JSON or form
     body). Django reads no more than Content-Length, so a body without one is read as empty."""
@@ -44,11 +36,11 @@ class RequestSizeLimitMiddleware:
         try:
             length = int(request.META.get("CONTENT_LENGTH") or 0)
         except ValueError:
-            return _answer(request, 400, "Content-Length must be a whole number of bytes")
+            return error_response(request, 400, "Content-Length must be a whole number of bytes", static=True)
         limit, what = max_request_bytes(request.META.get("CONTENT_TYPE", ""))
         if length > limit:
-            return _answer(request, 413, f"the request is {length / 2**20:.1f} MB; at most "
-                                         f"{limit / 2**20:.0f} MB are accepted for {what}")
+            return error_response(request, 413, f"the request is {length / 2**20:.1f} MB; at most "
+                                                f"{limit / 2**20:.0f} MB are accepted for {what}", static=True)
         return self.get_response(request)
 
 
@@ -65,5 +57,5 @@ class BusyDatabaseMiddleware:
         if not isinstance(exception, OperationalError):
             return None
         log.warning("database unavailable for %s %s: %s", request.method, request.path, exception)
-        return _answer(request, 503, "the database is busy or unavailable; try again in a few seconds",
-                       **{"Retry-After": "5"})
+        return error_response(request, 503, "the database is busy or unavailable; try again in a few seconds",
+                              static=True, **{"Retry-After": "5"})

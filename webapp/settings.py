@@ -46,6 +46,7 @@ SECURE_CONTENT_TYPE_NOSNIFF = True
 SECURE_REFERRER_POLICY = "same-origin"
 SECURE_CROSS_ORIGIN_OPENER_POLICY = "same-origin"
 X_FRAME_OPTIONS = "DENY"
+CSRF_FAILURE_VIEW = "webapp.errors.csrf_failure"  # the site's 403 page, saying to reload the form
 # proxies in front of the site that append the client's address to X-Forwarded-For: the address that the login
 # lockouts and the API's anonymous throttle count is the one the outermost of them saw (0: REMOTE_ADDR, and a
 # client's own X-Forwarded-For is ignored)
@@ -61,6 +62,7 @@ INSTALLED_APPS = [
     "rest_framework",
     "rest_framework.authtoken",
     "drf_spectacular",
+    "drf_spectacular_sidecar",  # Swagger UI's JS and CSS as static files, for the API docs page
     "axes",
     "webapp.accounts",
     "webapp.facades",
@@ -192,6 +194,12 @@ SPECTACULAR_SETTINGS = {
     "DESCRIPTION": "Photos, segmentations, reconstruction jobs and procedures of the FaçAID site.",
     "VERSION": "1",
     "SERVE_INCLUDE_SCHEMA": False,
+    # the docs page (/api/v1/docs) loads Swagger UI from our static files and asks no other site for anything: no
+    # validator badge, which would send the schema's address to swagger.io
+    "SWAGGER_UI_DIST": "SIDECAR",
+    "SWAGGER_UI_FAVICON_HREF": "SIDECAR",
+    "SWAGGER_UI_SETTINGS": {"deepLinking": True, "validatorUrl": None, "docExpansion": "list",
+                            "defaultModelsExpandDepth": 0},
 }
 
 LOGGING = {

@@ -1,15 +1,39 @@
 from django.conf import settings
 from django.contrib import admin
 from django.urls import include, path
-from drf_spectacular.views import SpectacularAPIView
+from drf_spectacular.utils import extend_schema
+from drf_spectacular.views import SpectacularAPIView, SpectacularSwaggerView
+
+
+class ApiDocsView(SpectacularSwaggerView):
+    """The schema as a page (templates/api_docs.html) under the site's own Cross-Origin-Opener-Policy: drf-spectacular
+    loosens it to unsafe-none for OAuth2 pop-ups, which this API has none of."""
+
+    url_name = "schema"
+    template_name = "api_docs.html"
+
+    @extend_schema(exclude=True)
+    def get(self, request, *args, **kwargs):
+        response = super().get(request, *args, **kwargs)
+        del response["Cross-Origin-Opener-Policy"]  # SecurityMiddleware sets same-origin, as on every page
+        return response
+
 
 urlpatterns = [
     path("admin/", admin.site.urls),
     path("accounts/", include("webapp.accounts.urls")),
     path("api/v1/schema", SpectacularAPIView.as_view(), name="schema"),
+    # the schema as a page (Swagger UI from drf-spectacular-sidecar's static files: nothing from another site)
+    path("api/v1/docs", ApiDocsView.as_view(), name="api-docs"),
     path("api/v1/", include("webapp.facades.api_urls")),
     path("", include("webapp.facades.urls")),
 ]
+
+# the site's error pages, and JSON under /api/ (webapp/errors.py)
+handler400 = "webapp.errors.bad_request"
+handler403 = "webapp.errors.permission_denied"
+handler404 = "webapp.errors.page_not_found"
+handler500 = "webapp.errors.server_error"
 
 if settings.DEBUG:
     from django.conf.urls.static import static

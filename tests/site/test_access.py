@@ -90,3 +90,75 @@ def test_lists_show_only_your_own(objects, as_alice, as_bob):
     assert as_bob.get("/api/v1/photos/").json()["count"] == 0
     assert as_bob.get("/api/v1/procedures/").json()["count"] == 0
     assert as_bob.get("/api/v1/jobs/").json()["count"] == 0
+
+
+def fork_as_bob(as_bob, proc) -> Procedure:
+    r = as_bob.post(f"/procedures/{proc.code}/fork")  # the page's button
+    assert r.status_code == 302
+    return Procedure.objects.get(code=r["Location"].rsplit("/", 1)[1])
+
+
+def test_a_fork_keeps_the_overlay_and_rerun_while_the_photo_is_visible_to_the_forker(objects, as_alice, as_bob):
+    photo, seg, proc, job = objects
+    for obj in (photo, proc):
+        obj.visibility = "public"
+        obj.save()
+    fork = fork_as_bob(as_bob, proc)
+    assert (fork.photo_id, fork.segmentation_id, fork.owner.username) == (photo.id, seg.id, "bob")
+    r = as_bob.get(f"/api/v1/procedures/{fork.code}/").json()
+    assert (r["photo"], r["segmentation"]) == (str(photo.code), str(seg.code))
+    page = as_bob.get(f"/procedures/{fork.code}").content.decode()
+    assert f"/api/v1/photos/{photo.code}/image" in page and 'id="overlay"' in page  # the overlay
+    assert "download/overlay.png" in page and "Re-run inference from a prefix" in page
+    assert as_bob.get(f"/api/v1/procedures/{fork.code}/download/overlay.png").status_code == 200
+    r = as_bob.post(f"/procedures/{fork.code}/rerun", {"nodes": 3})  # the page's re-run
+    rerun = Job.objects.get(owner__username="bob")
+    assert r["Location"] == f"/jobs/{rerun.code}" and rerun.segmentation_id == seg.id
+    assert rerun.params["prefix_procedure"] == str(fork.code) and rerun.params["prefix_nodes"] == 3
+    r = as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2, "k": 2}, format="json")
+    assert r.status_code == 202 and r.json()["segmentation"] == str(seg.code)
+    assert as_bob.post(f"/api/v1/procedures/{fork.code}/fork").json()["photo"] == str(photo.code)  # forks of forks
+    # bob's jobs on alice's photo are not listed to her; hers are
+    mine = Job.objects.create(owner=proc.owner, segmentation=seg)
+    page = as_alice.get(f"/photos/{photo.code}").content.decode()
+    assert f"/jobs/{mine.code}" in page and f"/jobs/{rerun.code}" not in page
+
+    # alice makes her photo private: bob's fork stops showing it, and re-running it is refused
+    photo.visibility = "private"
+    photo.save()
+    page = as_bob.get(f"/procedures/{fork.code}").content.decode()
+    assert str(photo.code) not in page and str(seg.code) not in page and "Re-run inference" not in page
+    assert "No photo to overlay" in page and "overlay.png" not in page
+    r = as_bob.get(f"/api/v1/procedures/{fork.code}/").json()
+    assert (r["photo"], r["segmentation"]) == (None, None)
+    assert as_bob.get(f"/api/v1/procedures/{fork.code}/download/overlay.png").status_code == 400
+    before = Job.objects.count()
+    r = as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2}, format="json")
+    assert r.status_code == 400 and "no longer shared with you" in r.json()["procedure"]
+    r = as_bob.post(f"/procedures/{fork.code}/rerun", {"nodes": 2}, follow=True)
+    assert "no longer shared with you" in r.content.decode() and Job.objects.count() == before
+
+
+def test_a_fork_of_a_procedure_whose_photo_the_forker_may_not_see_names_neither(objects, as_alice, as_bob):
+    photo, seg, proc, job = objects  # alice's photo stays private; her procedure made from it is public
+    proc.visibility = "public"
+    proc.save()
+    fork = fork_as_bob(as_bob, proc)
+    assert (fork.photo_id, fork.segmentation_id) == (None, None)  # not only hidden: not linked at all
+    r = as_bob.get(f"/api/v1/procedures/{fork.code}/").json()
+    assert (r["photo"], r["segmentation"]) == (None, None)
+    page = as_bob.get(f"/procedures/{fork.code}").content.decode()
+    assert str(photo.code) not in page and str(seg.code) not in page and "Re-run inference" not in page
+    assert as_bob.get(f"/api/v1/procedures/{fork.code}/download/overlay.png").status_code == 400
+    r = as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2}, format="json")
+    assert r.status_code == 400 and "no segmentation" in r.json()["procedure"]
+    # publishing the photo later does not link an old fork to it; a new fork is linked
+    photo.visibility = "public"
+    photo.save()
+    assert Procedure.objects.get(pk=fork.pk).photo_id is None
+    assert fork_as_bob(as_bob, proc).photo_id == photo.id
+    # alice's own fork keeps her photo, private as it is
+    photo.visibility = "private"
+    photo.save()
+    r = as_alice.post(f"/api/v1/procedures/{proc.code}/fork")
+    assert r.status_code == 201 and r.json()["photo"] == str(photo.code)

@@ -71,3 +71,65 @@ def test_procedure_page_for_owner_and_visitor(alice):
     assert "download/labels.svg" in visitor and "download/labels.png" in visitor and "overlay.png" not in visitor
     assert "download/procedure.cga" in visitor and "download/mesh.zip" in visitor
     assert "CityEngine CGA rules" in visitor and "for Blender and other 3D tools" in visitor  # each says what it is
+
+
+def test_the_api_docs_page_names_only_files_of_this_site():
+    import re
+
+    from django.contrib.staticfiles import finders
+
+    r = Client().get("/api/v1/docs")
+    assert r.status_code == 200 and r["Content-Type"].startswith("text/html")
+    assert r["Cross-Origin-Opener-Policy"] == "same-origin"  # the site's, not drf-spectacular's unsafe-none
+    html = r.content.decode()
+    assert '<header class="top">' in html and "SwaggerUIBundle" in html
+    urls = re.findall(r'(?:src|href)="([^"]*)"', html) + re.findall(r'url: "([^"]*)"', html)
+    assert len(urls) > 5
+    for url in urls:
+        assert url.startswith("/") and not url.startswith("//") or url.startswith("data:"), url
+    assert not re.search(r"https?://|//cdn|jsdelivr|unpkg|googleapis", html.replace("http://www.w3.org/2000/svg", ""))
+    statics = [u for u in urls if u.startswith("/static/drf_spectacular_sidecar/")]
+    assert len(statics) == 2  # Swagger UI's CSS and JS
+    for url in statics:
+        assert finders.find(url.removeprefix("/static/")), url
+    # the footer's link goes to the page; the schema it reads stays a YAML file
+    assert 'href="/api/v1/docs">API docs</a>' in Client().get("/").content.decode()
+    r = Client().get("/api/v1/schema")
+    assert r.status_code == 200 and r["Content-Type"].startswith("application/vnd.oai.openapi")
+    assert r.content.startswith(b"openapi:")
+
+
+def test_jobs_are_named_by_their_photo(alice, bob):
+    import re
+
+    data, seg = facade_png()
+    owner = Client()
+    owner.force_login(alice)
+    named = Photo.objects.create(owner=alice, title="Rue de Rivoli", image=SimpleUploadedFile("a.png", data))
+    untitled = Photo.objects.create(owner=alice, image=SimpleUploadedFile("b.png", data))
+    jobs = {}
+    for photo in (named, untitled):
+        version = photo.segmentations.create(version=1, data=seg, rect_count=len(seg["rects"]))
+        jobs[photo.pk] = Job.objects.create(owner=alice, segmentation=version)
+    untitled_name = f"untitled photo {str(untitled.code)[:8]}"
+
+    def link_text(html: str, job: Job) -> str:
+        return re.search(rf'<a href="/jobs/{job.code}">([^<]*)</a>', html).group(1)
+
+    home = owner.get("/").content.decode()
+    assert link_text(home, jobs[named.pk]) == "Rue de Rivoli" and link_text(home, jobs[untitled.pk]) == untitled_name
+    for job in jobs.values():
+        assert str(job.code)[:8] not in home.replace(f"/jobs/{job.code}", "")  # named, not coded
+    page = owner.get(f"/photos/{named.code}").content.decode()
+    assert link_text(page, jobs[named.pk]) == "Rue de Rivoli" and "segmentation v1" in page
+    page = owner.get(f"/jobs/{jobs[named.pk].code}").content.decode()
+    assert "<h1>Reconstruction of Rue de Rivoli</h1>" in page and f'href="/photos/{named.code}"' in page
+    page = owner.get(f"/jobs/{jobs[untitled.pk].code}").content.decode()
+    assert f"<h1>Reconstruction of {untitled_name}</h1>" in page
+    # a job of bob's on a photo he may no longer see (a fork's re-run, the photo made private since) names nothing
+    other = Job.objects.create(owner=bob, segmentation=named.latest_segmentation())
+    visitor = Client()
+    visitor.force_login(bob)
+    for page in (visitor.get("/").content.decode(), visitor.get(f"/jobs/{other.code}").content.decode()):
+        assert "a photo not shared with you" in page
+        assert "Rivoli" not in page and str(named.code) not in page

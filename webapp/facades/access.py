@@ -80,6 +80,13 @@ def get_segmentation_for_user(user, code) -> Segmentation:
     return _get(qs, code)
 
 
+def segmentation_visible_to(user, proc: Procedure) -> bool:
+    """May ``user`` see the segmentation ``proc`` was made from, and so re-run it? The rule of
+    `get_segmentation_for_user`: its photo is theirs, public or unlisted (a fork's may have been made private since)."""
+    return proc.segmentation_id is not None and _readable(
+        Segmentation.objects.filter(pk=proc.segmentation_id), user, "photo__owner", "photo__visibility").exists()
+
+
 def get_procedure_for_user(user, code) -> Procedure:
     return _get(_readable(Procedure.objects.select_related("owner", "parent"), user), code)
 

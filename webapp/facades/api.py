@@ -517,10 +517,7 @@ def procedure_thumbnail(request, code):
 @parser_classes([JSONParser])
 def procedure_rerun(request, code):
     proc = access.get_rw_procedure_for_user(request.user, code)
-    if proc.segmentation is None:
-        raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
     form = RerunSerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    job = services.submit_job(request.user, proc.segmentation, k=form.validated_data["k"], seed=0, prefix=proc,
-                              prefix_nodes=form.validated_data["nodes"])
+    job = services.rerun(request.user, proc, form.validated_data["nodes"], form.validated_data["k"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)

@@ -20,7 +20,7 @@ from facaid.completion import RejectedError, complete
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
 from facaid.rectify import propose_corners_file
 from facaid.segmentation import Segmentation as SegmentationData
-from webapp.facades import jobs
+from webapp.facades import access, jobs
 from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility
 from webapp.facades.serializers import parse_procedure, parse_segmentation
 from webapp.facades.uploads import UploadError, normalize_photo
@@ -208,9 +208,22 @@ def remeasure(proc: Procedure) -> None:
 
 
 def fork_procedure(user, proc: Procedure) -> Procedure:
-    """A private copy owned by ``user`` with ``proc`` as its parent; the photo link is kept for its owner only."""
+    """A private copy owned by ``user`` with ``proc`` as its parent. Where ``user`` may see the photo, the copy keeps
+    it and the segmentation (its overlay and re-run); elsewhere it names neither, so that it cannot reveal them."""
     title = proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}"
-    mine = proc.photo is not None and proc.photo.owner == user
+    keep = access.photo_visible_to(user, proc.photo)
     return Procedure.objects.create(
         owner=user, title=title[:200], data=proc.data, parent=proc, accuracy=proc.accuracy, metrics=proc.metrics,
-        photo=proc.photo if mine else None, segmentation=proc.segmentation if mine else None)
+        photo=proc.photo if keep else None, segmentation_id=proc.segmentation_id if keep else None)
+
+
+def rerun(user, proc: Procedure, nodes: int, k: int = DEFAULT_K) -> Job:
+    """Re-run inference against the segmentation ``proc`` was made from, keeping its first ``nodes`` nodes (breadth
+    first), for its owner ``user``; a `ValidationError` naming ``procedure`` without a segmentation ``user`` may see
+    (none, or a fork's photo made private since the fork)."""
+    if proc.segmentation_id is None:
+        raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
+    if not access.segmentation_visible_to(user, proc):
+        raise ValidationError({"procedure": "the photo this procedure was made from is no longer shared with you, "
+                                            "so it cannot be re-run"})
+    return submit_job(user, proc.segmentation, k=k, seed=0, prefix=proc, prefix_nodes=nodes)

@@ -53,8 +53,8 @@ def home(request):
     if request.user.is_authenticated:
         context.update(photos=Photo.objects.filter(owner=request.user)[:12],
                        procedures=access.listed(Procedure.objects.filter(owner=request.user))[:12],
-                       jobs=Job.objects.filter(owner=request.user).select_related("result").defer(
-                           *access.JOB_WITHOUT)[:8])
+                       jobs=Job.objects.filter(owner=request.user).select_related(
+                           "result", "segmentation__photo").defer(*access.JOB_WITHOUT)[:8])
     return render(request, "facades/home.html", context)
 
 
@@ -80,8 +80,8 @@ def photo(request, code):
     context = {"photo": photo, "owner": owner, "segmentation": segmentation,
                "procedures": access.listed(photo.procedures.filter(owner=photo.owner) if owner else
                                            photo.procedures.filter(visibility="public")),
-               "jobs": Job.objects.filter(segmentation__photo=photo).select_related("result").defer(
-                   *access.JOB_WITHOUT)[:10] if owner
+               "jobs": Job.objects.filter(owner=photo.owner, segmentation__photo=photo).select_related(
+                   "result", "segmentation__photo").defer(*access.JOB_WITHOUT)[:10] if owner
                else Job.objects.none(),
                "segmentation_form": SegmentationForm(), "reconstruct_form": ReconstructForm(),
                "interchange_formats": INTERCHANGE_FORMATS, "metres_per_pixel": photo.metres_per_pixel(),
@@ -179,7 +179,9 @@ def photo_editor(request, code):
 
 
 def job(request, code):
-    return render(request, "facades/job.html", {"job": access.get_job_for_user(request.user, code)})
+    job = access.get_job_for_user(request.user, code)
+    return render(request, "facades/job.html", {
+        "job": job, "photo_visible": access.photo_visible_to(request.user, job.segmentation.photo)})
 
 
 def procedure(request, code):
@@ -188,6 +190,7 @@ def procedure(request, code):
     photo_visible = access.photo_visible_to(request.user, proc.photo)
     return render(request, "facades/procedure.html", {
         "proc": proc, "owner": owner, "photo_visible": photo_visible,
+        "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
         "downloads": [(name, d.help) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
@@ -218,11 +221,15 @@ def procedure_fork(request, code):
 def procedure_rerun(request, code):
     proc = access.get_rw_procedure_for_user(request.user, code)
     form = RerunForm(request.POST)
-    if not form.is_valid() or proc.segmentation is None:
-        messages.error(request, "Re-running needs the procedure's segmentation and a node count of at least 1.")
+    if not form.is_valid():
+        messages.error(request, "Re-running needs a node count of at least 1.")
         return redirect(proc)
     try:
-        job = services.submit_job(request.user, proc.segmentation, prefix=proc, prefix_nodes=form.cleaned_data["nodes"])
+        job = services.rerun(request.user, proc, form.cleaned_data["nodes"])
+    except ValidationError as exc:
+        text = _error_text(exc).removeprefix("procedure: ")
+        messages.error(request, f"{text[:1].upper()}{text[1:]}.")
+        return redirect(proc)
     except services.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(proc)

@@ -1,0 +1,18 @@
+"""How the pages name things to the viewer: `{% load naming %}{% photo_name photo %}`."""
+
+from __future__ import annotations
+
+from django import template
+
+from webapp.facades import access
+
+register = template.Library()
+
+
+@register.simple_tag(takes_context=True)
+def photo_name(context, photo) -> str:
+    """The photo's title, else 'untitled photo' and its short code. A photo the viewer may not see (a fork's job's,
+    made private since) is not named: neither its title nor its code."""
+    if not access.photo_visible_to(context["user"], photo):
+        return "a photo not shared with you"
+    return photo.title or f"untitled photo {str(photo.code)[:8]}"
