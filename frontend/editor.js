@@ -221,6 +221,7 @@ canvas.addEventListener("pointerup", (e) => {
     if (selectAdded && command.ids) ui.selection = new Set(command.ids);
   }
   changed();
+  if (d.kind === "draw" && command && $("#auto-complete").checked) completeNow();  // proposals after each drawn one
 });
 
 canvas.addEventListener("wheel", (e) => {
@@ -232,10 +233,18 @@ canvas.addEventListener("wheel", (e) => {
   draw();
 }, {passive: false});
 
-// proposals: a click rejects (or takes back) one before any tool sees the press
+// proposals: a click rejects (or takes back) one before any tool sees the press; Shift+click accepts it alone
 canvas.addEventListener("click", (e) => {
   const p = ui.drag ? null : proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY));
-  if (p) { p.accepted = p.accepted === false; draw(); }
+  if (!p) return;
+  if (e.shiftKey) {
+    ui.proposals = ui.proposals.filter((q) => q !== p);
+    run(acceptCommand([{...p, accepted: true}], `accept one ${p.label}`));
+    changed();
+  } else {
+    p.accepted = p.accepted === false;
+    draw();
+  }
 }, true);
 
 // --- keyboard: frontend/keys.js maps keys to actions ---------------------------------------------------------------
@@ -348,8 +357,8 @@ async function completeNow() {
     }
     ui.proposals = proposals;
     ui.proposalsFrom = "complete";
-    status(proposals.length ? `${proposals.length} proposals: click one to reject it, Enter or "Accept" to add ` +
-      "the rest." : "Nothing to propose yet: draw a few elements of a row and a column.");
+    status(proposals.length ? `${proposals.length} proposals: click one to reject it, Shift+click to add it alone, ` +
+      'Enter or "Accept" to add the rest.' : "Nothing to propose yet: draw a few elements of a row and a column.");
   } catch (err) {
     status(`No proposals: ${err.message}`, "error");
   } finally {

@@ -43,6 +43,7 @@ export const POINTER = [
   {keys: "Shift+click", does: "add to or take from the selection"},
   {keys: "Alt while dragging", does: "no snapping"},
   {keys: "click a proposal", does: "reject it (again: take it back)"},
+  {keys: "Shift+click a proposal", does: "add it alone (one undoable step)"},
   {keys: "two fingers", does: "pinch to zoom and pan"},
 ];
 

@@ -156,6 +156,32 @@ def test_completion_proposes_the_missing_window_accepted_undone_and_rejected(edi
     assert len([r for r in rects(page) if r["label"] == "window"]) == 5
 
 
+def test_proposals_after_each_drawn_element_from_the_photo_and_one_accepted_alone(editor):
+    page = editor
+    page.check("#auto-complete")
+    page.keyboard.press("d")
+    x, y = WINDOWS[1]
+    page.mouse.move(*screen(page, x, y))
+    page.mouse.down()
+    page.mouse.move(*screen(page, x + WIN_W, y + WIN_H), steps=6)
+    page.mouse.up()
+    # the photo shows six alike windows: the four not drawn are proposed as soon as the second is drawn
+    page.wait_for_function(f"{E}.ui.proposals.length === 4")
+    proposals = sorted(page.evaluate(f"{E}.ui.proposals"), key=lambda p: (p["y0"], p["x0"]))
+    want = sorted(WINDOWS[2:], key=lambda w: (w[1], w[0]))
+    assert [v for p in proposals for v in (p["x0"], p["y0"])] == pytest.approx([v for w in want for v in w], abs=2)
+    assert "Shift+click to add it alone" in page.text_content("#status")
+    one = proposals[0]
+    page.keyboard.down("Shift")
+    page.mouse.click(*screen(page, one["x0"] + 20, one["y0"] + 20))
+    page.keyboard.up("Shift")
+    windows = [r for r in rects(page) if r["label"] == "window"]
+    assert len(windows) == 3 and any((r["x0"], r["y0"]) == (one["x0"], one["y0"]) for r in windows)
+    assert page.evaluate(f"{E}.ui.proposals.length") == 3  # the others still shown
+    page.keyboard.press("Control+z")  # the one accepted is one undoable step
+    assert len([r for r in rects(page) if r["label"] == "window"]) == 2
+
+
 def test_zoom_readout_fit_cursor_and_selection_size_k_and_disabled_buttons(editor):
     page = editor
     v0 = view(page)
