@@ -97,3 +97,15 @@ def browser(monkeypatch):
         b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         yield b
         b.close()
+
+
+@pytest.fixture
+def editor(live_server, as_alice, browser):
+    """The editor open on Alice's windows photo with one segmentation, the wall and the first window
+    (`editor_helpers.open_editor`); the test fails on any uncaught error of the page."""
+    from editor_helpers import open_editor
+
+    page, context = open_editor(live_server, as_alice, browser)
+    yield page
+    assert page.errors == []
+    context.close()

@@ -9,21 +9,12 @@ import shutil
 
 import numpy as np
 import pytest
-from editor_helpers import WIN_H, WIN_W, WINDOWS, E, open_editor, rects, screen, view
+from editor_helpers import WIN_H, WIN_W, WINDOWS, E, rects, screen, view
 
 from facaid.defaults import DEFAULT_K
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
-
-
-@pytest.fixture
-def editor(live_server, as_alice, browser):
-    """The editor open on Alice's windows photo with one segmentation: the wall and the first window."""
-    page, context = open_editor(live_server, as_alice, browser)
-    yield page
-    assert page.errors == []
-    context.close()
 
 
 def test_wheel_zoom_space_pan_and_touch(editor):

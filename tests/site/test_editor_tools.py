@@ -8,21 +8,13 @@ import os
 import shutil
 
 import pytest
-from editor_helpers import WINDOWS, E, drag, open_editor, open_page, rects, screen, selected
+from editor_helpers import WINDOWS, E, drag, open_page, rects, screen, selected
 from site_helpers import login
 
 from webapp.facades.models import Segmentation
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
-
-
-@pytest.fixture
-def editor(live_server, as_alice, browser):
-    page, context = open_editor(live_server, as_alice, browser)
-    yield page
-    assert page.errors == []
-    context.close()
 
 
 @pytest.fixture
