@@ -9,6 +9,7 @@ import cityjson_lib
 import jsonschema_rs
 import numpy as np
 import pytest
+from format_helpers import window_grid
 
 from facaid.cityjson import cityjson_text, procedure_cityjson
 from facaid.generator import generate
@@ -111,9 +112,6 @@ def test_bad_input_is_refused(proc):
         procedure_cityjson(proc, SCALE, version="1.1")
     with pytest.raises(ValueError, match="scale must be a number of metres per pixel"):
         procedure_cityjson(proc, -1)
-    from facaid.grammar.procedure import Node, Procedure, Size
-
-    row = Node.repeat("x", 200, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
-    huge = Procedure(width=2000, height=2000, root=Node.repeat("y", 60, [(Size("flt", 1), row)]))
+    huge = window_grid(200, 60)
     with pytest.raises(MeshTooLarge, match="draws 24000 rectangles"):
         procedure_cityjson(huge, 0.01)

@@ -8,6 +8,7 @@ import xml.etree.ElementTree as ET
 import ifcopenshell
 import pytest
 import trimesh
+from format_helpers import window_grid
 from PIL import Image
 
 from facaid.cli import main
@@ -107,11 +108,8 @@ def test_bad_arguments_are_an_error_not_a_crash(tmp_path, source, capsys, args, 
 
 
 def test_bad_input_is_an_error_not_a_crash(tmp_path, capsys):
-    from facaid.grammar.procedure import Node, Size
-
-    row = Node.repeat("x", 200, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
     huge = tmp_path / "huge.json"
-    huge.write_text(Procedure(width=2000, height=2000, root=Node.repeat("y", 60, [(Size("flt", 1), row)])).to_json())
+    huge.write_text(window_grid(200, 60).to_json())
     for ext in (".glb", ".ifc", ".city.json", ".obj"):
         assert main(["export", str(huge), "--out", str(tmp_path / f"f{ext}")]) == 2
         assert "error: the procedure draws 24000 rectangles" in capsys.readouterr().err

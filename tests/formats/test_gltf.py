@@ -10,6 +10,7 @@ from collections import Counter
 import numpy as np
 import pytest
 import trimesh
+from format_helpers import window_grid
 
 from facaid.generator import generate
 from facaid.gltf import procedure_gltf
@@ -139,9 +140,6 @@ def test_a_bad_scale_is_refused(proc, bad):
 
 
 def test_a_procedure_of_too_many_rectangles_is_refused_with_its_count():
-    from facaid.grammar.procedure import Node, Procedure, Size
-
-    row = Node.repeat("x", 200, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
-    huge = Procedure(width=2000, height=2000, root=Node.repeat("y", 60, [(Size("flt", 1), row)]))
+    huge = window_grid(200, 60)
     with pytest.raises(MeshTooLarge, match=f"draws 24000 rectangles; a mesh is made of at most {MAX_MESH_RECTS}"):
         procedure_gltf(huge, 0.01)

@@ -12,6 +12,7 @@ import ifcopenshell.util.unit
 import ifcopenshell.validate
 import numpy as np
 import pytest
+from format_helpers import window_grid
 
 from facaid.generator import generate
 from facaid.ifc import MAX_OPENINGS, WALL_M, procedure_ifc
@@ -93,10 +94,7 @@ def test_a_bad_scale_is_refused(proc, bad):
 
 
 def test_a_procedure_of_too_many_openings_is_refused_with_its_count():
-    from facaid.grammar.procedure import Node, Procedure, Size
-
-    row = Node.repeat("x", 80, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
-    huge = Procedure(width=1600, height=1600, root=Node.repeat("y", 70, [(Size("flt", 1), row)]))
+    huge = window_grid(80, 70, 1600)
     with pytest.raises(MeshTooLarge, match=f"draws 5600 windows, doors and shop fronts; an IFC is made of at most "
                                            f"{MAX_OPENINGS}"):
         procedure_ifc(huge, 0.01)

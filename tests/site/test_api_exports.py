@@ -8,6 +8,7 @@ import json
 import ifcopenshell
 import pytest
 import trimesh
+from format_helpers import window_grid
 
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
@@ -70,11 +71,7 @@ def test_bad_parameters_and_too_large_procedures_are_a_400(procedure, as_alice, 
         for bad in ("0", "-1", "nan", "abc", "1e9"):
             r = as_alice.get(base + f"{name}?metres_per_pixel={bad}")
             assert r.status_code == 400 and "metres_per_pixel" in r.json(), (name, bad)
-    row = {"rule": "repeat", "axis": "x", "count": 200, "sizes": [["flt", 1], ["flt", 1]],
-           "children": [{"rule": "leaf", "label": "window"}, {"rule": "leaf", "label": "facade"}]}
-    huge = Procedure.objects.create(owner=alice, data={
-        "format": "facaid-procedure", "version": 1, "grammar": "facaid-split-1", "width": 2000, "height": 2000,
-        "root": {"rule": "repeat", "axis": "y", "count": 60, "sizes": [["flt", 1]], "children": [row]}})
+    huge = Procedure.objects.create(owner=alice, data=window_grid(200, 60).to_dict())
     for name in ("facade.glb", "facade.gltf", "facade.ifc", "facade.city.json"):
         r = as_alice.get(f"/api/v1/procedures/{huge.code}/download/{name}")
         assert r.status_code == 400 and "24000 rectangles" in r.json()["name"], name
