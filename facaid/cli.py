@@ -51,6 +51,17 @@ def _write_json(path: str | None, payload: dict) -> None:
         print(f"wrote {path}")
 
 
+def _open_photo(path: str):
+    from PIL import Image
+
+    try:
+        photo = Image.open(path)
+        photo.load()
+    except (OSError, Image.DecompressionBombError) as exc:
+        raise CliError(f"cannot read photo {path}: {exc}") from None
+    return photo
+
+
 # --- commands -----------------------------------------------------------------------------------------------
 
 def cmd_generate(args: argparse.Namespace) -> None:
@@ -113,12 +124,7 @@ def cmd_render(args: argparse.Namespace) -> None:
         print(f"wrote {args.out} ({seg.width}x{seg.height}, {len(seg.rects)} rectangles)")
         return
     if args.photo:
-        try:
-            photo = Image.open(args.photo)
-            photo.load()
-        except (OSError, Image.DecompressionBombError) as exc:
-            raise CliError(f"cannot read photo {args.photo}: {exc}") from None
-        image = overlay(photo, rasterize(seg), args.alpha)
+        image = overlay(_open_photo(args.photo), rasterize(seg), args.alpha)
     else:
         image = render_segmentation(seg, outline=args.outline)
     if args.legend:
@@ -250,6 +256,38 @@ def cmd_mesh(args: argparse.Namespace) -> None:
     out.write_text(obj, encoding="utf-8")
     mtl_path.write_text(mtl, encoding="utf-8")
     print(f"wrote {out} ({obj.count(chr(10) + 'f ')} faces) and {mtl_path}")
+
+
+def cmd_export(args: argparse.Namespace) -> None:
+    from facaid.cga import STOREY_M, checked_scale
+    from facaid.exports import EXPORTS, export_for
+    from facaid.grammar.procedure import Procedure
+
+    found = export_for(args.out)
+    if found is None:
+        raise CliError(f"--out {args.out}: the format comes from the file's extension, one of {' '.join(EXPORTS)}")
+    ext, export = found
+    if args.metres_per_pixel is not None and not export.scaled:
+        raise CliError(f"--metres-per-pixel sets the scale of the exports in metres; a {ext} file is in pixels")
+    if args.photo and not export.photo:
+        raise CliError(f"--photo is the texture of a .glb or .gltf; a {ext} file has none")
+    proc = Procedure.from_dict(_read_json(args.input))
+    photo = _open_photo(args.photo) if args.photo else None
+    if photo is not None and abs(photo.width * proc.height / (photo.height * proc.width) - 1) > 0.02:
+        print(f"warning: the photo ({photo.width}x{photo.height}) is stretched over the procedure "
+              f"({proc.width:g}x{proc.height:g}): give the rectified photo it was drawn on", file=sys.stderr)
+    note = ""
+    if export.scaled:
+        try:
+            scale = checked_scale(proc, args.metres_per_pixel)
+        except ValueError as exc:
+            raise CliError(f"--metres-per-pixel: {exc}") from None
+        source = "given" if args.metres_per_pixel is not None else f"a storey {STOREY_M:g} m tall"
+        note = f", {proc.width * scale:.2f} m x {proc.height * scale:.2f} m at {scale:.4g} m per pixel ({source})"
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    paths = export.write(proc, out, args.metres_per_pixel, photo)
+    print(f"wrote {' and '.join(str(p) for p in paths)}: {export.what}{note}")
 
 
 def _corners_arg(text: str) -> list[list[float]]:
@@ -522,6 +560,20 @@ def build_parser() -> argparse.ArgumentParser:
                        help="the scale (default: a storey, from the floors or the rows of windows, is 3 m tall; "
                             "12 m for the whole facade when it has neither)")
         e.set_defaults(func=func)
+
+    from facaid.exports import EXPORTS
+
+    x = sub.add_parser("export", help="a procedure in another format, chosen by the output's extension",
+                       description="Write a procedure as " + "; ".join(f"{ext} {e.what}" for ext, e in EXPORTS.items())
+                                   + ". The 3D formats and the CGA rules are in metres (docs/pipeline.md).")
+    x.add_argument("input", help="procedure JSON")
+    x.add_argument("--out", required=True, help="the file to write; its extension says the format")
+    x.add_argument("--metres-per-pixel", type=float, default=None,
+                   help="the scale of the metric formats (default: a storey, from the floors or the rows of windows, "
+                        "is 3 m tall; 12 m for the whole facade when it has neither)")
+    x.add_argument("--photo", help="the rectified photo the procedure was drawn on, shown on the fronts of a .glb or "
+                                   ".gltf")
+    x.set_defaults(func=cmd_export)
 
     rc = sub.add_parser("rectify", help="propose a photo's four facade corners, or rectify it from four corners",
                         description="Find the facade's four corners in a photo from its straight lines and vanishing "

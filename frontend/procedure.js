@@ -124,8 +124,8 @@ document.getElementById("save")?.addEventListener("click", async () => {
   }
 });
 
-// The CGA rules and the mesh are in metres: a facade width the user knows sets their scale (metres per pixel of
-// the saved procedure); left empty, the server's default makes a storey 3 m tall.
+// The CGA rules and the 3D models (the links marked data-scaled) are in metres: a facade width the user knows sets
+// their scale (metres per pixel of the saved procedure); left empty, the server's default (the page says which).
 const widthField = document.getElementById("width-m");
 if (widthField) widthField.max = Number(widthField.dataset.maxScale) * Number(widthField.dataset.px);  // the server's bound
 widthField?.addEventListener("input", () => {
@@ -133,7 +133,7 @@ widthField?.addEventListener("input", () => {
   const scaled = widthField.value !== "" && Number.isFinite(metres) && metres > 0 && metres <= Number(widthField.max);
   widthField.setCustomValidity(widthField.value === "" || scaled ? "" : `a width from 0.1 to ${widthField.max} m`);
   widthField.reportValidity();
-  for (const link of document.querySelectorAll("a[href*='/procedure.cga'], a[href*='/mesh.zip']")) {
+  for (const link of document.querySelectorAll("a[data-scaled]")) {
     const base = link.getAttribute("href").split("?")[0];
     link.setAttribute("href", scaled ? `${base}?metres_per_pixel=${metres / Number(widthField.dataset.px)}` : base);
   }

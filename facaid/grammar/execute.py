@@ -59,6 +59,7 @@ class _Executor:
         self.layouts: dict[tuple[int, float], tuple] = {}  # repeated copies share their layout
         self.fill_counts: dict[int, int] = {}
         self.first_boxes: dict[int, tuple[float, float, float, float]] | None = None  # set to record them
+        self.leaf_nodes: list[Node] | None = None  # set to record the node of each leaf
         self.offsets: dict[int, int] = {}
         if trace is not None:
             k = 0
@@ -102,7 +103,7 @@ class _Executor:
                 trace.mode.append(sizes[i].mode)
                 trace.axis.append(node.axis)
                 trace.flip.append(flip)
-            if child.rule == "leaf" and self.first_boxes is None:  # most nodes are leaves: no call
+            if child.rule == "leaf" and self.first_boxes is None and self.leaf_nodes is None:  # most are: no call
                 if trace is None and len(out) < MAX_LEAVES:
                     out.append((LABEL_ID[child.label], *sub))
                 else:
@@ -114,6 +115,8 @@ class _Executor:
         if len(self.out) >= MAX_LEAVES:
             raise ProcedureError(_path(where), f"expands to more than {MAX_LEAVES} rectangles")
         self.out.append((LABEL_ID[node.label], *box))
+        if self.leaf_nodes is not None:
+            self.leaf_nodes.append(node)
         if self.trace is not None:
             self.trace.leaves.append(me)
 
@@ -200,6 +203,25 @@ def execute_with_boxes(proc: Procedure) -> tuple[list[tuple[int, float, float, f
     return ex.out, ex.first_boxes
 
 
+def execute_with_nodes(proc: Procedure) -> tuple[list[tuple[int, float, float, float, float]], list[Node]]:
+    """`execute`, and the node each leaf is (the same node for every copy of a repeated one)."""
+    ex = _Executor(proc, None)
+    ex.leaf_nodes = []
+    ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
+    return ex.out, ex.leaf_nodes
+
+
+def leaf_rows(proc: Procedure, leaves: list[tuple[int, float, float, float, float]]) -> tuple[np.ndarray, np.ndarray]:
+    """`leaf_array`'s rows and, for each, the index of its leaf in ``leaves``."""
+    w, h = round(proc.width), round(proc.height)
+    arr = np.array(leaves, dtype=np.float64).reshape(-1, 5)
+    index = np.flatnonzero(arr[:, 0] != BACKGROUND)
+    box = np.rint(arr[index, 1:]).astype(np.int64)  # half to even, like round()
+    np.clip(box, 0, [w, h, w, h], out=box)
+    keep = (box[:, 0] < box[:, 2]) & (box[:, 1] < box[:, 3])
+    return np.concatenate([arr[index[keep], :1].astype(np.int64), box[keep]], axis=1), index[keep]
+
+
 def leaf_array(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None
                ) -> np.ndarray:
     """The executed leaves rounded to whole pixels as int64 rows (label, x0, y0, x1, y1); background and empty
@@ -207,15 +229,7 @@ def leaf_array(proc: Procedure, leaves: list[tuple[int, float, float, float, flo
 
     Edges are rounded, not sizes, so neighbours that share an edge keep sharing it and nothing overlaps.
     """
-    if leaves is None:
-        leaves = execute(proc)
-    w, h = round(proc.width), round(proc.height)
-    arr = np.array(leaves, dtype=np.float64).reshape(-1, 5)
-    arr = arr[arr[:, 0] != BACKGROUND]
-    box = np.rint(arr[:, 1:]).astype(np.int64)  # half to even, like round()
-    np.clip(box, 0, [w, h, w, h], out=box)
-    keep = (box[:, 0] < box[:, 2]) & (box[:, 1] < box[:, 3])
-    return np.concatenate([arr[keep, :1].astype(np.int64), box[keep]], axis=1)
+    return leaf_rows(proc, execute(proc) if leaves is None else leaves)[0]
 
 
 def flat_rows(proc: Procedure) -> np.ndarray:

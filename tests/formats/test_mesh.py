@@ -3,6 +3,7 @@ normal says, and a recess's sides face into it."""
 
 import numpy as np
 import pytest
+from format_helpers import window_grid
 
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
@@ -116,10 +117,8 @@ def test_cli_writes_the_obj_and_its_materials(tmp_path, capsys):
 
 
 def test_a_procedure_of_too_many_rectangles_is_refused_with_its_count():
-    from facaid.grammar.procedure import Node, Procedure, Size
     from facaid.mesh import MAX_MESH_RECTS, MeshTooLarge
 
-    row = Node.repeat("x", 200, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
-    proc = Procedure(width=2000, height=2000, root=Node.repeat("y", 60, [(Size("flt", 1), row)]))
+    proc = window_grid(200, 60)
     with pytest.raises(MeshTooLarge, match=f"draws 24000 rectangles; a mesh is made of at most {MAX_MESH_RECTS}"):
         procedure_mesh(proc, 0.01)

@@ -6,6 +6,7 @@ import xml.etree.ElementTree as ET
 import zipfile
 
 import pytest
+from format_helpers import window_grid
 from PIL import Image
 from site_helpers import image_bytes, upload
 
@@ -133,11 +134,7 @@ def test_downloads_render_and_variations(facade_photo, as_alice, alice):
         for name in ("procedure.cga", "mesh.zip"):
             r = as_alice.get(base + f"{name}?metres_per_pixel={bad}")
             assert r.status_code == 400 and "metres_per_pixel" in r.json(), (name, bad)
-    row = {"rule": "repeat", "axis": "x", "count": 200, "sizes": [["flt", 1], ["flt", 1]],
-           "children": [{"rule": "leaf", "label": "window"}, {"rule": "leaf", "label": "facade"}]}
-    huge = Procedure.objects.create(owner=alice, data={
-        "format": "facaid-procedure", "version": 1, "grammar": "facaid-split-1", "width": 2000, "height": 2000,
-        "root": {"rule": "repeat", "axis": "y", "count": 60, "sizes": [["flt", 1]], "children": [row]}})
+    huge = Procedure.objects.create(owner=alice, data=window_grid(200, 60).to_dict())
     r = as_alice.get(f"/api/v1/procedures/{huge.code}/download/mesh.zip")
     assert r.status_code == 400 and "24000 rectangles" in r.json()["name"]
     assert as_alice.get(base + "overlay.png?alpha=7").status_code == 400

@@ -59,10 +59,12 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     page.click("#vary")
     page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
 
-    # a facade width in metres sets the scale of the CGA rules and the mesh; cleared, the default again
+    # a facade width in metres sets the scale of the CGA rules and the 3D models; cleared, the default again
     cga = page.locator("a[href*='/procedure.cga']")
     page.fill("#width-m", "20")
     assert cga.get_attribute("href").endswith(f"/procedure.cga?metres_per_pixel={20 / data['width']}")
+    for name in ("mesh.zip", "facade.glb", "facade.ifc", "facade.city.json"):  # and every 3D model
+        assert page.get_attribute(f"a[href*='/{name}']", "href").endswith(f"?metres_per_pixel={20 / data['width']}")
     with page.expect_download() as d:
         cga.click()
     assert "20 m x" in d.value.path().read_text()

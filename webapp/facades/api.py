@@ -448,14 +448,15 @@ def render_preview(request):
 
 @extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),
                            OpenApiParameter("metres_per_pixel", float,
-                                            description="procedure.cga's and mesh.zip's scale (default: a storey "
-                                                        "is 3 m)")],
+                                            description="the scale of procedure.cga, mesh.zip and the 3D models "
+                                                        "(default: the photo's real size, else a storey is 3 m)")],
                responses={(200, "application/octet-stream"): bytes},
                summary="Downloads: procedure.json, segmentation.json (executed; segmentation.coco.json, "
                        "segmentation.labelme.json and segmentation.cvat.xml the same as another tool's annotations of "
                        "labels.png), labels.png, labels.svg (one group "
                        "of rectangles per class), procedure.cga (CityEngine CGA rules), mesh.zip (a relief mesh: "
-                       "facade.obj and facade.mtl), overlay.png")
+                       "facade.obj and facade.mtl), facade.glb and facade.gltf (glTF), facade-photo.glb (with the "
+                       "photo), facade.ifc (IFC4), facade.city.json (CityJSON 2.0), overlay.png")
 @api_view(["GET"])
 @throttle_classes(HEAVY)
 @permission_classes([AllowAny])

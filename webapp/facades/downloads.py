@@ -13,9 +13,12 @@ from PIL import Image
 from rest_framework.exceptions import ValidationError
 
 from facaid import interchange
-from facaid.cga import MAX_SCALE, checked_scale, procedure_cga
+from facaid.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
+from facaid.cityjson import cityjson_text, procedure_cityjson
+from facaid.gltf import procedure_gltf
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
+from facaid.ifc import procedure_ifc
 from facaid.mesh import MeshTooLarge, procedure_mesh
 from facaid.render import segmentation_svg
 from webapp.facades import rendering
@@ -31,25 +34,38 @@ class Download:
     content_type: str
     build: Callable[[Procedure, Tree, Params], bytes | str] | None  # None: a picture kept in storage
     needs_photo: bool = False  # offered only where the procedure's photo is visible to the user
+    scaled: bool = False  # in metres: takes ``metres_per_pixel``, else the scale of `download_scale`
+
+
+def drawn_on_original(proc: Procedure) -> bool:
+    """Whether the procedure was drawn on its photo's original image, not the rectified one (it has the original's
+    size, drawn before rectification)."""
+    photo = proc.photo
+    size = (proc.data.get("width", 0), proc.data.get("height", 0))
+    return bool(photo.rectified) and (round(size[0]), round(size[1])) == (photo.width, photo.height)
 
 
 def photo_scale(proc: Procedure) -> tuple[float, str] | None:
     """The scale the procedure's photo gives (its real width or height over the pixels of the image the procedure
-    was drawn on) and a line saying so; None without a photo or a real size. The image is the rectified one unless
-    the procedure has the original's size (drawn before rectification)."""
+    was drawn on) and a line saying so; None without a photo or a real size."""
     photo = proc.photo
     if photo is None or (photo.real_width_m is None and photo.real_height_m is None):
         return None
-    size = (proc.data.get("width", 0), proc.data.get("height", 0))
-    drawn_on = photo.working_size()
-    if photo.rectified and (round(size[0]), round(size[1])) == (photo.width, photo.height):
-        drawn_on = (photo.width, photo.height)
-    scale = photo.metres_per_pixel(drawn_on)
+    scale = photo.metres_per_pixel((photo.width, photo.height) if drawn_on_original(proc) else None)
     if scale is None:
         return None
     what = (f"the photo's real width, {photo.real_width_m:g} m" if photo.real_width_m is not None
             else f"the photo's real height, {photo.real_height_m:g} m")
     return scale, what
+
+
+def download_scale(proc: Procedure, tree: Tree) -> tuple[float, str]:
+    """The scale the metric downloads take without ``metres_per_pixel`` and where it comes from: the photo's real
+    size, else a storey 3 m tall."""
+    scale, source = _scale(proc, tree, {})
+    if scale is None:
+        return default_scale(tree), f"a storey is {STOREY_M:g} m tall"
+    return scale, source
 
 
 def _scale(proc: Procedure, tree: Tree, params: Params) -> tuple[float | None, str]:
@@ -80,17 +96,47 @@ def _cga(proc: Procedure, tree: Tree, params: Params) -> str:
     return procedure_cga(tree, scale, name=proc.title or stem(proc), scale_from=source)
 
 
-def _mesh_zip(proc: Procedure, tree: Tree, params: Params) -> bytes:
-    try:
+def _metric(write: Callable[[Procedure, Tree, float | None, str], bytes | str]
+            ) -> Callable[[Procedure, Tree, Params], bytes | str]:
+    """A builder of a download in metres: ``write(proc, tree, scale, scale_from)`` at the request's scale; a
+    procedure too large for it is a bad request."""
+    def build(proc: Procedure, tree: Tree, params: Params) -> bytes | str:
         scale, source = _scale(proc, tree, params)
-        obj, mtl = procedure_mesh(tree, scale, mtl_name="facade.mtl", scale_from=source)
-    except MeshTooLarge as exc:
-        raise ValidationError({"name": str(exc)}) from None
+        try:
+            return write(proc, tree, scale, source)
+        except MeshTooLarge as exc:
+            raise ValidationError({"name": str(exc)}) from None
+    return build
+
+
+def _mesh_zip(proc: Procedure, tree: Tree, scale: float | None, source: str) -> bytes:
+    obj, mtl = procedure_mesh(tree, scale, mtl_name="facade.mtl", scale_from=source)
     out = io.BytesIO()
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
         z.writestr("facade.obj", obj)
         z.writestr("facade.mtl", mtl)
     return out.getvalue()
+
+
+def _gltf(binary: bool, photo: bool = False) -> Callable[[Procedure, Tree, float | None, str], bytes]:
+    def write(proc: Procedure, tree: Tree, scale: float | None, source: str) -> bytes:
+        image = None
+        if photo:
+            drawn = proc.photo.image if drawn_on_original(proc) else proc.photo.working_image()
+            with drawn.open("rb") as f:
+                image = Image.open(f)
+                image.load()
+        return procedure_gltf(tree, scale, binary=binary, photo=image, scale_from=source,
+                              name=proc.title or stem(proc))
+    return write
+
+
+def _ifc(proc: Procedure, tree: Tree, scale: float | None, source: str) -> str:
+    return procedure_ifc(tree, scale, scale_from=source, name=proc.title or stem(proc))
+
+
+def _cityjson(proc: Procedure, tree: Tree, scale: float | None, source: str) -> str:
+    return cityjson_text(procedure_cityjson(tree, scale, scale_from=source, name=proc.title or stem(proc)))
 
 
 def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
@@ -124,9 +170,20 @@ DOWNLOADS: dict[str, Download] = {
     "labels.svg": Download("the label map as vector rectangles, one group per class", "image/svg+xml",
                            lambda proc, tree, params: segmentation_svg(to_segmentation(tree))),
     "procedure.cga": Download("CityEngine CGA rules: apply Facade to a facade shape", "text/plain; charset=utf-8",
-                              _cga),
+                              _cga, scaled=True),
     "mesh.zip": Download("a 3D relief mesh (OBJ and MTL) for Blender and other 3D tools", "application/zip",
-                         _mesh_zip),
+                         _metric(_mesh_zip), scaled=True),
+    "facade.glb": Download("the relief as glTF (binary) for 3D tools and the web: a node per element with its label "
+                           "and tree path, repeated ones as instances of one mesh, a material per class",
+                           "model/gltf-binary", _metric(_gltf(binary=True)), scaled=True),
+    "facade.gltf": Download("the same glTF as text, its data inline", "model/gltf+json", _metric(_gltf(binary=False)),
+                            scaled=True),
+    "facade-photo.glb": Download("that glTF with the photo on the fronts", "model/gltf-binary",
+                                 _metric(_gltf(binary=True, photo=True)), needs_photo=True, scaled=True),
+    "facade.ifc": Download("IFC4 for BIM tools: a wall whose openings hold its windows and doors", "application/x-step",
+                           _metric(_ifc), scaled=True),
+    "facade.city.json": Download("CityJSON 2.0 for GIS: an LoD3 building with wall, window and door surfaces",
+                                 "application/city+json", _metric(_cityjson), scaled=True),
     "overlay.png": Download("the label map over the photo", "image/png", _overlay, needs_photo=True),
 }
 

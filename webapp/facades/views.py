@@ -15,8 +15,9 @@ from rest_framework.exceptions import ValidationError
 
 from facaid.cga import MAX_SCALE
 from facaid.defaults import DEFAULT_K, MAX_K
+from facaid.grammar import ProcedureError
 from webapp.facades import access, jsonbody, services, throttling
-from webapp.facades.downloads import DOWNLOADS, photo_scale
+from webapp.facades.downloads import DOWNLOADS, download_scale
 from webapp.facades.forms import (
     PhotoForm,
     RealSizeForm,
@@ -26,7 +27,7 @@ from webapp.facades.forms import (
     VisibilityForm,
 )
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure
-from webapp.facades.serializers import PhotoSerializer
+from webapp.facades.serializers import PhotoSerializer, parse_procedure
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
 
@@ -193,8 +194,17 @@ def procedure(request, code):
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
-        "downloads": [(name, d.help) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
-        "max_scale": MAX_SCALE, "photo_scale": photo_scale(proc)})
+        "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
+        "max_scale": MAX_SCALE, "scale": _download_scale(proc)})
+
+
+def _download_scale(proc) -> tuple[float, str] | None:
+    """The scale of the metric downloads, for the page to say; None for a procedure stored before a limit it now
+    breaks."""
+    try:
+        return download_scale(proc, parse_procedure(proc.data))
+    except (ValidationError, ProcedureError):
+        return None
 
 
 @login_required

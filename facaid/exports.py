@@ -1,0 +1,106 @@
+"""What `facaid export` writes, by the output's extension: the procedure itself, its label map as a picture, and
+the formats of other tools, the 3D ones in metres at a scale each file states."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from PIL import Image
+
+    from facaid.grammar.procedure import Procedure
+
+
+@dataclass(frozen=True)
+class Export:
+    what: str  # what the file is, for --help and the line printed
+    write: Callable[[Procedure, Path, float | None, Image.Image | None], list[Path]]  # the files written
+    scaled: bool = True  # in metres, at --metres-per-pixel
+    photo: bool = False  # takes --photo
+
+
+def _text(path: Path, text: str | bytes) -> list[Path]:
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text, encoding="utf-8")
+    return [path]
+
+
+def _json(proc, path, scale, photo):
+    return _text(path, proc.to_json(indent=1) + "\n")
+
+
+def _png(proc, path, scale, photo):
+    from facaid.grammar.execute import to_segmentation
+    from facaid.render import render_segmentation
+
+    render_segmentation(to_segmentation(proc)).save(path, "PNG")
+    return [path]
+
+
+def _svg(proc, path, scale, photo):
+    from facaid.grammar.execute import to_segmentation
+    from facaid.render import segmentation_svg
+
+    return _text(path, segmentation_svg(to_segmentation(proc)))
+
+
+def _cga(proc, path, scale, photo):
+    from facaid.cga import procedure_cga
+
+    return _text(path, procedure_cga(proc, scale, name=path.name))
+
+
+def _obj(proc, path, scale, photo):
+    from facaid.mesh import procedure_mesh
+
+    mtl = path.with_suffix(".mtl")
+    obj, materials = procedure_mesh(proc, scale, mtl_name=mtl.name)
+    return _text(path, obj) + _text(mtl, materials)
+
+
+def _gltf(binary: bool):
+    def write(proc, path, scale, photo):
+        from facaid.gltf import procedure_gltf
+
+        return _text(path, procedure_gltf(proc, scale, binary=binary, photo=photo, name=path.name))
+    return write
+
+
+def _ifc(proc, path, scale, photo):
+    from facaid.ifc import procedure_ifc
+
+    return _text(path, procedure_ifc(proc, scale, name=path.name))
+
+
+def _cityjson(proc, path, scale, photo):
+    from facaid.cityjson import cityjson_text, procedure_cityjson
+
+    return _text(path, cityjson_text(procedure_cityjson(proc, scale, name=path.name)))
+
+
+EXPORTS: dict[str, Export] = {  # the longest extension that a file name ends in wins
+    ".json": Export("the procedure JSON", _json, scaled=False),
+    ".png": Export("the label map as a picture", _png, scaled=False),
+    ".svg": Export("the label map as vector rectangles", _svg, scaled=False),
+    ".cga": Export("CityEngine CGA rules", _cga),
+    ".obj": Export("a relief mesh (OBJ, with its MTL beside it)", _obj),
+    ".glb": Export("glTF binary: one node per element, repeats as instances", _gltf(True), photo=True),
+    ".gltf": Export("glTF text with its data inline", _gltf(False), photo=True),
+    ".ifc": Export("IFC4: a wall with its windows and doors in openings", _ifc),
+    ".city.json": Export("CityJSON 2.0: an LoD3 building with wall, window and door surfaces", _cityjson),
+}
+
+
+def export_for(path: str | Path) -> tuple[str, Export] | None:
+    """The extension and the export of a file name, None when it names none."""
+    name = Path(path).name.lower()
+    found = [ext for ext in EXPORTS if name.endswith(ext) and len(name) > len(ext)]
+    if not found:
+        return None
+    ext = max(found, key=len)
+    return ext, EXPORTS[ext]

@@ -1,0 +1,10 @@
+"""Procedures the format and download tests share."""
+
+from facaid.grammar.procedure import Node, Procedure, Size
+
+
+def window_grid(columns: int, rows: int, size: int = 2000) -> Procedure:
+    """``rows`` rows of ``columns`` windows, each beside a piece of wall: ``2 * columns * rows`` rectangles;
+    window_grid(200, 60) draws 24,000, past every 3D export's cap."""
+    row = Node.repeat("x", columns, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
+    return Procedure(width=size, height=size, root=Node.repeat("y", rows, [(Size("flt", 1), row)]))
