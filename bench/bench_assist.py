@@ -10,7 +10,9 @@ a true element not drawn yet (same class, IoU >= 0.7) and pays one action for ev
 1-189) and the test half (190-378) apart, beside the effort without completion (the 95 % stop alone), with the
 median time of a completion call. CMP is evaluation data: nothing here trains. CMP's photos are not in the repo:
 ``--generated N`` runs the same annotator on N held-out generated facades (seeds 5000 on) drawn on photo-like
-renders of themselves (`facaid.photolike.render_photo`), without and with the photo (searched and checking).
+renders of themselves (`facaid.photolike.render_photo`), their wall one rectangle as a person draws it
+(`facaid.evaluation.assist.as_drawn`), not the flattened pieces around each element, without and with the photo
+(searched, and checking the proposals).
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import statistics
 import time
 
 from facaid.completion import DEFAULT_MIN_SCORE, complete
-from facaid.evaluation.assist import simulate, summary
+from facaid.evaluation.assist import as_drawn, simulate, summary
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.paths import DEFAULT_CMP
 
@@ -72,8 +74,8 @@ def generated(args) -> None:
     from facaid.generator import generate
     from facaid.photolike import render_photo
 
-    cases = [(g.segmentation, render_photo(g.segmentation, seed)) for seed in range(5000, 5000 + args.generated)
-             for g in [generate(seed)]]
+    cases = [(as_drawn(g.segmentation), render_photo(g.segmentation, seed))
+             for seed in range(5000, 5000 + args.generated) for g in [generate(seed)]]
     result = {"min_score": args.min_score, "facades": len(cases)}
     for name, propose in (("alone", lambda seg, photo: (lambda s, rejected: [])),
                           ("structure", lambda seg, photo: functools.partial(complete, min_score=args.min_score)),

@@ -6,7 +6,7 @@
 - copy: the element's true place with the size of a drawn element of its class (best IoU): a perfect
   chooser of where to copy a drawn element, never wrong.
 - exact: every true element not drawn yet (the floor of the protocol: effort = the calls' cadence).
-    .venv/bin/python experiments/2026-12-04-assist-oracle/oracle.py [--stride 1] [--half dev]
+    .venv/bin/python experiments/2026-12-04-assist-oracle/oracle.py [--stride 1] [--half dev|test|generated]
 """
 import argparse
 import statistics
@@ -64,10 +64,15 @@ def oracle(truth, kind):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--stride", type=int, default=1)
-    ap.add_argument("--half", default="dev")
+    ap.add_argument("--half", default="dev", help="dev, test, or generated (12 held-out generated facades)")
     args = ap.parse_args()
-    recs = load_records(DEFAULT_CMP)
-    recs = (recs[:DEV_FACADES] if args.half == "dev" else recs[DEV_FACADES:])[:: args.stride]
+    if args.half == "generated":
+        from facaid.generator import generate
+        from facaid.evaluation.assist import as_drawn
+        recs = [(str(seed), as_drawn(generate(seed).segmentation)) for seed in range(5000, 5012)]
+    else:
+        recs = load_records(DEFAULT_CMP)
+        recs = (recs[:DEV_FACADES] if args.half == "dev" else recs[DEV_FACADES:])[:: args.stride]
     for kind in ("exact", "copy", "lattice"):
         s = [simulate(seg, oracle(seg, kind)) for _, seg in recs]
         eff = [x.effort for x in s]

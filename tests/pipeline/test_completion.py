@@ -8,7 +8,7 @@ import pytest
 import facaid
 from facaid.cli import main
 from facaid.completion import complete
-from facaid.evaluation.assist import simulate
+from facaid.evaluation.assist import as_drawn, simulate
 from facaid.labels import FACADE, LABEL_ID
 from facaid.segmentation import Rect, Segmentation, SegmentationError
 
@@ -142,3 +142,22 @@ def test_cli_complete(tmp_path, capsys):
     assert "--min-score must be in [0, 1]" in capsys.readouterr().err
     assert main(["complete", str(path), "--photo", str(tmp_path / "none.png")]) == 2
     assert "photo not found" in capsys.readouterr().err
+
+
+def test_as_drawn_makes_the_wall_one_rectangle_and_keeps_the_label_map():
+    from facaid.generator import generate
+    from facaid.segmentation import rasterize
+
+    seg = generate(5000).segmentation
+    walls = [r for r in seg.rects if r.label == FACADE]
+    drawn = as_drawn(seg)
+    assert len(walls) > 50 and [r for r in drawn.rects if r.label == FACADE] == [Rect(FACADE, *_box(walls))]
+    assert (rasterize(drawn) == rasterize(seg)).all()
+    assert [r for r in drawn.rects if r.label != FACADE] == [r for r in seg.rects if r.label != FACADE]
+    # two blocks of different heights, sky between: a wall rectangle each
+    two = Segmentation(100, 60, (Rect(FACADE, 0, 10, 40, 60), Rect(FACADE, 60, 30, 100, 60)))
+    assert sorted(as_drawn(two).rects) == sorted(two.rects)
+
+
+def _box(rects):
+    return min(r.x0 for r in rects), min(r.y0 for r in rects), max(r.x1 for r in rects), max(r.y1 for r in rects)
