@@ -45,6 +45,7 @@ CASES = {  # name: what the request is
     "json-4MB-of-objects": "POST /api/v1/render, 4 MB of [{},{},...] (the most objects a body can hold), anonymous",
     "segmentation-list-100": "GET a photo's 100 segmentation versions of 20,000 rectangles each (a page)",
     "remeasure-40MP": "PATCH the data of a procedure made from a 40 MP segmentation (2,000 windows), re-measured",
+    "compare.png-97200-leaves": "GET the difference picture of two versions of the 97,200-leaf procedure",
 }
 
 CHILD = r"""
@@ -182,6 +183,13 @@ elif case == "remeasure-40MP":
     little = Procedure.objects.create(owner=user, data=small)
     warm = lambda: owner.patch(f"/api/v1/procedures/{little.code}/", {"data": small}, format="json")
     run = lambda: owner.patch(f"/api/v1/procedures/{proc.code}/", {"data": tree}, format="json")
+elif case == "compare.png-97200-leaves":
+    big, little = stored(facade(16384, 16384, 180)), stored(facade(100, 80, 2))
+    for proc, count in ((big, 179), (little, 1)):
+        proc.data["root"]["count"] = count
+        proc.save()  # a second version
+    warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/versions/compare.png?a=1&b=2")
+    run = lambda: anon.get(f"/api/v1/procedures/{big.code}/versions/compare.png?a=1&b=2")
 else:
     raise SystemExit(f"unknown case {case}")
 

@@ -113,6 +113,30 @@ def procedure_iou(proc: Procedure, target: Segmentation) -> dict[str, float]:
     return class_iou(rasterize(to_segmentation(proc)), rasterize(target))
 
 
+def confusion(a: np.ndarray, b: np.ndarray, block: int = 1 << 20) -> np.ndarray:
+    """The (L, L) counts of pixels labelled i in ``a`` and j in ``b`` (two label maps of one shape), counted
+    about ``block`` pixels at a time, so that the temporaries stay a few MB whatever the maps' size."""
+    if a.shape != b.shape:
+        raise ValueError(f"label maps differ in shape: {a.shape} vs {b.shape}")
+    n = len(LABELS)
+    flat_a, flat_b = a.reshape(-1), b.reshape(-1)
+    out = np.zeros(n * n, dtype=np.int64)
+    for start in range(0, flat_a.size, block):
+        pair = flat_a[start : start + block].astype(np.int64) * n + flat_b[start : start + block]
+        out += np.bincount(pair, minlength=n * n)
+    return out.reshape(n, n)
+
+
+def measure(proc: Procedure, target: Segmentation) -> tuple[float, dict[str, float]]:
+    """`procedure_accuracy` and `procedure_iou` together, from one rasterization of each map and their
+    `confusion`: the same figures for about half the memory."""
+    counts = confusion(rasterize(to_segmentation(proc)), rasterize(target))
+    total, hits = int(counts.sum()), np.diag(counts)
+    unions = counts.sum(axis=0) + counts.sum(axis=1) - hits
+    iou = {name: float(hits[i] / unions[i]) for i, name in enumerate(LABELS) if unions[i]}
+    return (float(hits.sum() / total) if total else float("nan")), iou
+
+
 def element_rectangles(seg: Segmentation) -> int:
     """The elements of an annotation: its rectangles of a class other than wall and background."""
     return sum(1 for r in seg.rects if r.label not in (BACKGROUND, FACADE))

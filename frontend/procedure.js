@@ -1,7 +1,11 @@
-// The procedure page: an editable tree of parameters with live re-rendering, variations, overlay opacity.
+// The procedure page: an editable tree of parameters with live re-rendering, saved as a new version or as a new
+// procedure, the history (procedure-history.js), variations, overlay opacity.
+import {accuracyText, mountHistory} from "./procedure-history.js";
+
 const script = document.currentScript || document.querySelector("script[data-code]");
 const code = script.dataset.code;
 const csrf = document.querySelector("meta[name=csrf-token]").content;
+const versions = mountHistory({code, owner: script.dataset.owner === "1", csrf});
 let proc = JSON.parse(document.getElementById("procedure-data").textContent);
 let renderTimer = null;
 let renderedUrl = null;
@@ -114,15 +118,41 @@ function scheduleRender() {
   }, 300);
 }
 
-document.getElementById("save")?.addEventListener("click", async () => {
-  const r = await fetch(`/api/v1/procedures/${code}/`, {method: "PATCH", credentials: "same-origin",
-    headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify({data: proc})});
-  const body = await r.json();
-  document.getElementById("saved").textContent = r.ok ? "saved" : `not saved: ${JSON.stringify(body)}`;
-  if (r.ok && body.accuracy !== null && document.getElementById("accuracy")) {
-    document.getElementById("accuracy").textContent = body.accuracy.toFixed(4);
+async function send(url, method, data) {
+  const r = await fetch(url, {method, credentials: "same-origin",
+    headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
+  return [r, await r.json().catch(() => ({}))];
+}
+
+// The figures shown are the saved version's, as the server measured them: never the ones of the tree before.
+function showSaved(body) {
+  const version = document.getElementById("version");
+  if (version) version.textContent = body.version;
+  const figure = document.getElementById("figure");
+  figure.replaceChildren();
+  if (body.accuracy !== null) {
+    const b = document.createElement("b");
+    b.textContent = accuracyText(body.accuracy);
+    figure.append(" · pixel accuracy ", b);
+  } else if (body.metrics?.unmeasured) {
+    figure.append(` · pixel accuracy not measured: ${body.metrics.unmeasured}`);
   }
+}
+
+document.getElementById("save")?.addEventListener("click", async () => {
+  const [r, body] = await send(`/api/v1/procedures/${code}/`, "PATCH", {data: proc});
+  document.getElementById("saved").textContent = r.ok ? `saved as version ${body.version}`
+    : `not saved: ${JSON.stringify(body)}`;
+  if (r.ok) { showSaved(body); versions.refresh(); }
 });
+
+// A tree (the edited one, or a variation) as a procedure of the user's whose parent is this one; its page opens.
+async function saveAsNew(data) {
+  const [r, body] = await send(`/api/v1/procedures/${code}/save-as-new`, "POST", {data});
+  if (r.ok) location.assign(`/procedures/${body.code}`);
+  else document.getElementById("saved").textContent = `not saved: ${JSON.stringify(body)}`;
+}
+document.getElementById("save-new")?.addEventListener("click", () => saveAsNew(proc));
 
 // The CGA rules and the 3D models (the links marked data-scaled) are in metres: a facade width the user knows sets
 // their scale (metres per pixel of the saved procedure); left empty, the server's default (the page says which).
@@ -162,10 +192,22 @@ document.getElementById("vary").addEventListener("click", async () => {
     caption.textContent = `${v.meta?.variation || "variant"} · ${Math.round(v.width)}×${Math.round(v.height)}`;
     const use = document.createElement("button");
     use.textContent = "Edit this one";
+    use.title = "load it into the parameters: saving it then makes a new version, or a new procedure";
     use.addEventListener("click", () => { proc = v; drawTree(); scheduleRender(); });
     card.append(img, caption, use);
+    if (script.dataset.user === "1") {
+      const keep = document.createElement("button");
+      keep.textContent = "Save as new procedure";
+      keep.addEventListener("click", () => saveAsNew(v));
+      card.append(" ", keep);
+    }
     grid.append(card);
   }
 });
 
 drawTree();
+versions.refresh().then(() => {
+  // a re-run that fits worse is shown beside the version it continued
+  const warned = document.querySelector("#rerun-warning [data-compare]");
+  if (warned) versions.compare(...warned.dataset.compare.split(",").map(Number));
+});

@@ -78,6 +78,8 @@ def world(django_user_model):
             segmentation = Segmentation.objects.create(photo=photo, version=1, data=seg, rect_count=len(seg["rects"]))
     public = Procedure.objects.create(owner=alice, title="public", data=generate(3).procedure.to_dict(),
                                       photo=photo, segmentation=segmentation, visibility="public")
+    public.data = generate(5).procedure.to_dict()
+    public.save()  # a version 2
     private = Procedure.objects.create(owner=bob, title="private", data=generate(4).procedure.to_dict())
     job = Job.objects.create(owner=alice, segmentation=segmentation)
     codes = {"photos": [str(photo.code)], "segmentations": [str(segmentation.code)], "jobs": [str(job.code)],
@@ -94,6 +96,8 @@ def real_parameters(case, world, pick: int) -> None:
         params["code"] = choices[pick % len(choices)]
     if "name" in params:
         params["name"] = list(DOWNLOADS)[pick % len(DOWNLOADS)]
+    if "number" in params:  # a procedure's version: each has version 1 (the public one a second)
+        params["number"] = str(1 + pick % 3)
     case.path_parameters = params
 
 

@@ -1,11 +1,13 @@
 """The procedure page in Debian's Chromium through Playwright: the parameter tree shows rounded values without
-changing the stored ones, an edit re-renders at once and saves, variations come back as eight cards, a facade width
-in metres scales the CGA rules and the mesh. (The
+changing the stored ones, an edit re-renders at once and saves as a new version, variations come back as eight
+cards, a facade width in metres scales the CGA rules and the mesh, the history lists the versions, compares two
+side by side and reverts, a re-run that fits worse is shown beside the version it continued. (The
 procedure beside its overlay on a photo is checked in `test_editor_end_to_end.py`, which makes a photo's
 procedure through the worker.)"""
 
 from __future__ import annotations
 
+import os
 import shutil
 
 import pytest
@@ -13,10 +15,22 @@ from site_helpers import login
 
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
+from facaid.variation import vary
+from webapp.facades import versions
 from webapp.facades.models import Procedure, Segmentation
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
+
+
+def open_as_alice(browser, live_server, proc: Procedure, viewport: dict):
+    """Alice's browser on the procedure's page, and the list its script errors are gathered in."""
+    page = browser.new_page(viewport=viewport)
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/procedures/{proc.code}")
+    return page, errors
 
 
 def _repeats(node: dict) -> list[dict]:
@@ -33,11 +47,7 @@ def _sizes(node: dict) -> list[float]:
 def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     data = generate(3).procedure.to_dict()
     proc = Procedure.objects.create(owner=alice, data=data, visibility="private")
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    login(page, live_server.url, "alice", "alice-password-1")
-    page.goto(f"{live_server.url}/procedures/{proc.code}")
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1400, "height": 1000})
     page.wait_for_selector("#tree input")
     shown = page.eval_on_selector_all("#tree input", "els => els.map(e => e.value)")
     assert all(len(v.split(".")[1]) <= 4 for v in shown if "." in v)  # no run of float digits
@@ -51,7 +61,7 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     page.wait_for_function("document.getElementById('render').src.startsWith('blob:')")
     assert page.text_content("#saved") == "unsaved changes"
     page.click("#save")
-    page.wait_for_function("document.getElementById('saved').textContent === 'saved'")
+    page.wait_for_function("document.getElementById('saved').textContent === 'saved as version 2'")
     stored = Procedure.objects.get(pk=proc.pk).data
     assert _repeats(stored["root"])[0]["count"] == first["count"] + 1
     assert _sizes(stored["root"]) == _sizes(data["root"])  # the rounded display did not round the values
@@ -85,9 +95,7 @@ def test_nodes_are_numbered_breadth_first_and_a_click_picks_the_re_run_prefix(li
     data = generate(3).procedure.to_dict()
     proc = Procedure.objects.create(owner=alice, data=data, segmentation=Segmentation.objects.get(
         photo__code=seg["photo"], version=seg["version"]))
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    login(page, live_server.url, "alice", "alice-password-1")
-    page.goto(f"{live_server.url}/procedures/{proc.code}")
+    page, _ = open_as_alice(browser, live_server, proc, {"width": 1400, "height": 1000})
     page.wait_for_selector("#tree .bfs")
     shown = page.eval_on_selector_all("#tree li", "els => els.map(li => li.firstChild.textContent + "
                                                   "li.childNodes[1].textContent)")
@@ -99,3 +107,83 @@ def test_nodes_are_numbered_breadth_first_and_a_click_picks_the_re_run_prefix(li
         assert by_index[k] == (node.label if node.is_leaf else f"{node.rule}_{node.axis}")
     page.click('#tree .bfs >> text="#5"')
     assert page.input_value("#id_nodes") == "6"
+
+
+def _faithful(alice, seg: dict) -> Procedure:
+    segmentation = Segmentation.objects.get(photo__code=seg["photo"], version=seg["version"])
+    return Procedure.objects.create(owner=alice, title="Generated facade", data=generate(3).procedure.to_dict(),
+                                    accuracy=1.0, segmentation=segmentation, photo=segmentation.photo)
+
+
+def _pictures_loaded(page) -> None:
+    page.wait_for_function("['compare-a', 'compare-b', 'compare-diff'].every(id => "
+                           "{ const i = document.getElementById(id); return i.complete && i.naturalWidth > 0; })")
+
+
+def test_history_lists_versions_compares_two_and_reverts(live_server, alice, facade_photo, browser, tmp_path):
+    _, seg = facade_photo
+    proc = _faithful(alice, seg)
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900})
+    page.wait_for_selector("#history tbody tr")
+    assert page.locator("#history tbody tr").count() == 1 and page.text_content("#version") == "1"
+
+    # an edit saved: version 2, its own accuracy shown at once (the server's), both versions listed
+    first = _repeats(proc.data["root"])[0]
+    page.locator("#tree li > input").first.fill(str(first["count"] + 1))
+    page.wait_for_function("document.getElementById('render').src.startsWith('blob:')")
+    page.click("#save")
+    page.wait_for_function("document.getElementById('saved').textContent === 'saved as version 2'")
+    page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 2")
+    saved = Procedure.objects.get(pk=proc.pk)
+    assert saved.accuracy < 1.0 and page.text_content("#version") == "2"
+    assert page.text_content("#figure").strip() == f"· pixel accuracy {saved.accuracy:.4f}"
+    assert page.text_content("#history tbody tr.current").count(f"{saved.accuracy:.4f}") == 1
+
+    # compare: by default the current version (B) against the one before (A)
+    page.click("#compare")
+    page.wait_for_selector("#comparison:not([hidden])")
+    _pictures_loaded(page)
+    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 1.0000"
+    assert page.text_content("#compare-b-caption") == f"B: version 2 · pixel accuracy {saved.accuracy:.4f}"
+    assert "% of the pixels: their label differs" in page.text_content("#compare-diff-caption")
+    page.locator("#history-panel").scroll_into_view_if_needed()
+    path = os.environ.get("FACAID_HISTORY_SCREENSHOT") or str(tmp_path / "procedure-history.png")
+    page.locator("#history-panel").screenshot(path=path)
+
+    # revert to version 1: a third version equal to it, the page shows its figures
+    page.click("#history button[data-revert='1']")
+    page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
+    assert page.text_content("#version") == "3" and "1.0000" in page.text_content("#figure")
+    assert "reverted to version 1" in page.text_content("#history tbody tr.current")
+    assert Procedure.objects.get(pk=proc.pk).data == proc.data
+    assert errors == []
+
+    # someone who may see the procedure reads its history, with no revert
+    Procedure.objects.filter(pk=proc.pk).update(visibility="public")
+    other = browser.new_page()
+    other.goto(f"{live_server.url}/procedures/{proc.code}")
+    other.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
+    assert other.locator("#history button[data-revert]").count() == 0 and other.locator("#save").count() == 0
+
+
+def test_a_re_run_that_fits_worse_is_shown_beside_the_version_it_continued(live_server, alice, facade_photo, browser,
+                                                                          tmp_path):
+    _, seg = facade_photo
+    proc = _faithful(alice, seg)
+    tree = Tree.from_dict(proc.data)
+    worse = next(v for v in vary(tree, 8, 0) if v.meta["variation"] == "swap" and (v.width, v.height) == (
+        tree.width, tree.height)).to_dict()
+    versions.add_rerun(proc, worse, 0.75, {"source": "model"}, based_on=1, nodes=3)  # as the worker stores one
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 1100})
+    assert "fits worse than version 1: pixel accuracy 0.7500 against 1.0000" in page.text_content("#rerun-warning")
+    page.wait_for_selector("#comparison:not([hidden])")  # opened by itself
+    _pictures_loaded(page)
+    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 1.0000"
+    assert page.text_content("#compare-b-caption") == "B: version 2 · pixel accuracy 0.7500"
+    assert "worse" in page.get_attribute("#history tbody tr.current td:nth-child(5)", "class")
+    path = os.environ.get("FACAID_RERUN_SCREENSHOT") or str(tmp_path / "procedure-rerun-warning.png")
+    page.screenshot(path=path, full_page=True)
+    page.click("#rerun-warning button[data-revert='1']")
+    page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
+    assert page.locator("#rerun-warning").count() == 0 and page.text_content("#version") == "3"
+    assert errors == []

@@ -86,19 +86,21 @@ def test_rerun_from_a_prefix_and_a_failure_is_recorded(alice, worker):
     assert r.status_code == 202
     rerun = wait_for(Job.objects.get(code=r.json()["code"]), {"done", "failed"})
     check_done(rerun, attempts=1)
-    assert rerun.result.parent_id == first.result.id  # lineage
+    assert rerun.result_id == first.result_id and rerun.result_version == 2  # the procedure's next version
+    [made, continued] = [rerun.result.versions.get(version=n) for n in (2, 1)]
+    assert made.kind == "rerun" and made.based_on == 1 and made.data == rerun.result.data
     tok = Tokenizer.load(DEFAULT_CHECKPOINT / "tokenizer.json")  # the tokenizer alone, not the model
 
     def structure(data):  # the first three nodes without their sizes (the sizing refits those)
         ids = prefix_from_procedure(tok, Tree.from_dict(data), 3)
         return [t for t in ids if tok.vocab.kinds[t] not in ("abs", "flt", "rel")]
 
-    assert structure(rerun.result.data) == structure(first.result.data)
+    assert structure(made.data) == structure(continued.data)
     # a job whose prefix procedure was deleted before it ran fails with a message; the worker goes on
     worker.kill()
     r = client.post(f"/api/v1/procedures/{first.result.code}/rerun", {"nodes": 2}, format="json")
     doomed = Job.objects.get(code=r.json()["code"])
-    Procedure.objects.filter(id=first.result.id).delete()
+    Procedure.objects.filter(id=first.result_id).delete()
     worker.start()
     doomed = wait_for(doomed, {"done", "failed"})
     assert doomed.status == "failed" and "DoesNotExist" in doomed.message

@@ -33,7 +33,7 @@ from facaid.grammar import to_segmentation
 from facaid.grammar.procedure import ProcedureError
 from facaid.rectify import rectify_file
 from facaid.variation import vary
-from webapp.facades import access, downloads, pictures, rendering, services
+from webapp.facades import access, downloads, pictures, rendering, services, versions
 from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility
@@ -46,9 +46,12 @@ from webapp.facades.serializers import (
     PhotoUploadSerializer,
     ProcedureSerializer,
     ProcedureSummarySerializer,
+    ProcedureVersionSerializer,
+    ProcedureVersionSummarySerializer,
     ProcedureWriteSerializer,
     RectifySerializer,
     RerunSerializer,
+    SaveAsNewSerializer,
     SegmentationSerializer,
     SegmentationSummarySerializer,
     VariationsSerializer,
@@ -363,7 +366,8 @@ def gallery(request):
 
 @extend_schema(methods=["GET"], responses=ProcedureSerializer, summary="A procedure")
 @extend_schema(methods=["PATCH"], request=ProcedureWriteSerializer, responses=ProcedureSerializer,
-               summary="Edit title, visibility or the procedure itself (re-executed and re-measured)")
+               summary="Edit title, visibility or the procedure itself: a changed tree is a new version, re-measured "
+                       "(the answer's accuracy and metrics are the new version's)")
 @extend_schema(methods=["DELETE"], responses={204: None}, summary="Delete a procedure")
 @api_view(["GET", "PATCH", "DELETE"])
 @throttle_classes(HEAVY)
@@ -379,11 +383,14 @@ def procedure_detail(request, code):
         return Response(status=status.HTTP_204_NO_CONTENT)
     form = ProcedureWriteSerializer(data=request.data, partial=True)
     form.is_valid(raise_exception=True)
-    for key, value in form.validated_data.items():
+    changes = dict(form.validated_data)
+    tree = changes.pop("data", None)
+    for key, value in changes.items():
         setattr(proc, key, value)
-    if "data" in form.validated_data:
-        services.remeasure(proc)
-    proc.save()
+    if tree is None:
+        proc.save()
+    else:
+        versions.save_tree(proc, tree)
     return Response(ProcedureSerializer(proc, context={"request": request}).data)
 
 
@@ -497,7 +504,12 @@ def _picture(request, proc: Procedure, kind: str) -> HttpResponse:
         except LookupError:
             raise Http404("no such procedure") from None
         etag = f'"{tag}"'
+    return _cacheable(resp, etag, proc)
 
+
+def _cacheable(resp: HttpResponse, etag: str, proc: Procedure) -> HttpResponse:
+    """A picture of ``proc`` named by ``etag``: revalidated by it; shared caches may keep a public procedure's a
+    minute."""
     resp["ETag"] = etag
     resp["Cache-Control"] = "public, max-age=60" if proc.visibility == Visibility.PUBLIC else "private, no-cache"
     return resp
@@ -522,3 +534,113 @@ def procedure_rerun(request, code):
     form.is_valid(raise_exception=True)
     job = services.rerun(request.user, proc, form.validated_data["nodes"], form.validated_data["k"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
+
+
+# --- versions -----------------------------------------------------------------------------------------------------
+
+@extend_schema(responses=ProcedureVersionSummarySerializer(many=True),
+               summary="The procedure's versions, newest first: every save of its tree, with its pixel accuracy "
+                       "against the procedure's segmentation as measured then, what made it (created, edit, revert, "
+                       "rerun), the version it was made from and a re-run's warning when it fits worse (their trees: "
+                       "versions/<n>/)")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def procedure_versions(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    pager = Pagination()
+    page = pager.paginate_queryset(proc.versions.defer("data").order_by("-version"), request)
+    for version in page:
+        version.procedure = proc
+    return pager.get_paginated_response(ProcedureVersionSummarySerializer(page, many=True).data)
+
+
+@extend_schema(responses=ProcedureVersionSerializer, summary="One version of the procedure, with its tree")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def procedure_version(request, code, number):
+    proc = access.get_procedure_for_user(request.user, code)
+    return Response(ProcedureVersionSerializer(versions.get_version(proc, number)).data)
+
+
+@extend_schema(responses={(200, "image/png"): bytes, 304: None},
+               summary="A version's label map (at most 1,024 px a side), named by its digest (the ETag)")
+@api_view(["GET"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+def procedure_version_picture(request, code, number):
+    proc = access.get_procedure_for_user(request.user, code)
+    version = versions.get_version(proc, number)
+    etag = f'"{version.digest}"'
+    if etag in request.headers.get("If-None-Match", ""):
+        return _cacheable(HttpResponse(status=304), etag, proc)
+    seg = to_segmentation(parse_procedure(version.data))
+    return _cacheable(HttpResponse(rendering.label_map_png(seg, rendering.COMPARE_SIDE), content_type="image/png"),
+                      etag, proc)
+
+
+@extend_schema(request=None, responses={201: ProcedureSerializer},
+               summary="Revert: a new version whose tree is version <n>'s, measured again (nothing is deleted); "
+                       "the owner's (others: 403, or 404 where they may not see it); a 400 when it is the current "
+                       "tree")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([IsAuthenticated])
+def procedure_revert(request, code, number):
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    versions.revert(proc, number)
+    return Response(ProcedureSerializer(proc, context={"request": request}).data, status=status.HTTP_201_CREATED)
+
+
+COMPARED = [OpenApiParameter("a", int, required=True, description="a version number (the older, say)"),
+            OpenApiParameter("b", int, required=True, description="another (the newer)")]
+
+
+@extend_schema(parameters=COMPARED, responses={200: dict},
+               summary="Compare two versions: {'a', 'b' (each version as versions/ lists it, with its 'width' and "
+                       "'height'), 'differing' (the share of the pictures' pixels whose label differs, on one canvas "
+                       "of at most 1,024 px a side), 'differing_pixels', 'pixels', 'overlay' (compare.png: the "
+                       "difference picture), 'segmentation' (what both accuracies were measured against)}")
+@api_view(["GET"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+def procedure_compare(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    a, b, diff = versions.compare(proc, request.query_params.get("a"), request.query_params.get("b"))
+    sides = {}
+    for key, version in (("a", a), ("b", b)):
+        tree = parse_procedure(version.data)
+        sides[key] = {**ProcedureVersionSummarySerializer(version).data, "width": tree.width, "height": tree.height}
+    seg = ProcedureSerializer(proc, context={"request": request}).get_segmentation(proc)
+    return Response({**sides, "differing": diff["differing"] / diff["pixels"], "differing_pixels": diff["differing"],
+                     "pixels": diff["pixels"], "segmentation": seg,
+                     "overlay": f"/api/v1/procedures/{proc.code}/versions/compare.png?a={a.version}&b={b.version}"})
+
+
+@extend_schema(parameters=COMPARED, responses={(200, "image/png"): bytes},
+               summary="The difference of two versions: b's label map, paled, with the pixels whose label differs "
+                       "from a's in magenta (one canvas, at most 1,024 px a side)")
+@api_view(["GET"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+def procedure_compare_picture(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    a, b, diff = versions.compare(proc, request.query_params.get("a"), request.query_params.get("b"))
+    return _cacheable(HttpResponse(diff["png"], content_type="image/png"), f'"{a.digest}-{b.digest}"', proc)
+
+
+@extend_schema(request=SaveAsNewSerializer, responses={201: ProcedureSerializer},
+               summary="Save as a new procedure: yours, private, whose parent is this one (kept with its photo as a "
+                       "fork keeps it), holding 'data' (an edited tree or a variation; default: this one's tree) as "
+                       "its second version, re-measured; titled from 'title', else from the variation that made it "
+                       "or a running number, so that it is told apart from its parent")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def procedure_save_as_new(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    form = SaveAsNewSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    copy = versions.save_as_new(request.user, proc, form.validated_data.get("data"),
+                                form.validated_data.get("title", ""))
+    return Response(ProcedureSerializer(copy, context={"request": request}).data, status=status.HTTP_201_CREATED)

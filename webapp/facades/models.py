@@ -1,14 +1,16 @@
-"""Photos, their segmentations (versioned), reconstruction jobs and procedures. Every object is addressed by
-a UUID ``code``; photos and procedures carry a visibility (private, unlisted, public)."""
+"""Photos, their segmentations (versioned), reconstruction jobs and procedures (versioned: every save of a tree
+is a new `ProcedureVersion`, and none is ever changed or deleted but with its procedure). Every object is addressed
+by a UUID ``code``; photos and procedures carry a visibility (private, unlisted, public)."""
 
 from __future__ import annotations
 
 import hashlib
 import json
 import uuid
+from dataclasses import dataclass
 
 from django.conf import settings
-from django.db import models
+from django.db import models, transaction
 from django.urls import reverse
 from django.utils import timezone
 
@@ -140,14 +142,35 @@ class Procedure(models.Model):
     def get_absolute_url(self) -> str:
         return reverse("procedure", args=[self.code])
 
-    def save(self, *args, **kwargs) -> None:
+    def save(self, *args, change: Change | None = None, **kwargs) -> None:
+        """Save, and record the tree as a new version: always with ``change`` (what made it), else when the tree
+        differs from the latest version's (a procedure created, an edit in the admin), so that a save of the title
+        or visibility alone records none."""
         fields = kwargs.get("update_fields")
-        if fields is None and "data" not in self.get_deferred_fields():
+        writes_tree = "data" in fields if fields is not None else "data" not in self.get_deferred_fields()
+        if writes_tree:
             self.digest = tree_digest(self.data)
-        elif fields is not None and "data" in fields:
-            self.digest = tree_digest(self.data)
-            kwargs["update_fields"] = {*fields, "digest"}
-        super().save(*args, **kwargs)
+            if fields is not None:
+                kwargs["update_fields"] = {*fields, "digest"}
+        with transaction.atomic(using=kwargs.get("using")):
+            super().save(*args, **kwargs)  # first: the row's write lock orders racing saves' version numbers
+            if writes_tree:
+                self._record_version(change)
+
+    def _record_version(self, change: Change | None) -> None:
+        latest = self.versions.order_by("-version").values("version", "digest").first()
+        if change is None:
+            if latest is not None and latest["digest"] == self.digest:
+                return
+            change = Change(ProcedureVersion.Kind.EDIT if latest else ProcedureVersion.Kind.CREATED)
+        ProcedureVersion.objects.create(
+            procedure=self, version=(latest["version"] if latest else 0) + 1, data=self.data, digest=self.digest,
+            accuracy=self.accuracy, metrics=self.metrics, kind=change.kind, note=change.note[:200],
+            based_on=change.based_on, warning=change.warning[:300])
+
+    def current_version(self) -> ProcedureVersion | None:
+        """The latest version: the one whose tree the procedure holds."""
+        return self.versions.defer("data").order_by("-version").first()
 
     def lineage(self) -> list[Procedure]:
         """Ancestors, nearest first (forks of forks), stopping at a cycle or a deleted parent."""
@@ -157,6 +180,47 @@ class Procedure(models.Model):
             seen.add(node.pk)
             node = node.parent
         return out
+
+
+@dataclass(frozen=True)
+class Change:
+    """What made a version: its kind, a line for the history, the version it was made from (the one a revert
+    restores or a re-run continued) and a warning (a re-run that fits worse than that one)."""
+
+    kind: str
+    note: str = ""
+    based_on: int | None = None
+    warning: str = ""
+
+
+class ProcedureVersion(models.Model):
+    """One saved tree of a procedure, with its figures as measured when it was saved (against the procedure's
+    segmentation, which never changes). Written once, never edited: a revert is a new version."""
+
+    class Kind(models.TextChoices):
+        CREATED = "created", "Created"
+        EDIT = "edit", "Edited"
+        REVERT = "revert", "Reverted"
+        RERUN = "rerun", "Re-run"
+
+    procedure = models.ForeignKey(Procedure, on_delete=models.CASCADE, related_name="versions")
+    version = models.PositiveIntegerField()
+    data = models.JSONField()
+    digest = models.CharField(max_length=16)  # tree_digest(data): the ETag of its picture
+    accuracy = models.FloatField(null=True, blank=True)
+    metrics = models.JSONField(default=dict, blank=True)
+    kind = models.CharField(max_length=10, choices=Kind.choices)
+    note = models.CharField(max_length=200, blank=True)
+    based_on = models.PositiveIntegerField(null=True, blank=True)
+    warning = models.CharField(max_length=300, blank=True)
+    created = models.DateTimeField(default=timezone.now)
+
+    class Meta:
+        ordering = ["procedure", "-version"]
+        constraints = [models.UniqueConstraint(fields=["procedure", "version"], name="one_procedure_version")]
+
+    def __str__(self) -> str:
+        return f"{self.procedure} v{self.version}"
 
 
 class Job(models.Model):
@@ -180,6 +244,7 @@ class Job(models.Model):
     message = models.TextField(blank=True)  # why it failed
     attempts = models.PositiveIntegerField(default=0)
     result = models.ForeignKey(Procedure, on_delete=models.SET_NULL, null=True, blank=True, related_name="jobs")
+    result_version = models.PositiveIntegerField(null=True, blank=True)  # the version of `result` it made
     created = models.DateTimeField(default=timezone.now)
     started = models.DateTimeField(null=True, blank=True)
     heartbeat = models.DateTimeField(null=True, blank=True)  # a running worker touches it every few seconds

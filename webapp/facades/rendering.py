@@ -12,11 +12,15 @@ import io
 import numpy as np
 from PIL import Image
 
+from facaid.grammar import Procedure as Tree
 from facaid.labels import PRIORITY
+from facaid.metrics import scaled_procedure_map
 from facaid.render import colorize
 from facaid.segmentation import Segmentation as SegmentationData
 
 MAX_RENDER_SIDE = 2048
+COMPARE_SIDE = 1024  # the pictures of two versions compared: the page shows them side by side
+DIFFERENT = (255, 0, 255)  # magenta, in no class's colour: the pixels whose label differs
 _PRIORITY = np.asarray(PRIORITY)
 
 
@@ -75,3 +79,29 @@ def overlay_png(seg: SegmentationData, photo: Image.Image, alpha: float = 0.5,
     labels = label_map(seg, max_side)
     size = (labels.shape[1], labels.shape[0])
     return _png(Image.blend(photo_at(photo, size), colorize(labels), alpha))
+
+
+def common_maps(a: Tree, b: Tree, max_side: int = COMPARE_SIDE) -> tuple[np.ndarray, np.ndarray]:
+    """The two executed procedures' label maps on one canvas (the larger width and height, shrunk to at most
+    ``max_side`` a side), both from its top-left corner in the same pixels: where one tree does not reach is
+    background, so a resized version differs by the area it gained or lost."""
+    width, height = max(a.width, b.width), max(a.height, b.height)
+    scale = min(1.0, max_side / max(width, height))
+    w, h = max(1, round(width * scale)), max(1, round(height * scale))
+    out = []
+    for tree in (a, b):
+        canvas = np.zeros((h, w), dtype=np.uint8)
+        painted = scaled_procedure_map(tree, scale)[:h, :w]
+        canvas[: painted.shape[0], : painted.shape[1]] = painted
+        out.append(canvas)
+    return out[0], out[1]
+
+
+def difference_png(a: Tree, b: Tree, max_side: int = COMPARE_SIDE) -> tuple[bytes, int, int]:
+    """``b``'s label map, paled, with the pixels whose label differs from ``a``'s in `DIFFERENT`; and the count of
+    those pixels and of all the picture's."""
+    first, second = common_maps(a, b, max_side)
+    differ = first != second
+    picture = (0.35 * np.asarray(colorize(second), dtype=np.float32) + 0.65 * 255).astype(np.uint8)
+    picture[differ] = DIFFERENT
+    return _png(Image.fromarray(picture, "RGB")), int(differ.sum()), int(differ.size)

@@ -14,7 +14,7 @@ from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access
-from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, ProcedureVersion, Segmentation, Visibility
 
 
 def parse_segmentation(data) -> SegmentationData:
@@ -156,13 +156,18 @@ class ProcedureSerializer(serializers.ModelSerializer):
     parent = serializers.SerializerMethodField()
     photo = serializers.SerializerMethodField()
     segmentation = serializers.SerializerMethodField()
+    version = serializers.SerializerMethodField(help_text="the current version's number (versions/ lists them)")
 
     class Meta:
         model = Procedure
-        fields = ["code", "owner", "title", "visibility", "accuracy", "metrics", "parent", "photo",
+        fields = ["code", "owner", "title", "visibility", "version", "accuracy", "metrics", "parent", "photo",
                   "segmentation", "data", "created", "updated"]
-        read_only_fields = ["code", "owner", "accuracy", "metrics", "parent", "photo", "segmentation", "created",
-                            "updated"]
+        read_only_fields = ["code", "owner", "version", "accuracy", "metrics", "parent", "photo", "segmentation",
+                            "created", "updated"]
+
+    def get_version(self, proc: Procedure) -> int | None:
+        current = proc.current_version()
+        return current.version if current else None
 
     # links to other objects are shown only to those who may see them (a fork of a procedure made private later
     # does not reveal its parent; a public procedure does not reveal its private photo)
@@ -187,13 +192,47 @@ class ProcedureSummarySerializer(ProcedureSerializer):
         fields = ["code", "owner", "title", "visibility", "accuracy", "parent", "created"]
 
 
-class ProcedureWriteSerializer(serializers.Serializer):
+class ProcedureVersionSummarySerializer(serializers.ModelSerializer):
+    """A version as the history lists it: its figures, what made it, and links to its picture and its tree."""
+
+    picture = serializers.SerializerMethodField()
+    url = serializers.SerializerMethodField()
+
+    class Meta:
+        model = ProcedureVersion
+        fields = ["version", "kind", "note", "based_on", "warning", "accuracy", "metrics", "digest", "created",
+                  "picture", "url"]
+        read_only_fields = fields
+
+    def _base(self, version: ProcedureVersion) -> str:
+        return f"/api/v1/procedures/{version.procedure.code}/versions/{version.version}/"
+
+    def get_picture(self, version: ProcedureVersion) -> str:
+        return f"{self._base(version)}labels.png"
+
+    def get_url(self, version: ProcedureVersion) -> str:
+        return self._base(version)
+
+
+class ProcedureVersionSerializer(ProcedureVersionSummarySerializer):
+    class Meta(ProcedureVersionSummarySerializer.Meta):
+        fields = [*ProcedureVersionSummarySerializer.Meta.fields, "data"]
+        read_only_fields = fields
+
+
+class SaveAsNewSerializer(serializers.Serializer):
+    """A title and a tree; saving as a new procedure takes the procedure's own tree and a title of its own when
+    they are left out."""
+
     title = title_field()
-    visibility = serializers.ChoiceField(Visibility.choices, required=False)
-    data = serializers.JSONField(required=False)
+    data = serializers.JSONField(required=False, help_text="a procedure JSON (validated)")
 
     def validate_data(self, value):
         return parse_procedure(value).to_dict()
+
+
+class ProcedureWriteSerializer(SaveAsNewSerializer):
+    visibility = serializers.ChoiceField(Visibility.choices, required=False)
 
 
 class JobSerializer(serializers.ModelSerializer):
@@ -203,7 +242,7 @@ class JobSerializer(serializers.ModelSerializer):
     class Meta:
         model = Job
         fields = ["code", "kind", "status", "progress", "stage", "message", "attempts", "params", "segmentation",
-                  "result", "created", "started", "finished"]
+                  "result", "result_version", "created", "started", "finished"]
         read_only_fields = fields
 
     def get_result(self, job: Job) -> str | None:

@@ -1,6 +1,6 @@
 """What the site does, for the API's views and the pages alike: photos stored from uploads, segmentation
-versions, reconstruction jobs (with their per-user cap), procedures re-measured and forked. Bad input raises DRF's
-`ValidationError` naming the field; the callers turn it into a 400 or a message on the page."""
+versions, reconstruction jobs (with their per-user cap), procedures forked (their versions: `versions`). Bad input
+raises DRF's `ValidationError` naming the field; the callers turn it into a 400 or a message on the page."""
 
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ from facaid.rectify import propose_corners_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
 from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility
-from webapp.facades.serializers import parse_procedure, parse_segmentation
+from webapp.facades.serializers import parse_segmentation
 from webapp.facades.uploads import UploadError, normalize_photo
 
 
@@ -177,10 +177,15 @@ class TooManyJobs(APIException):
 def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
                prefix_nodes: int = 0) -> Job:
     """Queue a reconstruction; `TooManyJobs` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
-    running, so that one account cannot fill the workers' queue."""
+    running, so that one account cannot fill the workers' queue. A re-run from a prefix continues the prefix
+    procedure's current version; of the user's own procedure against its own segmentation, its result is that
+    procedure's next version, else a new procedure whose parent it is."""
     params = {"k": k, "seed": seed}
     if prefix is not None and prefix_nodes > 0:
-        params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id)
+        current = prefix.current_version()
+        params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id,
+                      prefix_version=current.version if current else None,
+                      as_version=prefix.owner_id == user.id and prefix.segmentation_id == segmentation.id)
     with transaction.atomic():  # the count and the new row together: two submissions at once cannot both pass
         get_user_model().objects.select_for_update().filter(pk=user.pk).first()
         active = Job.objects.filter(owner=user, status__in=(Job.Status.QUEUED, Job.Status.RUNNING)).count()
@@ -188,23 +193,6 @@ def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Pr
             raise TooManyJobs(f"You have {active} reconstructions waiting or running (at most "
                               f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
         return jobs.submit(owner=user, segmentation=segmentation, params=params)
-
-
-def remeasure(proc: Procedure) -> None:
-    """Pixel accuracy of an edited procedure against the segmentation it was made from."""
-    if proc.segmentation_id is None:
-        proc.accuracy = None
-        return
-    from facaid.metrics import procedure_accuracy
-    from facaid.segmentation import Segmentation as SegmentationData
-    from facaid.segmentation import flatten
-
-    target = flatten(SegmentationData.from_dict(proc.segmentation.data))
-    tree = parse_procedure(proc.data)
-    if (round(tree.width), round(tree.height)) == (target.width, target.height):
-        proc.accuracy = procedure_accuracy(tree, target)
-    else:
-        proc.accuracy = None  # resized: no longer comparable
 
 
 def fork_procedure(user, proc: Procedure) -> Procedure:

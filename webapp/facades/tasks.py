@@ -10,11 +10,12 @@ from celery.exceptions import SoftTimeLimitExceeded, TimeLimitExceeded
 from celery.signals import worker_ready
 from django.conf import settings
 from django.db import OperationalError, close_old_connections, transaction
+from django.utils import timezone
 
 from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
-from webapp.facades import jobs
-from webapp.facades.models import Job, Procedure, Visibility
+from webapp.facades import jobs, versions
+from webapp.facades.models import Job, Procedure, ProcedureVersion, Visibility
 from worker import compute
 from worker.app import RUN_JOB, app
 
@@ -79,10 +80,17 @@ def run_job(self, job_id: int) -> None:
         heart.stop.set()
 
 
+# what a job's result says of its tree, kept in the procedure's metrics beside its accuracy
+JOB_METRICS = ("accuracy_decoded", "iou", "timings", "source", "retried", "shortcut")
+
+
 def _compute(job: Job) -> dict:
     params = job.params or {}
     prefix = None
-    if params.get("prefix_procedure"):
+    if params.get("prefix_version"):  # the version that was current when the re-run was asked for
+        prefix = ProcedureVersion.objects.get(procedure__code=params["prefix_procedure"],
+                                              version=params["prefix_version"]).data
+    elif params.get("prefix_procedure"):  # a job queued before procedures had versions
         prefix = Procedure.objects.get(code=params["prefix_procedure"]).data
 
     def progress(fraction: float, stage: str) -> None:
@@ -94,19 +102,32 @@ def _compute(job: Job) -> dict:
 
 
 def _store(job: Job, result: dict) -> None:
-    photo = job.segmentation.photo
+    """The result as a new procedure, or, for a re-run of the owner's procedure against its own segmentation, as
+    that procedure's next version (`versions.add_rerun`)."""
+    photo, params = job.segmentation.photo, job.params or {}
+    metrics = {k: result[k] for k in JOB_METRICS if k in result}
     with transaction.atomic():
         if Job.objects.select_for_update().filter(id=job.id, status=Job.Status.RUNNING).count() != 1:
             return  # recovered and given to another worker meanwhile
-        proc = Procedure.objects.create(
-            owner=job.owner, title=photo.title or "", data=result["procedure"], photo=photo,
-            segmentation=job.segmentation, accuracy=result["accuracy"],
-            metrics={k: result[k] for k in ("accuracy_decoded", "iou", "timings", "source", "retried", "shortcut")
-                     if k in result},
-            parent=Procedure.objects.filter(id=(job.params or {}).get("parent_id", -1)).first(),  # may be gone
-            visibility=(job.params or {}).get("visibility", Visibility.PRIVATE))
+        if params.get("as_version") and params.get("prefix_version"):
+            proc = Procedure.objects.select_for_update().filter(id=params["parent_id"]).first()
+            if proc is None:
+                jobs.fail(job.id, "the procedure to re-run was deleted while the job ran")
+                return
+            version = versions.add_rerun(proc, result["procedure"], result["accuracy"], metrics,
+                                         params["prefix_version"], int(params["prefix_nodes"])).version
+        else:
+            parent = Procedure.objects.filter(id=params.get("parent_id", -1)).first()  # may be gone
+            title = photo.title or ""
+            if params.get("prefix_nodes"):  # told apart from the procedure it continued
+                title = f"{parent or title or 'Procedure'} · re-run keeping {params['prefix_nodes']} nodes"
+            proc = Procedure.objects.create(
+                owner=job.owner, title=title[:200], data=result["procedure"], photo=photo,
+                segmentation=job.segmentation, accuracy=result["accuracy"], metrics=metrics, parent=parent,
+                visibility=params.get("visibility", Visibility.PRIVATE))
+            version = 1
         Job.objects.filter(id=job.id).update(status=Job.Status.DONE, progress=1.0, stage="done", result=proc,
-                                             finished=proc.created)
+                                             result_version=version, finished=timezone.now())
 
 
 def _recover_forever(every: int) -> None:

@@ -190,7 +190,7 @@ def procedure(request, code):
     owner = request.user == proc.owner
     photo_visible = access.photo_visible_to(request.user, proc.photo)
     return render(request, "facades/procedure.html", {
-        "proc": proc, "owner": owner, "photo_visible": photo_visible,
+        "proc": proc, "owner": owner, "photo_visible": photo_visible, "current": proc.current_version(),
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
@@ -243,6 +243,8 @@ def procedure_rerun(request, code):
     except services.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(proc)
+    messages.info(request, f"Re-running version {job.params['prefix_version']}: the result will be the procedure's "
+                           "next version, shown beside it.")
     return redirect(job)
 
 

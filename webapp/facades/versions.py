@@ -1,0 +1,150 @@
+"""Versions of procedures, for the API's views and the pages alike: a tree saved (re-measured against the
+procedure's segmentation, so that no figure outlives the tree it was measured on), an old version restored (a new
+version equal to it: nothing is deleted), a re-run's result kept as a version beside the one it continued (with a
+warning when it fits worse), a procedure saved as a new one with lineage, and two versions compared. Bad input
+raises DRF's `ValidationError` naming the field; an unknown version is `Http404`."""
+
+from __future__ import annotations
+
+from django.db import transaction
+from django.http import Http404
+from rest_framework.exceptions import ValidationError
+
+from facaid.metrics import measure
+from facaid.segmentation import Segmentation as SegmentationData
+from facaid.segmentation import flatten
+from webapp.facades import rendering, services
+from webapp.facades.models import Change, Procedure, ProcedureVersion
+from webapp.facades.serializers import parse_procedure
+
+# figures of the job that made a tree (its timings, the decoded candidate's accuracy, how it searched): true of that
+# tree alone, so an edit, a revert or a copy drops them; `source` (where the structure came from) stays
+JOB_FIGURES = ("accuracy_decoded", "timings", "retried", "shortcut", "denoised")
+MAX_VERSION_DIGITS = 9
+
+
+def remeasure(proc: Procedure) -> None:
+    """Pixel accuracy and per-class IoU of the procedure's tree against the segmentation it was made from, into
+    ``accuracy`` and ``metrics`` (nothing is saved). A tree of another size than the segmentation (a resized
+    variant) is not comparable: no accuracy, and ``metrics["unmeasured"]`` says why."""
+    metrics = {k: v for k, v in (proc.metrics or {}).items() if k not in (*JOB_FIGURES, "iou", "unmeasured")}
+    proc.accuracy = None
+    if proc.segmentation_id is not None:
+        target = flatten(SegmentationData.from_dict(proc.segmentation.data))
+        tree = parse_procedure(proc.data)
+        size = (round(tree.width), round(tree.height))
+        if size == (target.width, target.height):
+            proc.accuracy, metrics["iou"] = measure(tree, target)
+        else:
+            metrics["unmeasured"] = (f"the tree is {size[0]}x{size[1]} px but its segmentation is "
+                                     f"{target.width}x{target.height}")
+    proc.metrics = metrics
+
+
+def save_tree(proc: Procedure, data: dict, change: Change | None = None) -> None:
+    """Give the procedure ``data`` (a validated procedure JSON), re-measured, and save it with its other fields as
+    a new version (an edit unless ``change`` says otherwise), also when the tree is the one it holds: every save
+    is a version, and its figures are fresh."""
+    proc.data = data
+    remeasure(proc)
+    proc.save(change=change or Change(ProcedureVersion.Kind.EDIT))
+
+
+def version_number(text, field: str | None = None) -> int:
+    """A version number from a path (malformed: `Http404`) or from the query parameter ``field`` (a 400 naming
+    it)."""
+    text = "" if text is None else str(text)
+    if text.isascii() and text.isdigit() and len(text) <= MAX_VERSION_DIGITS:
+        return int(text)
+    if field is None:
+        raise Http404(f"no version {text[:20]!r}: versions are numbered from 1")
+    raise ValidationError({field: f"give a version number, got {text[:20]!r}"})
+
+
+def get_version(proc: Procedure, number, field: str | None = None, with_data: bool = True) -> ProcedureVersion:
+    """Version ``number`` of the procedure: `Http404` (from a path) or a 400 naming ``field`` when there is none."""
+    n = version_number(number, field)
+    rows = proc.versions.all() if with_data else proc.versions.defer("data")
+    version = rows.filter(version=n).first()
+    if version is None:
+        latest = proc.versions.order_by("-version").values_list("version", flat=True).first() or 0
+        message = f"no version {n} of this procedure: it has versions 1 to {latest}"
+        if field is None:
+            raise Http404(message)
+        raise ValidationError({field: message})
+    version.procedure = proc
+    return version
+
+
+def revert(proc: Procedure, number) -> ProcedureVersion:
+    """A new version whose tree is version ``number``'s, measured again; the versions between stay."""
+    old = get_version(proc, number)
+    if old.digest == proc.digest:
+        raise ValidationError({"version": f"version {old.version} is the tree this procedure holds now: "
+                                          "there is nothing to revert"})
+    proc.metrics = dict(old.metrics)  # where its structure came from, as that version knew it
+    save_tree(proc, old.data, Change(ProcedureVersion.Kind.REVERT, f"reverted to version {old.version}",
+                                     based_on=old.version))
+    return proc.current_version()
+
+
+def rerun_warning(accuracy: float | None, base: float | None, based_on: int) -> str:
+    """The warning of a re-run that fits worse (a lower pixel accuracy, to the 4 decimals shown) than the version
+    it continued; empty when it fits as well or better, or when either was not measured."""
+    if accuracy is None or base is None or round(accuracy, 4) >= round(base, 4):
+        return ""
+    return (f"This re-run fits worse than version {based_on}: pixel accuracy {accuracy:.4f} against "
+            f"{base:.4f}. Revert to version {based_on} to keep that one.")
+
+
+def add_rerun(proc: Procedure, data: dict, accuracy: float | None, metrics: dict, based_on: int,
+              nodes: int) -> ProcedureVersion:
+    """A re-run's result (measured by the job against the procedure's own segmentation) as the procedure's new
+    version, beside version ``based_on`` that it continued."""
+    base = proc.versions.filter(version=based_on).values_list("accuracy", flat=True).first()
+    proc.data, proc.accuracy, proc.metrics = data, accuracy, metrics
+    proc.save(change=Change(ProcedureVersion.Kind.RERUN, f"re-run keeping the first {nodes} nodes of version "
+                                                         f"{based_on}", based_on=based_on,
+                            warning=rerun_warning(accuracy, base, based_on)))
+    return proc.current_version()
+
+
+def new_title(user, proc: Procedure, data: dict) -> str:
+    """A title that tells a saved copy from its parent and its siblings: the variation and seed that made it, or
+    a running number among the user's copies of the parent."""
+    base = proc.title or "Procedure"
+    meta = data.get("meta") if isinstance(data.get("meta"), dict) else {}
+    if isinstance(meta.get("variation"), str) and meta["variation"]:
+        what = f"{meta['variation'][:40]} variant"
+        if isinstance(meta.get("variation_seed"), int) and isinstance(meta.get("variation_index"), int):
+            what += f" (seed {meta['variation_seed']}, #{meta['variation_index'] + 1})"
+        return f"{base} · {what}"[:200]
+    n = Procedure.objects.filter(parent=proc, owner=user).count() + 1
+    return f"{base} · variant {n}"[:200]
+
+
+def save_as_new(user, proc: Procedure, data: dict | None = None, title: str = "") -> Procedure:
+    """A new procedure of ``user``'s whose parent is ``proc``: a fork (its links to the photo as a fork keeps
+    them), then ``data`` (an edited tree or a variation, when given) as its second version, re-measured."""
+    tree = proc.data if data is None else data
+    current = proc.current_version()
+    note = f"saved as a new procedure from version {current.version if current else 1} of {proc}"
+    title = title or new_title(user, proc, tree)
+    with transaction.atomic():
+        copy = services.fork_procedure(user, proc)
+        copy.title = title
+        if data is None:
+            copy.save(update_fields=["title"])
+        else:
+            save_tree(copy, data, Change(ProcedureVersion.Kind.EDIT, note))
+    return copy
+
+
+def compare(proc: Procedure, a, b, max_side: int = rendering.COMPARE_SIDE) -> tuple[ProcedureVersion,
+                                                                                     ProcedureVersion, dict]:
+    """Versions ``a`` and ``b`` (from the query: a 400 names the bad one) and their difference picture:
+    {"png", "differing", "pixels"} (pixels whose label differs, of the picture's, at most ``max_side`` a side)."""
+    first, second = get_version(proc, a, "a"), get_version(proc, b, "b")
+    png, differing, pixels = rendering.difference_png(parse_procedure(first.data), parse_procedure(second.data),
+                                                      max_side)
+    return first, second, {"png": png, "differing": differing, "pixels": pixels}
