@@ -157,3 +157,29 @@ def login(page, base: str, username: str, password: str) -> None:
     page.fill("#id_password", password)
     page.click("button[type=submit]")
     page.wait_for_url(f"{base}/")
+
+
+def offline_page(browser, base: str, viewport=(1280, 900)):
+    """A page whose requests to anything but ``base`` are refused and listed in `page.elsewhere`; its uncaught
+    errors collect in `page.errors`."""
+    page = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}).new_page()
+    page.elsewhere, page.errors = [], []
+
+    def route(r):
+        if r.request.url.startswith(base) or r.request.url.startswith("data:"):
+            r.continue_()
+        else:
+            page.elsewhere.append(r.request.url)
+            r.abort()
+
+    page.route("**/*", route)
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    return page
+
+
+def screenshot(target, name: str, tmp_path) -> str:
+    """A picture of a page or of one element (a locator) as ``name``, in FACAID_SCREENSHOT_DIR when set (docs/img
+    to update the docs' pictures), else in ``tmp_path``; its path."""
+    path = os.path.join(os.environ.get("FACAID_SCREENSHOT_DIR") or str(tmp_path), name)
+    target.screenshot(path=path)
+    return path

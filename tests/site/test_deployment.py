@@ -1,10 +1,11 @@
 """The container setup, read without a Docker engine (none on the test machine): docker-compose.yml runs
 PostgreSQL, Redis with an append-only file, the site under gunicorn and a GPU worker, each with a healthcheck, on
 named volumes, configured by DATABASE_URL and REDIS_URL; the Dockerfile copies everything the settings and the
-worker read."""
+worker read; the set-up, CI and the image vendor three.js from npm at the lock file's version."""
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -58,3 +59,18 @@ def test_dockerfile_copies_what_the_site_and_worker_read():
     assert 'torch==2.13.0' in text
     ignored = (ROOT / ".dockerignore").read_text().split()
     assert not any(n in ignored for n in needed)
+
+
+def test_the_set_up_ci_and_the_image_vendor_three_js_at_the_locked_version():
+    pinned = json.loads((ROOT / "package.json").read_text())["dependencies"]["three"]
+    locked = json.loads((ROOT / "package-lock.json").read_text())["packages"]["node_modules/three"]
+    assert re.fullmatch(r"\d+\.\d+\.\d+", pinned) and locked["version"] == pinned  # exact, never a range
+    assert locked["integrity"].startswith("sha512-")
+    assert "bash scripts/vendor-js" in (ROOT / "scripts" / "setup").read_text()
+    assert "need+=(npm)" in (ROOT / ".ci" / "run").read_text()
+    docker = (ROOT / "Dockerfile").read_text()
+    assert re.search(r"^FROM node:\S+ AS vendor-js$", docker, flags=re.M) and "RUN bash scripts/vendor-js" in docker
+    assert "COPY --from=vendor-js /app/webapp/static/vendor webapp/static/vendor" in docker
+    # made, never committed: git and the image's build context leave the copies out
+    assert {"/node_modules/", "/webapp/static/vendor/"} <= set((ROOT / ".gitignore").read_text().split())
+    assert {"node_modules", "webapp/static/vendor"} <= set((ROOT / ".dockerignore").read_text().split())

@@ -73,6 +73,28 @@ def test_procedure_page_for_owner_and_visitor(alice):
     assert "CityEngine CGA rules" in visitor and "for Blender and other 3D tools" in visitor  # each says what it is
 
 
+def test_the_procedure_pages_3d_panel_loads_three_js_from_this_site(alice):
+    import json
+    import re
+
+    from facaid.generator import generate
+
+    data, _ = facade_png()
+    photo = Photo.objects.create(owner=alice, title="Generated facade", image=SimpleUploadedFile("f.png", data))
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="public", photo=photo)
+    owner = Client()
+    owner.force_login(alice)
+    for client, photo_visible in ((owner, True), (Client(), False)):  # the photo is private: the owner's glTF only
+        html = client.get(f"/procedures/{proc.code}").content.decode()
+        imports = json.loads(re.search(r'<script type="importmap">(.*?)</script>', html, re.S).group(1))["imports"]
+        assert imports == {"three": "/static/vendor/three/build/three.module.js",
+                           "three/addons/": "/static/vendor/three/examples/jsm/"}
+        panel = re.search(r'<details class="panel preview3d" id="preview3d"([^>]*)>', html).group(1)
+        assert f'data-glb="/api/v1/procedures/{proc.code}/download/facade.glb"' in panel
+        assert ("facade-photo.glb" in panel) == photo_visible == ('id="preview3d-photo"' in html)
+        assert '<script type="module" src="/static/editor/preview3d.js">' in html
+
+
 def test_the_api_docs_page_names_only_files_of_this_site():
     import re
 

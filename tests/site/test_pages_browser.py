@@ -5,39 +5,15 @@ there (api-docs.png, not-found.png)."""
 
 from __future__ import annotations
 
-import os
 import shutil
 import uuid
 
 import pytest
 from editor_helpers import open_editor
-from site_helpers import login
+from site_helpers import login, offline_page, screenshot
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
-
-
-def offline_page(browser, base: str, viewport=(1280, 900)):
-    """A page whose requests to anything but ``base`` are refused and listed in `page.elsewhere`; its uncaught
-    errors collect in `page.errors`."""
-    page = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}).new_page()
-    page.elsewhere, page.errors = [], []
-
-    def route(r):
-        if r.request.url.startswith(base) or r.request.url.startswith("data:"):
-            r.continue_()
-        else:
-            page.elsewhere.append(r.request.url)
-            r.abort()
-
-    page.route("**/*", route)
-    page.on("pageerror", lambda e: page.errors.append(str(e)))
-    return page
-
-
-def screenshot(page, name: str, tmp_path) -> None:
-    folder = os.environ.get("FACAID_SCREENSHOT_DIR") or str(tmp_path)
-    page.screenshot(path=os.path.join(folder, name), full_page=False)
 
 
 def test_the_api_docs_list_the_operations_offline(live_server, alice, browser, tmp_path):
