@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/bench_assist.py [--stride 1] [--limit N] [--min-score S] [--json F]
     .venv/bin/python bench/bench_assist.py --generated 12      # + photo-like renders of generated facades
+    .venv/bin/python bench/bench_assist.py --timing 6          # one call's time, with and without the photo
 
 A simulated annotator (`facaid.evaluation.assist.simulate`) draws each facade's true elements in reading order,
 asks `facaid.completion.complete` for proposals after every third, accepts at no cost each proposal that matches
@@ -37,9 +38,13 @@ def main() -> None:
     ap.add_argument("--min-score", type=float, default=DEFAULT_MIN_SCORE)
     ap.add_argument("--json", default=None)
     ap.add_argument("--generated", type=int, default=0, help="N generated facades with photo-like renders instead")
+    ap.add_argument("--timing", type=int, default=0,
+                    help="time one call on 150 drawn elements of N generated facades rendered at 2x (1-2 MP photos)")
     args = ap.parse_args()
     if args.generated:
         return generated(args)
+    if args.timing:
+        return timing(args)
     records = load_records(args.data)
     halves = {"dev": records[:DEV_FACADES], "test": records[DEV_FACADES:]}
     calls: list[float] = []
@@ -68,6 +73,34 @@ def main() -> None:
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
+
+
+def timing(args) -> None:
+    """The median time of one completion call with and without the photo on the first 150 elements (reading
+    order) of N held-out generated facades, each scaled 2x with its photo-like render (0.8-2.2 MP), 5 calls each."""
+    from PIL import Image
+
+    from facaid.generator import generate
+    from facaid.photolike import render_photo
+    from facaid.segmentation import Rect, Segmentation
+
+    took: dict[str, list[float]] = {"structure": [], "photo": []}
+    for seed in range(5000, 5000 + args.timing):
+        seg = as_drawn(generate(seed).segmentation)
+        big = Segmentation(2 * seg.width, 2 * seg.height, tuple(
+            Rect(r.label, 2 * r.x0, 2 * r.y0, 2 * r.x1, 2 * r.y1) for r in seg.rects))
+        photo = render_photo(generate(seed).segmentation, seed).resize((big.width, big.height), Image.BILINEAR)
+        drawn = Segmentation(big.width, big.height, tuple(sorted(big.rects, key=lambda r: (r.y0, r.x0))[:150]))
+        for name, kw in (("structure", {}), ("photo", {"photo": photo})):
+            runs = []
+            for _ in range(5):
+                t0 = time.perf_counter()
+                complete(drawn, min_score=args.min_score, **kw)
+                runs.append(time.perf_counter() - t0)
+            took[name].append(statistics.median(runs))
+    for name, t in took.items():
+        print(f"150 drawn elements, 0.8-2.2 MP ({len(t)} facades), {name}: median "
+              f"{1000 * statistics.median(t):.0f} ms, at most {1000 * max(t):.0f} ms")
 
 
 def generated(args) -> None:

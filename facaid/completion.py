@@ -24,11 +24,12 @@ a drawn one:
    that looks like a type's drawn elements with the wall around them (`facaid.appearance.search`, NCC at least
    `SEARCH_MATCH`, anywhere in the facade, rows and lattices or not) is proposed at the type's size (score
    `PHOTO_CONFIRMED`, reason ``looks like window``). On photo-like renders of 12 held-out generated facades this
-   takes the effort from 0.785 (the structure, checked by the photo) to 0.700.
-6. **The photo checks**: each proposal scored at least `PHOTO_CANDIDATE` is moved to the best of 25 nearby places
-   and compared with the drawn elements of its class (`facaid.appearance`: normalized cross-correlation of 12 x 12
-   grey patches); at `PHOTO_MATCH` or more it scores at least `PHOTO_CONFIRMED`, below that half its structural
-   score, and ``photo`` holds the similarity. Where the photo is flat (a rendered label map) it has no say.
+   takes the effort from 0.72 (the structure, checked by the photo) to 0.443.
+6. **The photo checks** every proposal scored at least `PHOTO_CANDIDATE`, the searched ones too: it is moved to
+   the best of 25 nearby places and compared with the drawn elements of its class (`facaid.appearance`: normalized
+   cross-correlation of 12 x 12 grey patches); at `PHOTO_MATCH` or more it scores at least `PHOTO_CONFIRMED`,
+   below that half its score, and ``photo`` holds the similarity. Where the photo is flat (a rendered label map)
+   it has no say.
 
 Proposals outside the drawn facade rectangles' bounds (the image when none is drawn), cut by the image's edge, over
 a drawn element of the same class, mostly under a drawn element of a class that paints over them, or near a
@@ -71,9 +72,9 @@ COLUMN_TOLERANCE = 0.3  # elements whose left edges agree within this share of t
 
 
 PHOTO_CANDIDATE = 0.7  # proposals scored at least this by the structure are shown to the photo
-PHOTO_MATCH = 0.8  # NCC against the drawn examples of the class at which the photo confirms a proposal
+PHOTO_MATCH = 0.9  # NCC against the drawn examples of the class at which the photo confirms a proposal
 PHOTO_CONFIRMED = 0.9  # ... and the score it has at least then
-SEARCH_MATCH = 0.9  # NCC at which a place anywhere in the photo that looks like a type's elements is proposed
+SEARCH_MATCH = 0.93  # NCC at which a place anywhere in the photo that looks like a type's elements is proposed
 
 
 class RejectedError(ValueError):

@@ -194,6 +194,9 @@ SPECTACULAR_SETTINGS = {
     "DESCRIPTION": "Photos, segmentations, reconstruction jobs and procedures of the FaçAID site.",
     "VERSION": "1",
     "SERVE_INCLUDE_SCHEMA": False,
+    # two models have a field `kind` with different choices: name each set, or the schema gets KindF8fEnum
+    "ENUM_NAME_OVERRIDES": {"VersionKindEnum": "webapp.facades.models.ProcedureVersion.Kind",
+                            "JobKindEnum": "webapp.facades.models.Job.Kind"},
     # the docs page (/api/v1/docs) loads Swagger UI from our static files and asks no other site for anything: no
     # validator badge, which would send the schema's address to swagger.io
     "SWAGGER_UI_DIST": "SIDECAR",

@@ -4,7 +4,7 @@ import numpy as np
 from PIL import Image
 
 from facaid.appearance import refine, search, similarity
-from facaid.completion import complete
+from facaid.completion import PHOTO_MATCH, complete
 from facaid.labels import FACADE, LABEL_ID
 from facaid.segmentation import Rect, Segmentation
 
@@ -66,7 +66,7 @@ def test_search_finds_every_window_of_the_photo_from_one_example_and_nothing_on_
     found = sorted(tuple(int(round(v)) for v in b) for b in boxes)
     assert len(found) == len(SCATTERED) and (sims >= 0.9).all()
     for got, want in zip(found, sorted(SCATTERED), strict=True):
-        assert max(abs(g - w) for g, w in zip(got, want, strict=True)) <= 4  # within the searched copy's pixel
+        assert max(abs(g - w) for g, w in zip(got, want, strict=True)) <= 1
     flat = np.full((500, 600), 128, np.float32)
     assert len(search(flat, np.array([SCATTERED[0]], float), (60, 60), 0.9)[0]) == 0
     assert len(search(grey, np.zeros((0, 4)), (60, 60), 0.9)[0]) == 0
@@ -78,6 +78,7 @@ def test_with_a_photo_completion_proposes_windows_no_structure_implies():
     assert complete(seg) == []  # one window: no row, no column, no pitch
     proposals = complete(seg, _photo(SCATTERED))
     assert len(proposals) == len(SCATTERED) - 1
-    assert all(p["reason"] == "looks like window" and p["score"] >= 0.9 and p["photo"] >= 0.8 for p in proposals)
+    assert all(p["reason"] == "looks like window" and p["score"] >= 0.9 and p["photo"] >= PHOTO_MATCH
+               for p in proposals)
     for p in proposals:
-        assert any(abs(p["x0"] - b[0]) <= 4 and abs(p["y0"] - b[1]) <= 4 for b in SCATTERED[1:])
+        assert any(abs(p["x0"] - b[0]) <= 1 and abs(p["y0"] - b[1]) <= 1 for b in SCATTERED[1:])
