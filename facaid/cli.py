@@ -231,6 +231,36 @@ def cmd_vary(args: argparse.Namespace) -> None:
     print(f"wrote {len(variants)} variants and variants.png (the original first) to {out}/")
 
 
+def _assignment(text: str) -> tuple[str, float]:
+    name, sep, value = text.partition("=")
+    try:
+        if not sep:
+            raise ValueError
+        return name.strip(), float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE (e.g. floors=6), got {text!r}") from None
+
+
+def cmd_params(args: argparse.Namespace) -> None:
+    from facaid.grammar.procedure import Procedure
+    from facaid.parameters import named_parameters, set_parameters
+
+    proc = Procedure.from_dict(_read_json(args.input))
+    if args.set:
+        if not args.out:
+            raise CliError("--set needs --out FILE for the edited procedure")
+        proc = set_parameters(proc, dict(args.set))
+        Path(args.out).write_text(proc.to_json(indent=1) + "\n")
+    params = named_parameters(proc)
+    for p in params:
+        value = f"{p.value:g}" if p.integer else f"{p.value:.1f} px"
+        fixed = "  (fixed: no repeat lays them out)" if p.min == p.max else ""
+        print(f"{p.name:<14} {value:>10}  {p.label}{fixed}")
+    if args.set:
+        print(f"wrote {args.out} ({proc.width:g}x{proc.height:g})")
+    _write_json(args.json, {"parameters": [p.to_dict() for p in params]})
+
+
 def cmd_cga(args: argparse.Namespace) -> None:
     from facaid.cga import default_scale, procedure_cga
     from facaid.grammar.procedure import Procedure
@@ -541,6 +571,17 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--seed", type=int, default=0)
     v.add_argument("--out", default="out/variants", help="output directory (default out/variants)")
     v.set_defaults(func=cmd_vary)
+
+    pa = sub.add_parser("params", help="a procedure's named parameters (floors, floor height, ...), read or set",
+                        description="List the named parameters of a procedure (upper floors, floor height, ground "
+                                    "floor and attic heights, tiles per floor, tile width, facade width and height), "
+                                    "or set some (--set floors=6 --out FILE): the other parts keep their size.")
+    pa.add_argument("input", help="procedure JSON")
+    pa.add_argument("--set", type=_assignment, action="append", metavar="NAME=VALUE",
+                    help="set a named parameter (repeatable)")
+    pa.add_argument("--out", help="where to write the edited procedure (with --set)")
+    pa.add_argument("--json", help="write the parameters as JSON to this file")
+    pa.set_defaults(func=cmd_params)
 
     exports = (
         ("cga", cmd_cga, "a procedure as CityEngine CGA rules", "output .cga file",

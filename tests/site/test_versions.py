@@ -262,3 +262,36 @@ def test_migration_0005_gives_every_procedure_its_tree_as_version_1(alice):
     assert (v1.version, v1.data, v1.digest, v1.accuracy, v1.metrics) == (1, data, proc.digest, 0.93,
                                                                          {"source": "model"})
     assert v1.kind == "created" and v1.created == proc.updated
+
+
+def test_named_parameters_through_the_api(facade_photo, as_alice, as_bob, alice):
+    """GET lists the named parameters; POST sets them (returned only, or saved as the next version with a fresh
+    accuracy); bad names and values are a 400 naming them, and another user cannot save."""
+    _, seg = facade_photo
+    proc = _faithful(alice, seg, visibility="public")
+    r = as_alice.get(_url(proc, "parameters"))
+    assert r.status_code == 200, r.content
+    floors = {p["name"]: p for p in r.json()["parameters"]}["floors"]
+    assert floors["integer"] and floors["nodes"]
+    target = floors["value"] + 1
+    r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": target}}, format="json")
+    assert r.status_code == 200, r.content
+    body = r.json()
+    assert {p["name"]: p["value"] for p in body["parameters"]}["floors"] == target
+    assert body["version"] is None and len(_history(as_alice, proc)) == 1  # not saved
+    r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": target}, "save": True}, format="json")
+    assert r.status_code == 200, r.content
+    saved = r.json()
+    assert saved["version"] == 2, saved
+    # a taller facade than its segmentation: measured again on save, and said to be unmeasurable, never stale
+    assert saved["accuracy"] is None and "its segmentation is" in saved["metrics"]["unmeasured"]
+    [v2, v1] = _history(as_alice, proc)
+    assert v2["kind"] == "edit" and "floors" in v2["note"] and v1["version"] == 1
+    proc.refresh_from_db()
+    assert proc.data["height"] > generate(3).procedure.height and proc.accuracy is None
+    for bad, word in (({"values": {"storeys": 3}}, "storeys"), ({"values": {"floors": 0}}, "floors"),
+                      ({"values": {"floors": "x"}}, "values"), ({}, "values")):
+        r = as_alice.post(_url(proc, "parameters"), bad, format="json")
+        assert r.status_code == 400 and word in json.dumps(r.json()), (bad, r.content)
+    r = as_bob.post(_url(proc, "parameters"), {"values": {"floors": target}, "save": True}, format="json")
+    assert r.status_code in (403, 404) and len(_history(as_alice, proc)) == 2

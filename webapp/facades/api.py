@@ -31,17 +31,28 @@ from rest_framework.response import Response
 from facaid import interchange
 from facaid.grammar import to_segmentation
 from facaid.grammar.procedure import ProcedureError
+from facaid.parameters import named_parameters, set_parameters
 from facaid.rectify import rectify_file
 from facaid.variation import vary
 from webapp.facades import access, downloads, pictures, rendering, services, versions
 from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.jsonbody import JSONParser
-from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.models import (
+    Change,
+    Draft,
+    Job,
+    Photo,
+    Procedure,
+    ProcedureVersion,
+    Segmentation,
+    Visibility,
+)
 from webapp.facades.paging import Pagination
 from webapp.facades.serializers import (
     ConvertSerializer,
     JobCreateSerializer,
     JobSerializer,
+    ParametersSerializer,
     PhotoSerializer,
     PhotoUploadSerializer,
     ProcedureSerializer,
@@ -419,6 +430,36 @@ def procedure_variations(request, code):
     except (ProcedureError, ValueError) as exc:
         raise ValidationError({"data": f"no variations of this procedure: {exc}"}) from None
     return Response({"variants": [v.to_dict() for v in variants]})
+
+
+@extend_schema(methods=["GET"], request=None, responses={200: dict},
+               summary="The named parameters (floors, floor height, bays, ...): {'parameters': [...]}")
+@extend_schema(methods=["POST"], request=ParametersSerializer, responses={200: dict},
+               summary="Set named parameters: {'data', 'parameters', 'accuracy', 'metrics', 'version'}; with save, the "
+                       "result is the next version (the accuracy is that version's, measured on save)")
+@api_view(["GET", "POST"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def procedure_parameters(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    if request.method == "GET":
+        return Response({"parameters": [p.to_dict() for p in named_parameters(parse_procedure(proc.data))]})
+    form = ParametersSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    try:
+        edited = set_parameters(parse_procedure(proc.data), form.validated_data["values"])
+    except (ProcedureError, ValueError) as exc:
+        raise ValidationError({"values": str(exc)}) from None
+    answer = {"data": edited.to_dict(), "parameters": [p.to_dict() for p in named_parameters(edited)],
+              "accuracy": None, "metrics": None, "version": None}
+    if form.validated_data["save"]:
+        proc = access.get_rw_procedure_for_user(request.user, code)
+        names = ", ".join(f"{k} {v:g}" for k, v in form.validated_data["values"].items())
+        versions.save_tree(proc, answer["data"], Change(ProcedureVersion.Kind.EDIT, f"set {names}"[:200]))
+        latest = proc.versions.aggregate(Max("version"))["version__max"]
+        answer.update(accuracy=proc.accuracy, metrics=proc.metrics, version=latest)
+    return Response(answer)
 
 
 @extend_schema(request=ConvertSerializer, responses={200: dict},

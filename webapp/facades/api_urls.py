@@ -19,6 +19,7 @@ urlpatterns = [
     path("procedures/<str:code>/", api.procedure_detail, name="api-procedure"),
     path("procedures/<str:code>/fork", api.procedure_fork, name="api-procedure-fork"),
     path("procedures/<str:code>/variations", api.procedure_variations, name="api-procedure-variations"),
+    path("procedures/<str:code>/parameters", api.procedure_parameters, name="api-procedure-parameters"),
     path("procedures/<str:code>/rerun", api.procedure_rerun, name="api-procedure-rerun"),
     path("procedures/<str:code>/save-as-new", api.procedure_save_as_new, name="api-procedure-save-as-new"),
     path("procedures/<str:code>/versions/", api.procedure_versions, name="api-procedure-versions"),

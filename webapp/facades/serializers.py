@@ -277,6 +277,13 @@ class VariationsSerializer(serializers.Serializer):
     seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
 
 
+class ParametersSerializer(serializers.Serializer):
+    values = serializers.DictField(child=serializers.FloatField(), allow_empty=True,
+                                   help_text="named parameters to set, e.g. {\"floors\": 6}")
+    save = serializers.BooleanField(default=False, help_text="save the result as the procedure's next version "
+                                                             "(owner only); else it is only returned")
+
+
 class ConvertSerializer(serializers.Serializer):
     text = TextField(trim_whitespace=False, help_text="the annotation file's content")
     format = serializers.ChoiceField(interchange.FORMATS, required=False,

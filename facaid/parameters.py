@@ -1,0 +1,283 @@
+"""Named parameters: the few figures a person thinks of a facade in, read off the tree's roles and set back into it.
+
+A procedure's raw parameters are every size of every node (hundreds on a real facade). The named ones are: the
+number of upper floors, the floor height, the ground floor and attic heights, the tiles (bays) per floor, the tile
+width, and the facade's width and height. Each is found from the nodes' roles (`facaid.grammar.procedure.ROLES`)
+and names the node paths it stands for, so that a page can link a parameter to its part of the picture.
+
+Setting one edits the tree consistently: the tree is first *normalised* (every size becomes the length it lays out
+to, so floating sizes hold their real pixel lengths; execution is unchanged), then the edited lengths or counts
+change and every enclosing node and the image grow by what their contents grew, so that the other parts keep their
+size: six floors of 80 px become seven, the facade is 80 px (and a floor's molding) taller, the ground floor stays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+from facaid.grammar.layout import expand, layout
+from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
+from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
+
+__all__ = ["NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
+
+# name: (label, role, axis): a length (px) of the nodes of that role along that axis, or a count (axis None)
+_LENGTHS = {
+    "floor_height": ("floor height", "floor", "y"),
+    "ground_height": ("ground floor height", "ground", "y"),
+    "attic_height": ("attic height", "attic", "y"),
+    "tile_width": ("tile (bay) width", "tile", "x"),
+}
+NAMES = ("floors", "floor_height", "ground_height", "attic_height", "bays", "tile_width", "width", "height")
+
+
+@dataclass
+class Parameter:
+    name: str
+    label: str
+    value: float
+    unit: str  # "px" or "count"
+    integer: bool
+    min: float
+    max: float
+    nodes: list[str] = field(default_factory=list)  # the paths of the nodes it stands for
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+class _Instances:
+    """Every node instance of a procedure: per node, its path, how many instances and the first one's extents."""
+
+    def __init__(self, proc: Procedure):
+        self.path: dict[int, str] = {}
+        self.count: dict[int, int] = {}
+        self.extent: dict[int, tuple[float, float]] = {}
+        self.parent_axis: dict[int, str | None] = {}
+        self.outer: dict[int, bool] = {}  # no ancestor with the same role
+        self._visit(proc.root, "root", float(proc.width), float(proc.height), None, frozenset())
+
+    def _visit(self, node: Node, path: str, w: float, h: float, axis: str | None, roles: frozenset) -> None:
+        key = id(node)
+        if key not in self.path:
+            self.path[key], self.extent[key], self.parent_axis[key] = path, (w, h), axis
+            self.outer[key] = node.role not in roles
+        self.count[key] = self.count.get(key, 0) + 1
+        if node.rule == "leaf":
+            return
+        length = w if node.axis == "x" else h
+        _, children, _ = expand(node, length)
+        lengths = layout(expand(node, length)[0], length)
+        inner = roles | {node.role} if node.role else roles
+        n = len(node.children)
+        for i, (child, extent) in enumerate(zip(children, lengths, strict=True)):
+            cw, ch = (extent, h) if node.axis == "x" else (w, extent)
+            self._visit(child, f"{path}/{i % n}", cw, ch, node.axis, inner)
+
+
+def _nodes(proc: Procedure) -> dict[str, Node]:
+    return dict(proc.nodes())
+
+
+def normalised(proc: Procedure) -> Procedure:
+    """The same facade with every size set to the length it lays out to in the node's first instance (``rel``
+    becomes ``abs``; ``flt`` keeps its mode with its real length as weight). Execution does not change."""
+    out = Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
+    inst = _Instances(out)
+    for _, node in out.nodes():
+        if node.rule == "leaf" or node.count == "fill":
+            continue
+        w, h = inst.extent[id(node)]
+        length = w if node.axis == "x" else h
+        lengths = layout(expand(node, length)[0], length)[: len(node.sizes)]
+        node.sizes = [Size("flt" if s.mode == "flt" else "abs", round(v, 4)) for s, v in zip(node.sizes, lengths,
+                                                                                            strict=True)]
+    return out
+
+
+def _floor_repeats(proc: Procedure, inst: _Instances, role: str, axis: str) -> list[tuple[str, Node]]:
+    """The repeats with a count along ``axis`` that lay out the outermost nodes of ``role`` (for each, the nearest
+    such repeat above it), largest count first."""
+    nodes = _nodes(proc)
+    found: dict[str, Node] = {}
+    for path, node in nodes.items():
+        if node.role != role or not inst.outer.get(id(node)):
+            continue
+        parts = path.split("/")
+        for k in range(len(parts) - 1, 0, -1):
+            above = nodes["/".join(parts[:k])]
+            if above.rule == "repeat" and above.axis == axis and above.count != "fill":
+                found["/".join(parts[:k])] = above
+                break
+    return sorted(found.items(), key=lambda pn: -pn[1].count)
+
+
+def _count_of(inst: _Instances, proc: Procedure, role: str) -> tuple[int, list[str]]:
+    nodes = [(p, n) for p, n in proc.nodes() if n.role == role and inst.outer.get(id(n))]
+    return sum(inst.count[id(n)] for _, n in nodes), [p for p, _ in nodes]
+
+
+def _bays(proc: Procedure, inst: _Instances) -> tuple[int, list[str]] | None:
+    """Tiles in the first floor that has any, and the repeats laying them out."""
+    for _, floor in proc.nodes():
+        if floor.role not in ("floor", "ground") or not inst.outer.get(id(floor)):
+            continue
+        tiles = [(p, n) for p, n in floor.walk(inst.path[id(floor)]) if n.role == "tile" and inst.outer[id(n)]]
+        if tiles:
+            per_floor = sum(inst.count[id(n)] for _, n in tiles) // max(1, inst.count[id(floor)])
+            return per_floor, [p for p, _ in tiles]
+    return None
+
+
+def named_parameters(proc: Procedure) -> list[Parameter]:
+    """The named parameters this procedure has (those whose roles it holds), in `NAMES` order."""
+    inst = _Instances(proc)
+    out: list[Parameter] = []
+    floors, paths = _count_of(inst, proc, "floor")
+    if floors:
+        editable = bool(_floor_repeats(proc, inst, "floor", "y"))
+        out.append(Parameter("floors", "upper floors", floors, "count", True, floors if not editable else 1,
+                             floors if not editable else MAX_COUNT, paths))
+    for name, (label, role, axis) in _LENGTHS.items():
+        nodes = [(p, n) for p, n in proc.nodes() if n.role == role and inst.outer.get(id(n))
+                 and inst.parent_axis[id(n)] == axis]
+        if nodes:
+            w, h = inst.extent[id(nodes[0][1])]
+            out.append(Parameter(name, label, round(w if axis == "x" else h, 2), "px", False, 1.0, MAX_EXTENT,
+                                 [p for p, _ in nodes]))
+        if name == "ground_height" and (bays := _bays(proc, inst)):
+            out.append(Parameter("bays", "tiles per floor", bays[0], "count", True, 1, MAX_COUNT, bays[1]))
+    out.append(Parameter("width", "facade width", float(proc.width), "px", False, 8.0, MAX_EXTENT, ["root"]))
+    out.append(Parameter("height", "facade height", float(proc.height), "px", False, 8.0, MAX_EXTENT, ["root"]))
+    order = {n: i for i, n in enumerate(NAMES)}
+    return sorted(out, key=lambda p: order[p.name])
+
+
+def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
+    """Grow the nodes in ``own`` (id → change of each instance's length along ``axis``) and, to fit them, every
+    node enclosing them and the image; a normalised tree stays normalised, so nothing else changes size."""
+    memo: dict[int, float] = {}
+    holds: dict[int, bool] = {}
+
+    def has_target(node: Node) -> bool:
+        if id(node) not in holds:
+            holds[id(node)] = id(node) in own or any(has_target(c) for c in node.children)
+        return holds[id(node)]
+
+    def pad(node: Node, extra: float) -> None:
+        """Lengthen ``node`` by ``extra`` in what holds no edited node (a wing whose floors grew less than its
+        neighbour's takes the difference in its wall or sky, not in its floors)."""
+        if node.rule == "leaf" or id(node) in own:
+            return
+        if node.axis != axis:
+            for c in node.children:
+                pad(c, extra)
+            return
+        free = [i for i, c in enumerate(node.children) if not has_target(c)]
+        i = next((i for i in free if node.sizes[i].mode == "flt"), free[0] if free else 0)
+        copies = (node.count + (i < node.tail) if node.rule == "repeat"
+                  else 1 if node.rule == "split" or (node.center and i == len(node.children) - 1) else 2)
+        node.sizes[i] = Size(node.sizes[i].mode, round(node.sizes[i].value + extra / copies, 4))
+        if not free:
+            pad(node.children[i], extra / copies)
+
+    def grow(node: Node) -> float:
+        key = id(node)
+        if key in memo:
+            return memo[key]
+        if key in own:
+            g = own[key]
+        elif node.rule == "leaf":
+            g = 0.0
+        elif node.axis != axis:
+            parts = [grow(c) for c in node.children]
+            g = max(parts)
+            for c, d in zip(node.children, parts, strict=True):
+                if d < g:
+                    pad(c, g - d)
+        else:
+            parts = [grow(c) for c in node.children]
+            node.sizes = [Size(s.mode, max(0.0, round(s.value + d, 4))) for s, d in zip(node.sizes, parts,
+                                                                                      strict=True)]
+            if node.rule == "repeat":
+                g = node.count * sum(parts) + sum(parts[: node.tail])
+            elif node.rule == "mirror":
+                g = 2 * sum(parts) - (parts[-1] if node.center else 0.0)
+            else:
+                g = sum(parts)
+        memo[key] = g
+        return g
+
+    g = grow(proc.root)
+    if axis == "x":
+        proc.width = round(proc.width + g, 4)
+    else:
+        proc.height = round(proc.height + g, 4)
+
+
+def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
+    """A new procedure with one named parameter set (see the module's docstring); raises `ValueError` naming the
+    problem for an unknown name, a value out of range or a parameter this procedure cannot change."""
+    params = {p.name: p for p in named_parameters(proc)}
+    if name not in NAMES:
+        raise ValueError(f"unknown parameter {name!r}; the named parameters are {', '.join(NAMES)}")
+    if name not in params:
+        have = ", ".join(params)
+        raise ValueError(f"this procedure has no {name!r} (no node with its role); it has {have}")
+    p = params[name]
+    if not isinstance(value, int | float) or isinstance(value, bool) or value != value:
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    if p.min == p.max and value != p.value:
+        raise ValueError(f"{name} cannot change here: no repeat lays out them (edit the tree instead)")
+    if p.integer and value != int(value):
+        raise ValueError(f"{name} is a count: a whole number, got {value!r}")
+    if not p.min <= value <= p.max:
+        raise ValueError(f"{name} must be from {p.min:g} to {p.max:g}, got {value:g}")
+    if name in ("width", "height"):
+        from facaid.variation import resize
+        return resize(proc, value if name == "width" else proc.width, value if name == "height" else proc.height)
+    out = normalised(proc)
+    inst = _Instances(out)
+    nodes = _nodes(out)
+    if name in _LENGTHS:
+        _, role, axis = _LENGTHS[name]
+        targets = [nodes[path] for path in p.nodes]
+        _grow(out, axis, {id(n): value - inst.extent[id(n)][0 if axis == "x" else 1] for n in targets})
+    else:
+        role, axis = ("floor", "y") if name == "floors" else ("tile", "x")
+        if name == "bays":  # every row of tiles, scaled in proportion
+            repeats = [(pth, n) for pth, n in out.nodes() if n.rule == "repeat" and n.axis == "x"
+                       and n.count != "fill" and any(c.role == "tile" for c in n.children)]
+        else:
+            repeats = _floor_repeats(out, inst, role, axis)[:1]
+        if not repeats and int(value) != int(p.value):
+            raise ValueError(f"{name} cannot change here: no repeat lays out the {role}s (edit the tree instead)")
+        own: dict[int, float] = {}
+        for _, node in repeats:
+            delta = int(value) - int(p.value)
+            if name == "bays":  # rows of another length change in proportion, by one at least
+                delta = round(delta * node.count / p.value) or (1 if delta > 0 else -1 if delta < 0 else 0)
+            new = node.count + delta
+            if not 1 <= new <= MAX_COUNT:
+                raise ValueError(f"{name} {value:g} needs a repeat of {new} copies (1 to {MAX_COUNT})")
+            length = inst.extent[id(node)][0 if axis == "x" else 1]
+            tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
+            own[id(node)] = (new - node.count) * (length - tail) / node.count
+            node.count = new
+        _grow(out, axis, own)
+    try:
+        validate(out)
+    except ProcedureError as exc:
+        raise ValueError(f"{name} {value:g} makes an invalid procedure: {exc}") from None
+    return out
+
+
+def set_parameters(proc: Procedure, values: dict[str, float]) -> Procedure:
+    """Several named parameters, set one after the other in `NAMES` order (counts before lengths)."""
+    unknown = sorted(set(values) - set(NAMES))
+    if unknown:
+        raise ValueError(f"unknown parameter(s) {', '.join(unknown)}; the named parameters are {', '.join(NAMES)}")
+    for name in NAMES:
+        if name in values:
+            proc = set_parameter(proc, name, values[name])
+    return proc

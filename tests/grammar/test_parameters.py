@@ -1,0 +1,133 @@
+"""Named parameters: read off the roles, set back consistently, and the CLI that does both."""
+
+import json
+
+import numpy as np
+import pytest
+
+from facaid.cli import main
+from facaid.generator import STYLE_NAMES, generate_procedure
+from facaid.grammar.execute import execute, to_segmentation
+from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.parameters import NAMES, named_parameters, normalised, set_parameter, set_parameters
+
+
+def _values(proc):
+    return {p.name: p.value for p in named_parameters(proc)}
+
+
+def _floor_rows(proc):
+    """Distinct y spans of the executed leaves under floor-role nodes, counted from the picture: the rows of
+    windows (window leaves whose top edges differ)."""
+    tops = sorted({round(y0) for label, x0, y0, x1, y1 in execute(proc) if label == 2 and y1 - y0 > 1})
+    return tops
+
+
+def _built(floors=5, height=60.0):
+    """A facade written by hand: attic band, a repeat of `floors` floors of 4 tiles, a ground floor."""
+    tile = Node.split("x", [(Size("flt", 10), Node.leaf("facade")), (Size("abs", 20), Node.leaf("window")),
+                            (Size("flt", 10), Node.leaf("facade"))], role="tile")
+    floor = Node.repeat("x", 4, [(Size("flt", 40), tile)], role="floor")
+    storey = Node.split("y", [(Size("flt", 45), floor), (Size("abs", 15), Node.leaf("molding", role="band"))])
+    ground = Node.split("x", [(Size("flt", 70), Node.leaf("shop")), (Size("abs", 20), Node.leaf("door")),
+                              (Size("flt", 70), Node.leaf("shop"))], role="ground")
+    root = Node.split("y", [(Size("abs", 30), Node.leaf("cornice", role="attic")),
+                            (Size("flt", floors * height), Node.repeat("y", floors, [(Size("flt", height), storey)],
+                                                                      role="floors")),
+                            (Size("abs", 80), ground)], role="facade")
+    return Procedure(160, 30 + floors * height + 80, root)
+
+
+def test_hand_written_facade_has_the_parameters_a_person_names():
+    got = _values(_built())
+    assert got["floors"] == 5 and got["bays"] == 4
+    assert got["floor_height"] == pytest.approx(45.0)  # the floor node, without its molding band
+    assert got["ground_height"] == pytest.approx(80.0) and got["attic_height"] == pytest.approx(30.0)
+    assert got["tile_width"] == pytest.approx(40.0)
+    assert list(got) == [n for n in NAMES if n in got]
+
+
+def test_floors_five_to_six_adds_a_floor_and_keeps_the_rest():
+    proc = _built()
+    out = set_parameter(proc, "floors", 6)
+    assert _values(out)["floors"] == 6
+    assert len(_floor_rows(out)) == 6 and len(_floor_rows(proc)) == 5
+    assert out.height == pytest.approx(proc.height + 60)  # one storey: floor and its molding band
+    before, after = _values(proc), _values(out)
+    for name in ("floor_height", "ground_height", "attic_height", "tile_width"):
+        assert after[name] == pytest.approx(before[name], abs=0.01), name
+    # the ground floor is where it was, counted from the bottom
+    shop = [b for b in execute(out) if b[0] == 11][0]
+    assert out.height - shop[2] == pytest.approx(80, abs=0.01)
+
+
+def test_lengths_change_and_the_facade_grows_by_them():
+    proc = _built()
+    out = set_parameters(proc, {"floor_height": 55, "ground_height": 100})
+    got = _values(out)
+    assert got["floor_height"] == pytest.approx(55) and got["ground_height"] == pytest.approx(100)
+    assert out.height == pytest.approx(proc.height + 5 * 10 + 20)
+    assert got["attic_height"] == pytest.approx(30)
+    wide = set_parameter(proc, "tile_width", 50)
+    assert _values(wide)["tile_width"] == pytest.approx(50) and wide.width == pytest.approx(200)
+
+
+def test_bays_and_size():
+    proc = _built()
+    out = set_parameter(proc, "bays", 6)
+    assert _values(out)["bays"] == 6 and out.width == pytest.approx(240)
+    assert _values(out)["tile_width"] == pytest.approx(40)
+    resized = set_parameter(proc, "width", 320)
+    assert resized.width == 320
+
+
+@pytest.mark.parametrize("style", STYLE_NAMES)
+def test_generated_facades_round_trip(style):
+    for seed in range(3):
+        proc = generate_procedure(seed, style)
+        a, b = np.array(execute(proc)), np.array(execute(normalised(proc)))
+        assert a.shape == b.shape and np.abs(a - b).max() < 0.01  # normalising changes nothing
+        for p in named_parameters(proc):
+            if p.name in ("width", "height") or p.min == p.max:
+                continue
+            target = p.value + 1 if p.integer else p.value + 10
+            out = set_parameter(proc, p.name, target)
+            assert to_segmentation(out).rects  # executes
+            if p.name != "bays":  # bays in rows of other lengths change in proportion
+                assert _values(out)[p.name] == pytest.approx(target, abs=0.05), (style, seed, p.name)
+
+
+def test_bad_values_name_the_problem():
+    proc = _built()
+    with pytest.raises(ValueError, match="unknown parameter 'storeys'"):
+        set_parameter(proc, "storeys", 3)
+    with pytest.raises(ValueError, match="whole number"):
+        set_parameter(proc, "floors", 5.5)
+    with pytest.raises(ValueError, match="from 1"):
+        set_parameter(proc, "floors", 0)
+    with pytest.raises(ValueError, match="must be a number"):
+        set_parameter(proc, "floor_height", "tall")
+    flat = Procedure(100, 100, Node.split("y", [(Size("flt", 50), Node.leaf("facade", role="floor")),
+                                                (Size("flt", 50), Node.leaf("facade", role="floor"))]))
+    assert _values(flat)["floors"] == 2
+    with pytest.raises(ValueError, match="cannot change here"):
+        set_parameter(flat, "floors", 3)
+    with pytest.raises(ValueError, match="no 'attic_height'"):
+        set_parameter(flat, "attic_height", 3)
+
+
+def test_cli_lists_and_sets(tmp_path, capsys):
+    src = tmp_path / "p.json"
+    src.write_text(_built().to_json())
+    assert main(["params", str(src), "--json", str(tmp_path / "params.json")]) == 0
+    listed = json.loads((tmp_path / "params.json").read_text())["parameters"]
+    assert {p["name"]: p["value"] for p in listed}["floors"] == 5
+    assert all({"name", "label", "value", "unit", "integer", "min", "max", "nodes"} <= set(p) for p in listed)
+    out = tmp_path / "six.json"
+    assert main(["params", str(src), "--set", "floors=6", "--out", str(out)]) == 0
+    assert _values(Procedure.from_json(out.read_text()))["floors"] == 6
+    capsys.readouterr()
+    assert main(["params", str(src), "--set", "floors=6"]) == 2
+    assert "--set needs --out" in capsys.readouterr().err
+    assert main(["params", str(src), "--set", "floors=0", "--out", str(out)]) == 2
+    assert "error: floors must be from 1" in capsys.readouterr().err
