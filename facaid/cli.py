@@ -220,7 +220,7 @@ def cmd_vary(args: argparse.Namespace) -> None:
     from facaid.variation import vary
 
     proc = Procedure.from_dict(_read_json(args.input))
-    variants = vary(proc, args.n, args.seed)
+    variants = vary(proc, args.n, args.seed, dict(args.range) if args.range else None)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for i, v in enumerate(variants):
@@ -229,6 +229,17 @@ def cmd_vary(args: argparse.Namespace) -> None:
     images = [render_segmentation(to_segmentation(p)) for p in [proc, *variants]]
     side_by_side(images, height=256).save(out / "variants.png")
     print(f"wrote {len(variants)} variants and variants.png (the original first) to {out}/")
+
+
+def _range(text: str) -> tuple[str, tuple[float, float]]:
+    name, sep, span = text.partition("=")
+    lo, dash, hi = span.partition("-")
+    try:
+        if not (sep and dash):
+            raise ValueError
+        return name.strip(), (float(lo), float(hi))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected NAME=LOW-HIGH (e.g. floors=4-7), got {text!r}") from None
 
 
 def _assignment(text: str) -> tuple[str, float]:
@@ -570,6 +581,9 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--n", type=int, default=8, help="number of variants (default 8)")
     v.add_argument("--seed", type=int, default=0)
     v.add_argument("--out", default="out/variants", help="output directory (default out/variants)")
+    v.add_argument("--range", type=_range, action="append", metavar="NAME=LOW-HIGH",
+                   help="draw this named parameter from a range in every variant, e.g. floors=4-7 (repeatable; "
+                        "see facaid params)")
     v.set_defaults(func=cmd_vary)
 
     pa = sub.add_parser("params", help="a procedure's named parameters (floors, floor height, ...), read or set",

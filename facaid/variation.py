@@ -143,14 +143,20 @@ def _box_sizes(proc: Procedure) -> dict[int, tuple[float, float]]:
     return {k: (b[2] - b[0], b[3] - b[1]) for k, b in first_boxes(proc).items()}
 
 
-def vary(proc: Procedure, n: int = 8, seed: int = 0) -> list[Procedure]:
+def vary(proc: Procedure, n: int = 8, seed: int = 0,
+         ranges: dict[str, tuple[float, float]] | None = None) -> list[Procedure]:
     """``n`` variants: counts of floors and tiles changed, the facade resized with its repeats adapting,
     tiles or floors swapped within the style. Deterministic by seed; every variant is valid. A draw that would
     cross the grammar's limits (a count past them, a facade at its largest made larger) is drawn again, so fewer
-    than ``n`` come back only when that keeps happening."""
+    than ``n`` come back only when that keeps happening.
+
+    With ``ranges`` (named parameter → (low, high), see `facaid.parameters`), each variant instead draws every
+    named parameter uniformly from its range (whole numbers for counts) and sets them: ``{"floors": (4, 7)}``."""
     if not 1 <= n <= 64:
         raise ValueError(f"n must be between 1 and 64, got {n}")
     rng = random.Random(f"facaid-vary:{seed}")
+    if ranges:
+        return _vary_ranges(proc, n, seed, rng, ranges)
     repeats = [p for p, node in proc.nodes() if node.rule == "repeat" and node.count != "fill"]
     roles = [r for r in ("tile", "floor") if any(node.role == r for _, node in proc.nodes())]
     style = proc.meta.get("style")
@@ -174,5 +180,36 @@ def vary(proc: Procedure, n: int = 8, seed: int = 0) -> list[Procedure]:
         except (ProcedureError, ValueError):
             continue
         variant.meta = {**proc.meta, "variation": kind, "variation_seed": seed, "variation_index": i}
+        out.append(variant)
+    return out
+
+
+def _vary_ranges(proc: Procedure, n: int, seed: int, rng: random.Random,
+                 ranges: dict[str, tuple[float, float]]) -> list[Procedure]:
+    from facaid.parameters import named_parameters, set_parameters
+
+    params = {p.name: p for p in named_parameters(proc)}
+    for name, (lo, hi) in ranges.items():
+        if name not in params:
+            raise ValueError(f"no named parameter {name!r} here; this procedure has {', '.join(params)}")
+        p = params[name]
+        if not lo <= hi:
+            raise ValueError(f"{name}: the range {lo:g}-{hi:g} is empty (low above high)")
+        if lo < p.min or hi > p.max:
+            raise ValueError(f"{name}: the range {lo:g}-{hi:g} leaves {p.min:g}-{p.max:g}")
+        if p.integer and (lo != int(lo) or hi != int(hi)):
+            raise ValueError(f"{name} is a count: give whole numbers, got {lo:g}-{hi:g}")
+    out = []
+    for _ in range(4 * n):
+        if len(out) == n:
+            break
+        values = {name: (rng.randint(int(lo), int(hi)) if params[name].integer else round(rng.uniform(lo, hi), 1))
+                  for name, (lo, hi) in sorted(ranges.items())}
+        try:
+            variant = set_parameters(proc, values)
+        except (ProcedureError, ValueError):
+            continue
+        variant.meta = {**proc.meta, "variation": "ranges", "variation_seed": seed, "variation_index": len(out),
+                        "parameters": values}
         out.append(variant)
     return out

@@ -131,3 +131,29 @@ def test_cli_lists_and_sets(tmp_path, capsys):
     assert "--set needs --out" in capsys.readouterr().err
     assert main(["params", str(src), "--set", "floors=0", "--out", str(out)]) == 2
     assert "error: floors must be from 1" in capsys.readouterr().err
+
+
+def test_variations_draw_named_parameters_from_ranges(tmp_path):
+    from facaid.variation import vary
+
+    proc = _built()
+    variants = vary(proc, 8, seed=3, ranges={"floors": (4, 7), "floor_height": (40, 50)})
+    assert len(variants) == 8
+    floors = [_values(v)["floors"] for v in variants]
+    assert set(floors) <= {4, 5, 6, 7} and len(set(floors)) > 1
+    assert all(40 <= _values(v)["floor_height"] <= 50 for v in variants)
+    assert all(v.meta["variation"] == "ranges" and v.meta["parameters"]["floors"] == f
+               for v, f in zip(variants, floors, strict=True))
+    again = vary(proc, 8, seed=3, ranges={"floors": (4, 7), "floor_height": (40, 50)})
+    assert [v.to_json() for v in again] == [v.to_json() for v in variants]  # deterministic by seed
+    for ranges, message in (({"storeys": (1, 2)}, "no named parameter 'storeys'"), ({"floors": (5, 3)}, "empty"),
+                            ({"floors": (0, 3)}, "leaves"), ({"floors": (2.5, 3)}, "whole numbers")):
+        with pytest.raises(ValueError, match=message):
+            vary(proc, 2, ranges=ranges)
+    src = tmp_path / "p.json"
+    src.write_text(proc.to_json())
+    assert main(["vary", str(src), "--n", "3", "--range", "floors=6-6", "--out", str(tmp_path / "v")]) == 0
+    written = sorted((tmp_path / "v").glob("variant-*.json"))
+    assert len(written) == 3 and all(_values(Procedure.from_json(f.read_text()))["floors"] == 6 for f in written)
+    with pytest.raises(SystemExit):
+        main(["vary", str(src), "--range", "floors=6", "--out", str(tmp_path / "w")])

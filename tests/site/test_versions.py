@@ -295,3 +295,15 @@ def test_named_parameters_through_the_api(facade_photo, as_alice, as_bob, alice)
         assert r.status_code == 400 and word in json.dumps(r.json()), (bad, r.content)
     r = as_bob.post(_url(proc, "parameters"), {"values": {"floors": target}, "save": True}, format="json")
     assert r.status_code in (403, 404) and len(_history(as_alice, proc)) == 2
+
+
+def test_variations_by_named_ranges_through_the_api(facade_photo, as_alice, alice):
+    _, seg = facade_photo
+    proc = _faithful(alice, seg)
+    r = as_alice.post(_url(proc, "variations"), {"n": 4, "seed": 1, "ranges": {"floors": [2, 3]}}, format="json")
+    assert r.status_code == 200, r.content
+    variants = r.json()["variants"]
+    assert len(variants) == 4 and {v["meta"]["parameters"]["floors"] for v in variants} <= {2, 3}
+    for bad in ({"ranges": {"storeys": [1, 2]}}, {"ranges": {"floors": [1]}}, {"ranges": {"floors": [3, 2]}}):
+        r = as_alice.post(_url(proc, "variations"), bad, format="json")
+        assert r.status_code == 400 and "ranges" in r.json(), (bad, r.content)

@@ -426,9 +426,11 @@ def procedure_variations(request, code):
     form = VariationsSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     try:
-        variants = vary(parse_procedure(proc.data), form.validated_data["n"], form.validated_data["seed"])
+        ranges = {k: tuple(v) for k, v in form.validated_data.get("ranges", {}).items()} or None
+        variants = vary(parse_procedure(proc.data), form.validated_data["n"], form.validated_data["seed"], ranges)
     except (ProcedureError, ValueError) as exc:
-        raise ValidationError({"data": f"no variations of this procedure: {exc}"}) from None
+        field = "ranges" if form.validated_data.get("ranges") else "data"
+        raise ValidationError({field: f"no variations of this procedure: {exc}"}) from None
     return Response({"variants": [v.to_dict() for v in variants]})
 
 

@@ -275,6 +275,9 @@ class RerunSerializer(serializers.Serializer):
 class VariationsSerializer(serializers.Serializer):
     n = serializers.IntegerField(min_value=1, max_value=32, default=8)
     seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
+    ranges = serializers.DictField(
+        child=serializers.ListField(child=serializers.FloatField(), min_length=2, max_length=2), required=False,
+        help_text="named parameter -> [low, high], e.g. {\"floors\": [4, 7]}: each variant draws them instead")
 
 
 class ParametersSerializer(serializers.Serializer):
