@@ -16,6 +16,8 @@ How the grammar maps:
   (named ``…_mx`` / ``…_my``).
 - CGA's y axis goes up where the procedure's goes down: every split along y lists its children bottom to top.
 - A leaf paints its label's palette colour (``Background`` is ``NIL``): the rules to replace with real geometry.
+- The named lengths of `facaid.parameters` (floor height, ...) are ``attr``s with a ``@Range``, and the parts they
+  stand for are sized by them; no part of a split is under `MIN_PART_M` (its neighbour takes its length).
 """
 
 from __future__ import annotations
@@ -116,10 +118,36 @@ def _camel(word: str) -> str:
     return word[:1].upper() + word[1:]
 
 
+MIN_PART_M = 0.01  # no part of a split is written shorter than this: it goes to its neighbour
+
+
+def _attributes(proc: Procedure, boxes: dict, scale: float) -> tuple[list[tuple[str, str, float, float, float]],
+                                                                      dict[int, str]]:
+    """The named lengths (`facaid.parameters`) as CGA attributes: (name, label, metres, low, high) each, and the
+    nodes whose size is that attribute (those whose length is the parameter's, within half a pixel)."""
+    from facaid.parameters import named_parameters
+
+    attrs, uses = [], {}
+    nodes = dict(proc.nodes())
+    for p in named_parameters(proc):
+        if p.unit != "px" or p.name in ("width", "height"):
+            continue
+        axis = 0 if p.name == "tile_width" else 1
+        used = [id(nodes[path]) for path in p.nodes
+                if abs(boxes[id(nodes[path])][axis + 2] - boxes[id(nodes[path])][axis] - p.value) <= 0.5]
+        if not used:
+            continue
+        metres = p.value * scale
+        attrs.append((p.name, p.label, metres, max(MIN_PART_M, metres / 2), metres * 2))
+        uses.update(dict.fromkeys(used, p.name))
+    return attrs, uses
+
+
 class _Writer:
     def __init__(self, proc: Procedure, scale: float):
         self.scale = scale
         _, self.boxes = execute_with_boxes(proc)
+        self.attrs, self.uses = _attributes(proc, self.boxes, scale)
         self.index = {id(node): k for k, (_, node) in enumerate(proc.nodes())}
         self.rules: dict[tuple[int, bool, bool], str] = {}  # (node, flipped x, flipped y) -> its rule's name
         self.lines: list[str] = []
@@ -157,11 +185,16 @@ class _Writer:
         sizes, children, reflected = expand(node, length)
         lengths = layout(sizes, length)
         items = []
-        for size, child, mirrored, part in zip(sizes, children, reflected, lengths, strict=True):
+        kept = _kept(sizes, lengths, MIN_PART_M / self.scale)
+        for size, child, mirrored, part in zip(sizes, children, reflected, kept, strict=True):
+            if part is None:  # under a centimetre: its neighbour has its length
+                continue
             child_flips = flips
             if mirrored:
                 child_flips = (not flips[0], flips[1]) if node.axis == "x" else (flips[0], not flips[1])
-            if size.mode == "abs":
+            if id(child) in self.uses and size.mode != "rel":
+                text = ("~" if size.mode == "flt" else "") + self.uses[id(child)]
+            elif size.mode == "abs":
                 text = self.metres(part)
             elif size.mode == "rel":
                 text = "'" + _number(part / length if length > 0 else 0.0, 6)
@@ -181,7 +214,8 @@ class _Writer:
         pattern = []
         for size, child, part in zip(node.sizes, node.children, lengths[:k], strict=True):
             fixed = floats and size.mode != "flt"
-            pattern.append(f"{'' if fixed else '~'}{self.metres(part)} : {self.rule(child, flips)}")
+            value = self.uses.get(id(child)) or self.metres(part)
+            pattern.append(f"{'' if fixed else '~'}{value} : {self.rule(child, flips)}")
         tail = [f"{self.metres(part)} : {self.rule(child, flips)}"
                 for child, part in zip(children[k * n:], lengths[k * n:], strict=True)]
         if backwards:
@@ -192,6 +226,22 @@ class _Writer:
             return group
         items = [*tail, group] if backwards else [group, *tail]
         return "{ " + " | ".join(items) + " }"
+
+
+def _kept(sizes: list, lengths: list[float], least: float) -> list[float | None]:
+    """The lengths a split writes: a part shorter than ``least`` pixels (but not the only part, nor a relative
+    one) is None, its length added to a neighbour's (the previous one, else the next), so that no part of the
+    rules is under a centimetre and the parts still fill the split."""
+    kept: list[float | None] = list(lengths)
+    for i, (size, part) in enumerate(zip(sizes, lengths, strict=True)):
+        if part >= least or size.mode == "rel" or len(lengths) == 1:
+            continue
+        near = [j for j in (*range(i - 1, -1, -1), *range(i + 1, len(kept))) if kept[j] is not None
+                and sizes[j].mode != "rel"]
+        if near:
+            kept[near[0]] += part
+            kept[i] = None
+    return kept
 
 
 def _one_line(text: str) -> str:
@@ -223,6 +273,11 @@ def procedure_cga(proc: Procedure, scale: float | None = None, name: str = "", s
         "",
         f'version "{CGA_VERSION}"',
         "",
+        *[line for name, label, metres, low, high in writer.attrs for line in (
+            f"// {label} (m): the rules' sizes of these parts",
+            f"@Range(min={_number(low, 4)}, max={_number(high, 4)})",
+            f"attr {name} = {_number(metres, 4)}",
+            "")],
         "@StartRule",
         f"Facade -->\n\t{root}\n",
     ]

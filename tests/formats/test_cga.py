@@ -73,9 +73,21 @@ def lay_out(group: tuple, length: float) -> list[tuple[object, float]]:
     return out
 
 
-def run_cga(text: str, width_m: float, height_m: float) -> list[tuple[str, float, float, float, float]]:
-    """The leaves the rules draw on a facade of this size: (label, x0, y0, x1, y1) in metres, y up."""
+def attributes(text: str) -> dict[str, float]:
+    """The ``attr name = value`` declarations, each after its ``@Range(min=.., max=..)`` annotation."""
+    found = re.findall(r"^@Range\(min=([\d.]+), max=([\d.]+)\)\nattr (\w+) = ([\d.]+)$", text, flags=re.M)
+    assert len(found) == len(re.findall(r"^attr ", text, flags=re.M))
+    for low, high, _, value in found:
+        assert float(low) <= float(value) <= float(high)
+    return {name: float(value) for _, _, name, value in found}
+
+
+def run_cga(text: str, width_m: float, height_m: float, **overrides: float
+            ) -> list[tuple[str, float, float, float, float]]:
+    """The leaves the rules draw on a facade of this size: (label, x0, y0, x1, y1) in metres, y up; attributes
+    set to their declared values or to ``overrides``."""
     rules = parse_rules(text)
+    attrs = attributes(text) | overrides
     leaves = []
 
     def apply(name: str, box: tuple[float, float, float, float]) -> None:
@@ -93,7 +105,9 @@ def run_cga(text: str, width_m: float, height_m: float) -> list[tuple[str, float
         if split is None:
             apply(body, box)
             return
-        tokens = re.findall(r"\}\*|[{}|:]|[~']?[\d.]+|\w+", split.group(2))
+        tokens = re.findall(r"\}\*|[{}|:]|[~']?[\d.]+|~?\w+", split.group(2))
+        tokens = [t if t.lstrip("~") not in attrs else t[:-len(t.lstrip("~"))] + str(attrs[t.lstrip("~")])
+                  for t in tokens]
         group, end = parse_group(tokens, 0)
         assert end == len(tokens)
         place(group, split.group(1), box)
@@ -238,3 +252,33 @@ def test_cli_writes_the_rules(tmp_path, capsys):
     assert "scale must be a number of metres per pixel" in capsys.readouterr().err
     path.write_text('{"root": 5}')
     assert main(["cga", str(path), "--out", str(tmp_path / "s.cga")]) == 2
+
+
+def test_named_lengths_are_attributes_with_ranges_and_steer_the_rules():
+    """The named parameters' lengths are declared as @Range attrs, the parts they stand for are sized by them,
+    and setting one (as a CityEngine user does in the inspector) changes those parts' metres."""
+    proc = generate(3).procedure
+    scale = default_scale(proc)
+    text = procedure_cga(proc)
+    attrs = attributes(text)
+    assert {"floor_height", "tile_width"} <= set(attrs)
+    assert attrs["floor_height"] == pytest.approx(3.0, abs=0.01)  # the default scale: a storey 3 m tall
+    assert re.search(r"\b~?floor_height : \w+", text) and re.search(r"\b~?tile_width : \w+", text)
+    assert_same_leaves(proc, text, scale)  # at the declared values the rules draw the procedure
+    w, h = proc.width * scale, proc.height * scale
+    windows = [leaf for leaf in run_cga(text, w, h) if leaf[0] == "window"]
+    wider = [leaf for leaf in run_cga(text, w, h, tile_width=attrs["tile_width"] * 1.3) if leaf[0] == "window"]
+    assert len(wider) <= len(windows) and wider != windows
+
+
+def test_no_part_of_a_split_is_under_a_centimetre():
+    root = Node.split("x", [(Size("abs", 0.2), Node.leaf("pillar")), (Size("flt", 50), Node.leaf("window")),
+                            (Size("abs", 49.8), Node.leaf("facade"))])
+    proc = Procedure(100, 100, Node.split("y", [(Size("flt", 1), root)]))
+    text = procedure_cga(proc, scale=0.02)  # the pillar is 4 mm
+    assert "Pillar" not in parse_rules(text).values() and ": Pillar" not in text
+    parts = [float(m) for m in re.findall(r"([\d.]+) : ", text)]
+    assert parts and min(parts) >= 0.01
+    drawn = run_cga(text, 2.0, 2.0)
+    window = [leaf for leaf in drawn if leaf[0] == "window"][0]
+    assert window[1] == pytest.approx(0.0) and window[3] == pytest.approx(1.004, abs=1e-3)  # it took the 4 mm
