@@ -18,6 +18,7 @@ from dataclasses import asdict, dataclass, field
 from facaid.grammar.layout import expand, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
+from facaid.resizing import resize
 
 __all__ = ["NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
 
@@ -234,7 +235,6 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
     if not p.min <= value <= p.max:
         raise ValueError(f"{name} must be from {p.min:g} to {p.max:g}, got {value:g}")
     if name in ("width", "height"):
-        from facaid.variation import resize
         return resize(proc, value if name == "width" else proc.width, value if name == "height" else proc.height)
     out = normalised(proc)
     inst = _Instances(out)

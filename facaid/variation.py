@@ -9,13 +9,11 @@ from __future__ import annotations
 import random
 
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.grammar.execute import first_boxes
-from facaid.grammar.layout import expand, layout
 from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Node, Procedure, ProcedureError, Size, validate
+from facaid.parameters import named_parameters, set_parameters
+from facaid.resizing import box_sizes, copy_procedure, regions, resize
 
-
-def _copy(proc: Procedure) -> Procedure:
-    return Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
+__all__ = ["change_count", "resize", "swap", "vary", "with_count", "with_size"]
 
 
 def _node(proc: Procedure, path: str) -> Node:
@@ -27,7 +25,7 @@ def _node(proc: Procedure, path: str) -> Node:
 
 def with_size(proc: Procedure, path: str, index: int, value: float, mode: str | None = None) -> Procedure:
     """Set size ``index`` of the node at ``path`` (e.g. ``root/1/0``); the site's parameter editor."""
-    out = _copy(proc)
+    out = copy_procedure(proc)
     node = _node(out, path)
     if not 0 <= index < len(node.sizes):
         raise ProcedureError(path, f"has {len(node.sizes)} sizes, no size {index}")
@@ -37,46 +35,11 @@ def with_size(proc: Procedure, path: str, index: int, value: float, mode: str | 
 
 
 def with_count(proc: Procedure, path: str, count: int | str) -> Procedure:
-    out = _copy(proc)
+    out = copy_procedure(proc)
     node = _node(out, path)
     if node.rule != "repeat":
         raise ProcedureError(path, f"is a {node.rule} node, not a repeat")
     node.count = count
-    validate(out)
-    return out
-
-
-def _regions(proc: Procedure) -> dict[int, float]:
-    """Length along its own axis of the first instance of every inner node, keyed by id(node)."""
-    boxes = _box_sizes(proc)
-    return {id(n): boxes[id(n)][0 if n.axis == "x" else 1] for _, n in proc.nodes()
-            if n.rule != "leaf" and id(n) in boxes}
-
-
-def resize(proc: Procedure, width: float, height: float) -> Procedure:
-    """The facade at a new size: fixed sizes keep their pixels, floating ones stretch, and every repeat
-    lays out as many copies of its pattern as now fit beside its tail (rounded, at least one), as a ``"fill"``
-    repeat counts them."""
-    if not (1 <= width <= MAX_EXTENT and 1 <= height <= MAX_EXTENT):
-        raise ValueError(f"size must be between 1 and {MAX_EXTENT:g} pixels, got {width}x{height}")
-    old = _regions(proc)
-    units = {}  # a repeat's pattern length and its tail's, at the old size
-    for _, node in proc.nodes():
-        if node.rule == "repeat" and node.count != "fill" and id(node) in old:
-            length = old[id(node)]
-            tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
-            units[id(node)] = ((length - tail) / node.count, tail)
-    out = _copy(proc)
-    out.width, out.height = width, height
-    # match nodes of the copy with the original by position in the walk
-    pairs = list(zip((n for _, n in proc.nodes()), (n for _, n in out.nodes()), strict=True))
-    for orig, new in pairs:  # top-down: a parent's count settles before its children are measured
-        if id(orig) not in units:
-            continue
-        lengths = _regions(out)
-        if id(new) in lengths:
-            unit, tail = units[id(orig)]
-            new.count = max(1, min(MAX_COUNT, round((lengths[id(new)] - tail) / unit)))
     validate(out)
     return out
 
@@ -88,7 +51,7 @@ def change_count(proc: Procedure, path: str, delta: int) -> Procedure:
     if node.rule != "repeat" or node.count == "fill":
         raise ProcedureError(path, "is not a repeat with a count")
     new_count = max(1, min(MAX_COUNT, node.count + delta))
-    unit = _regions(proc)[id(node)] / node.count
+    unit = regions(proc)[id(node)] / node.count
     grow = (new_count - node.count) * unit
     out = with_count(proc, path, new_count)
     if node.axis == "x":
@@ -114,21 +77,21 @@ def swap(proc: Procedure, role: str, rng: random.Random, style: str | None = Non
     if not targets:
         raise ValueError(f"the procedure has no node with role {role!r}")
     path, target = rng.choice(targets)
-    regions = _box_sizes(proc)
-    donors = [(n, regions[id(n)]) for _, n in proc.nodes()
-              if n.role == role and id(n) in regions and n.to_dict() != target.to_dict()]
+    extents = box_sizes(proc)
+    donors = [(n, extents[id(n)]) for _, n in proc.nodes()
+              if n.role == role and id(n) in extents and n.to_dict() != target.to_dict()]
     if not donors or rng.random() < 0.5:
         name = style if style in STYLE_NAMES else rng.choice(STYLE_NAMES)
         other = generate_procedure(rng.randrange(2**31), name)
-        other_regions = _box_sizes(other)
+        other_regions = box_sizes(other)
         donors = [(n, other_regions[id(n)]) for _, n in other.nodes() if n.role == role and id(n) in other_regions]
     if not donors:
-        return _copy(proc)
+        return copy_procedure(proc)
     donor, (dw, dh) = rng.choice(donors)
-    tw, th = regions[id(target)]
+    tw, th = extents[id(target)]
     replacement = _scaled_subtree(donor, tw / max(dw, 1e-6), th / max(dh, 1e-6))
     replacement.role = role
-    out = _copy(proc)
+    out = copy_procedure(proc)
     parent_path, _, index = path.rpartition("/")
     if not parent_path:
         out.root = replacement
@@ -136,11 +99,6 @@ def swap(proc: Procedure, role: str, rng: random.Random, style: str | None = Non
         _node(out, parent_path).children[int(index)] = replacement
     validate(out)
     return out
-
-
-def _box_sizes(proc: Procedure) -> dict[int, tuple[float, float]]:
-    """(width, height) of the first instance of every node, keyed by id(node)."""
-    return {k: (b[2] - b[0], b[3] - b[1]) for k, b in first_boxes(proc).items()}
 
 
 def vary(proc: Procedure, n: int = 8, seed: int = 0,
@@ -186,8 +144,6 @@ def vary(proc: Procedure, n: int = 8, seed: int = 0,
 
 def _vary_ranges(proc: Procedure, n: int, seed: int, rng: random.Random,
                  ranges: dict[str, tuple[float, float]]) -> list[Procedure]:
-    from facaid.parameters import named_parameters, set_parameters
-
     params = {p.name: p for p in named_parameters(proc)}
     for name, (lo, hi) in ranges.items():
         if name not in params:

@@ -23,7 +23,7 @@ function numberInput(value, step, onChange, decimals = 2) {
   input.type = "number"; input.step = step; input.value = String(Number(value.toFixed(decimals))); input.min = 0;
   input.addEventListener("input", () => {
     const v = Number(input.value);
-    if (input.value !== "" && Number.isFinite(v) && v >= 0) { onChange(v); scheduleRender(); }
+    if (input.value !== "" && Number.isFinite(v) && v >= 0) { onChange(v); namedStale = true; scheduleRender(); }
   });
   return input;
 }
@@ -73,6 +73,42 @@ function drawTree() {
   const root = document.createElement("ul");
   root.append(buildTree(proc.root, breadthFirst(proc.root)));
   document.getElementById("tree").replaceChildren(root);
+  drawNamed();
+}
+
+// The named parameters of the tree shown (edited or not), from the server, which also sets them consistently.
+let namedRequest = 0;
+let namedStale = false;  // the tree was edited by hand: the named values are read again once it renders
+async function drawNamed(values = null) {
+  const body = document.querySelector("#named tbody");
+  const status = document.getElementById("named-status");
+  const mine = ++namedRequest;
+  const [r, answer] = await send(`/api/v1/procedures/${code}/parameters`, "POST", {data: proc, values: values || {}});
+  if (mine !== namedRequest) return;  // a later edit asked again
+  if (!r.ok) { status.textContent = `not set: ${answer.values || JSON.stringify(answer)}`; return; }
+  status.textContent = "";
+  if (values) { proc = answer.data; drawTree(); scheduleRender(); return; }
+  body.replaceChildren(...answer.parameters.map((p) => {
+    const tr = document.createElement("tr");
+    tr.dataset.name = p.name;
+    tr.dataset.nodes = p.nodes.join(" ");
+    const th = document.createElement("th");
+    th.textContent = p.label;
+    const input = document.createElement("input");
+    input.type = "number"; input.name = p.name; input.min = p.min; input.max = p.max;
+    input.step = p.integer ? 1 : 0.5; input.value = p.integer ? String(p.value) : p.value.toFixed(1);
+    if (p.min === p.max) { input.disabled = true; input.title = "no repeat lays them out: edit the tree"; }
+    input.addEventListener("change", () => {
+      const v = Number(input.value);
+      if (input.value !== "" && Number.isFinite(v)) drawNamed({[p.name]: v});
+    });
+    const unit = document.createElement("td");
+    unit.className = "meta"; unit.textContent = p.unit === "px" ? "px" : "";
+    const td = document.createElement("td");
+    td.append(input);
+    tr.append(th, td, unit);
+    return tr;
+  }));
 }
 
 class Throttled extends Error {
@@ -110,6 +146,7 @@ function scheduleRender() {
       if (overlay) overlay.src = url;
       const saved = document.getElementById("saved");
       if (saved) saved.textContent = "unsaved changes";
+      if (namedStale) { namedStale = false; drawNamed(); }
     } catch (err) {
       const saved = document.getElementById("saved");
       if (saved) saved.textContent = err instanceof Throttled ? err.message : `not valid: ${err.message}`;

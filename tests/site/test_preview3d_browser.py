@@ -77,7 +77,7 @@ def test_the_3d_panel_loads_the_procedure_lit_and_names_its_elements(live_server
     requested = _requested(page)
     login(page, live_server.url, "alice", "alice-password-1")
     page.goto(f"{live_server.url}/procedures/{proc.code}")
-    page.wait_for_selector("#tree input")
+    page.wait_for_selector("#tree input", state="attached")  # in the closed "Advanced" panel
     # nothing of the preview is fetched until the panel opens
     assert not any("/vendor/three/" in u or u.endswith(".glb") for u in requested)
     assert page.evaluate("window.facaidPreview3d.frames") == 0

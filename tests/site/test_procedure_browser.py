@@ -23,13 +23,16 @@ pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
 
 
-def open_as_alice(browser, live_server, proc: Procedure, viewport: dict):
-    """Alice's browser on the procedure's page, and the list its script errors are gathered in."""
+def open_as_alice(browser, live_server, proc: Procedure, viewport: dict, advanced: bool = True):
+    """Alice's browser on the procedure's page (with its raw tree opened, unless not ``advanced``), and the list its
+    script errors are gathered in."""
     page = browser.new_page(viewport=viewport)
     errors = []
     page.on("pageerror", lambda e: errors.append(str(e)))
     login(page, live_server.url, "alice", "alice-password-1")
     page.goto(f"{live_server.url}/procedures/{proc.code}")
+    if advanced:
+        page.click("#advanced summary")
     return page, errors
 
 
@@ -187,3 +190,42 @@ def test_a_re_run_that_fits_worse_is_shown_beside_the_version_it_continued(live_
     page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
     assert page.locator("#rerun-warning").count() == 0 and page.text_content("#version") == "3"
     assert errors == []
+
+
+def test_named_parameters_first_the_tree_in_advanced(live_server, alice, browser, tmp_path):
+    """The named parameters are shown first and the raw tree is closed; a floor more re-renders a facade a floor
+    taller, the tree follows, and saving keeps it as version 2."""
+    from facaid.parameters import named_parameters
+
+    data = generate(3).procedure.to_dict()
+    proc = Procedure.objects.create(owner=alice, data=data, visibility="private")
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900}, advanced=False)
+    page.wait_for_selector("#named input[name=floors]")
+    assert not page.is_visible("#tree") and page.is_visible("#named")
+    before = {p.name: p for p in named_parameters(Tree.from_dict(data))}
+    labels = page.eval_on_selector_all("#named th", "els => els.map(e => e.textContent)")
+    assert labels[0] == "upper floors" and "floor height" in labels
+    floors = page.locator("#named input[name=floors]")
+    assert floors.input_value() == str(before["floors"].value)
+    assert page.get_attribute("#named tr[data-name=floors]", "data-nodes").split() == before["floors"].nodes
+    floors.fill(str(before["floors"].value + 1))
+    floors.dispatch_event("change")
+    page.wait_for_function("document.getElementById('render').src.startsWith('blob:')")
+    page.wait_for_function(f"document.querySelector('#named input[name=floors]').value === "
+                           f"'{before['floors'].value + 1}'")
+    assert page.text_content("#saved") == "unsaved changes"
+    path = os.environ.get("FACAID_PARAMETERS_SCREENSHOT") or str(tmp_path / "procedure-parameters.png")
+    page.locator("#named").screenshot(path=path)
+    page.click("#advanced summary")
+    assert page.is_visible("#tree input")
+    page.click("#save")
+    page.wait_for_function("document.getElementById('saved').textContent === 'saved as version 2'")
+    stored = Tree.from_dict(Procedure.objects.get(pk=proc.pk).data)
+    after = {p.name: p.value for p in named_parameters(stored)}
+    assert after["floors"] == before["floors"].value + 1 and stored.height > data["height"]
+    assert after["ground_height"] == pytest.approx(before["ground_height"].value, abs=0.01)
+    bad = page.locator("#named input[name=floor_height]")
+    bad.fill("0")
+    bad.dispatch_event("change")
+    page.wait_for_function("document.getElementById('named-status').textContent.includes('floor_height')")
+    assert not errors, errors

@@ -450,7 +450,8 @@ def procedure_parameters(request, code):
     form = ParametersSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     try:
-        edited = set_parameters(parse_procedure(proc.data), form.validated_data["values"])
+        tree = form.validated_data.get("data") or proc.data
+        edited = set_parameters(parse_procedure(tree), form.validated_data["values"])
     except (ProcedureError, ValueError) as exc:
         raise ValidationError({"values": str(exc)}) from None
     answer = {"data": edited.to_dict(), "parameters": [p.to_dict() for p in named_parameters(edited)],

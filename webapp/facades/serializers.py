@@ -285,6 +285,11 @@ class ParametersSerializer(serializers.Serializer):
                                    help_text="named parameters to set, e.g. {\"floors\": 6}")
     save = serializers.BooleanField(default=False, help_text="save the result as the procedure's next version "
                                                              "(owner only); else it is only returned")
+    data = serializers.JSONField(required=False, help_text="the tree to edit (a procedure JSON, validated; default "
+                                                           "the procedure's saved one): the page's unsaved edits")
+
+    def validate_data(self, value):
+        return parse_procedure(value).to_dict()
 
 
 class ConvertSerializer(serializers.Serializer):

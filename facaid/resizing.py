@@ -1,0 +1,54 @@
+"""Resizing a procedure: fixed sizes keep their pixels, floating ones stretch, repeats lay out as many copies as fit.
+
+Used by variations (`facaid.variation`) and by the named parameters' width and height (`facaid.parameters`).
+"""
+
+from __future__ import annotations
+
+from facaid.grammar.execute import first_boxes
+from facaid.grammar.layout import expand, layout
+from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Procedure, validate
+
+
+def copy_procedure(proc: Procedure) -> Procedure:
+    return Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
+
+
+def regions(proc: Procedure) -> dict[int, float]:
+    """Length along its own axis of the first instance of every inner node, keyed by id(node)."""
+    boxes = box_sizes(proc)
+    return {id(n): boxes[id(n)][0 if n.axis == "x" else 1] for _, n in proc.nodes()
+            if n.rule != "leaf" and id(n) in boxes}
+
+
+def resize(proc: Procedure, width: float, height: float) -> Procedure:
+    """The facade at a new size: fixed sizes keep their pixels, floating ones stretch, and every repeat
+    lays out as many copies of its pattern as now fit beside its tail (rounded, at least one), as a ``"fill"``
+    repeat counts them."""
+    if not (1 <= width <= MAX_EXTENT and 1 <= height <= MAX_EXTENT):
+        raise ValueError(f"size must be between 1 and {MAX_EXTENT:g} pixels, got {width}x{height}")
+    old = regions(proc)
+    units = {}  # a repeat's pattern length and its tail's, at the old size
+    for _, node in proc.nodes():
+        if node.rule == "repeat" and node.count != "fill" and id(node) in old:
+            length = old[id(node)]
+            tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
+            units[id(node)] = ((length - tail) / node.count, tail)
+    out = copy_procedure(proc)
+    out.width, out.height = width, height
+    # match nodes of the copy with the original by position in the walk
+    pairs = list(zip((n for _, n in proc.nodes()), (n for _, n in out.nodes()), strict=True))
+    for orig, new in pairs:  # top-down: a parent's count settles before its children are measured
+        if id(orig) not in units:
+            continue
+        lengths = regions(out)
+        if id(new) in lengths:
+            unit, tail = units[id(orig)]
+            new.count = max(1, min(MAX_COUNT, round((lengths[id(new)] - tail) / unit)))
+    validate(out)
+    return out
+
+
+def box_sizes(proc: Procedure) -> dict[int, tuple[float, float]]:
+    """(width, height) of the first instance of every node, keyed by id(node)."""
+    return {k: (b[2] - b[0], b[3] - b[1]) for k, b in first_boxes(proc).items()}
