@@ -133,8 +133,8 @@ def _attributes(proc: Procedure, boxes: dict, scale: float) -> tuple[list[tuple[
         if p.unit != "px" or p.name in ("width", "height"):
             continue
         axis = 0 if p.name == "tile_width" else 1
-        used = [id(nodes[path]) for path in p.nodes
-                if abs(boxes[id(nodes[path])][axis + 2] - boxes[id(nodes[path])][axis] - p.value) <= 0.5]
+        used = [key for key in (id(nodes[path]) for path in p.nodes)
+                if abs(boxes[key][axis + 2] - boxes[key][axis] - p.value) <= 0.5]
         if not used:
             continue
         metres = p.value * scale

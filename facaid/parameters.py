@@ -18,11 +18,11 @@ from dataclasses import asdict, dataclass, field
 from facaid.grammar.layout import expand, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
-from facaid.resizing import resize
+from facaid.resizing import repeat_unit, resize
 
 __all__ = ["NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
 
-# name: (label, role, axis): a length (px) of the nodes of that role along that axis, or a count (axis None)
+# name: (label, role, axis): the length (px) of the nodes of that role along the axis their parent splits
 _LENGTHS = {
     "floor_height": ("floor height", "floor", "y"),
     "ground_height": ("ground floor height", "ground", "y"),
@@ -67,8 +67,8 @@ class _Instances:
         if node.rule == "leaf":
             return
         length = w if node.axis == "x" else h
-        _, children, _ = expand(node, length)
-        lengths = layout(expand(node, length)[0], length)
+        sizes, children, _ = expand(node, length)
+        lengths = layout(sizes, length)
         inner = roles | {node.role} if node.role else roles
         n = len(node.children)
         for i, (child, extent) in enumerate(zip(children, lengths, strict=True)):
@@ -119,7 +119,7 @@ def _count_of(inst: _Instances, proc: Procedure, role: str) -> tuple[int, list[s
 
 
 def _bays(proc: Procedure, inst: _Instances) -> tuple[int, list[str]] | None:
-    """Tiles in the first floor that has any, and the repeats laying them out."""
+    """How many tiles the first floor that has any holds, and the paths of its outermost tile nodes."""
     for _, floor in proc.nodes():
         if floor.role not in ("floor", "ground") or not inst.outer.get(id(floor)):
             continue
@@ -253,16 +253,16 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         if not repeats and int(value) != int(p.value):
             raise ValueError(f"{name} cannot change here: no repeat lays out the {role}s (edit the tree instead)")
         own: dict[int, float] = {}
+        change = int(value) - int(p.value)
         for _, node in repeats:
-            delta = int(value) - int(p.value)
+            delta = change
             if name == "bays":  # rows of another length change in proportion, by one at least
-                delta = round(delta * node.count / p.value) or (1 if delta > 0 else -1 if delta < 0 else 0)
+                delta = round(change * node.count / p.value) or (1 if change > 0 else -1 if change < 0 else 0)
             new = node.count + delta
             if not 1 <= new <= MAX_COUNT:
                 raise ValueError(f"{name} {value:g} needs a repeat of {new} copies (1 to {MAX_COUNT})")
-            length = inst.extent[id(node)][0 if axis == "x" else 1]
-            tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
-            own[id(node)] = (new - node.count) * (length - tail) / node.count
+            unit, _ = repeat_unit(node, inst.extent[id(node)][0 if axis == "x" else 1])
+            own[id(node)] = delta * unit
             node.count = new
         _grow(out, axis, own)
     try:

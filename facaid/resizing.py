@@ -21,6 +21,12 @@ def regions(proc: Procedure) -> dict[int, float]:
             if n.rule != "leaf" and id(n) in boxes}
 
 
+def repeat_unit(node, length: float) -> tuple[float, float]:
+    """A counted repeat laid out on ``length``: the length of one copy of its pattern and of its tail."""
+    tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
+    return (length - tail) / node.count, tail
+
+
 def resize(proc: Procedure, width: float, height: float) -> Procedure:
     """The facade at a new size: fixed sizes keep their pixels, floating ones stretch, and every repeat
     lays out as many copies of its pattern as now fit beside its tail (rounded, at least one), as a ``"fill"``
@@ -31,9 +37,7 @@ def resize(proc: Procedure, width: float, height: float) -> Procedure:
     units = {}  # a repeat's pattern length and its tail's, at the old size
     for _, node in proc.nodes():
         if node.rule == "repeat" and node.count != "fill" and id(node) in old:
-            length = old[id(node)]
-            tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
-            units[id(node)] = ((length - tail) / node.count, tail)
+            units[id(node)] = repeat_unit(node, old[id(node)])
     out = copy_procedure(proc)
     out.width, out.height = width, height
     # match nodes of the copy with the original by position in the walk

@@ -73,22 +73,25 @@ function drawTree() {
   const root = document.createElement("ul");
   root.append(buildTree(proc.root, breadthFirst(proc.root)));
   document.getElementById("tree").replaceChildren(root);
-  drawNamed();
 }
 
-// The named parameters of the tree shown (edited or not), from the server, which also sets them consistently.
+// The named parameters of the tree shown (edited or not), read or set by the server, which edits the tree so that
+// the rest keeps its size; each answer holds the parameters of the tree it returns.
 let namedRequest = 0;
 let namedStale = false;  // the tree was edited by hand: the named values are read again once it renders
-async function drawNamed(values = null) {
-  const body = document.querySelector("#named tbody");
+async function askNamed(values = {}) {
   const status = document.getElementById("named-status");
   const mine = ++namedRequest;
-  const [r, answer] = await send(`/api/v1/procedures/${code}/parameters`, "POST", {data: proc, values: values || {}});
+  const [r, answer] = await send(`/api/v1/procedures/${code}/parameters`, "POST", {data: proc, values});
   if (mine !== namedRequest) return;  // a later edit asked again
   if (!r.ok) { status.textContent = `not set: ${answer.values || JSON.stringify(answer)}`; return; }
   status.textContent = "";
-  if (values) { proc = answer.data; drawTree(); scheduleRender(); return; }
-  body.replaceChildren(...answer.parameters.map((p) => {
+  if (Object.keys(values).length) { proc = answer.data; drawTree(); scheduleRender(); }
+  drawNamed(answer.parameters);
+}
+
+function drawNamed(parameters) {
+  document.querySelector("#named tbody").replaceChildren(...parameters.map((p) => {
     const tr = document.createElement("tr");
     tr.dataset.name = p.name;
     tr.dataset.nodes = p.nodes.join(" ");
@@ -100,7 +103,7 @@ async function drawNamed(values = null) {
     if (p.min === p.max) { input.disabled = true; input.title = "no repeat lays them out: edit the tree"; }
     input.addEventListener("change", () => {
       const v = Number(input.value);
-      if (input.value !== "" && Number.isFinite(v)) drawNamed({[p.name]: v});
+      if (input.value !== "" && Number.isFinite(v)) askNamed({[p.name]: v});
     });
     const unit = document.createElement("td");
     unit.className = "meta"; unit.textContent = p.unit === "px" ? "px" : "";
@@ -146,7 +149,7 @@ function scheduleRender() {
       if (overlay) overlay.src = url;
       const saved = document.getElementById("saved");
       if (saved) saved.textContent = "unsaved changes";
-      if (namedStale) { namedStale = false; drawNamed(); }
+      if (namedStale) { namedStale = false; askNamed(); }
     } catch (err) {
       const saved = document.getElementById("saved");
       if (saved) saved.textContent = err instanceof Throttled ? err.message : `not valid: ${err.message}`;
@@ -230,7 +233,7 @@ document.getElementById("vary").addEventListener("click", async () => {
     const use = document.createElement("button");
     use.textContent = "Edit this one";
     use.title = "load it into the parameters: saving it then makes a new version, or a new procedure";
-    use.addEventListener("click", () => { proc = v; drawTree(); scheduleRender(); });
+    use.addEventListener("click", () => { proc = v; drawTree(); askNamed(); scheduleRender(); });
     card.append(img, caption, use);
     if (script.dataset.user === "1") {
       const keep = document.createElement("button");
@@ -243,6 +246,7 @@ document.getElementById("vary").addEventListener("click", async () => {
 });
 
 drawTree();
+askNamed();
 versions.refresh().then(() => {
   // a re-run that fits worse is shown beside the version it continued
   const warned = document.querySelector("#rerun-warning [data-compare]");

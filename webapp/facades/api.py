@@ -460,8 +460,7 @@ def procedure_parameters(request, code):
         proc = access.get_rw_procedure_for_user(request.user, code)
         names = ", ".join(f"{k} {v:g}" for k, v in form.validated_data["values"].items())
         versions.save_tree(proc, answer["data"], Change(ProcedureVersion.Kind.EDIT, f"set {names}"[:200]))
-        latest = proc.versions.aggregate(Max("version"))["version__max"]
-        answer.update(accuracy=proc.accuracy, metrics=proc.metrics, version=latest)
+        answer.update(accuracy=proc.accuracy, metrics=proc.metrics, version=proc.current_version().version)
     return Response(answer)
 
 
