@@ -125,16 +125,18 @@ def _attributes(proc: Procedure, boxes: dict, scale: float) -> tuple[list[tuple[
                                                                       dict[int, str]]:
     """The named lengths (`facaid.parameters`) as CGA attributes: (name, label, metres, low, high) each, and the
     nodes whose size is that attribute (those whose length is the parameter's, within half a pixel)."""
-    from facaid.parameters import named_parameters
+    from facaid.parameters import AXES, named_parameters
 
     attrs, uses = [], {}
     nodes = dict(proc.nodes())
     for p in named_parameters(proc):
         if p.unit != "px" or p.name in ("width", "height"):
             continue
-        axis = 0 if p.name == "tile_width" else 1
-        used = [key for key in (id(nodes[path]) for path in p.nodes)
-                if abs(boxes[key][axis + 2] - boxes[key][axis] - p.value) <= 0.5]
+        axis = 0 if AXES[p.name] == "x" else 1
+        # a node's length is written in its parent's split: only where that split runs along the parameter's axis
+        used = [id(nodes[path]) for path in p.nodes if path != "root"
+                and nodes[path.rsplit("/", 1)[0]].axis == AXES[p.name]]
+        used = [key for key in used if abs(boxes[key][axis + 2] - boxes[key][axis] - p.value) <= 0.5]
         if not used:
             continue
         metres = p.value * scale

@@ -2,7 +2,8 @@
 
 A procedure's raw parameters are every size of every node (hundreds on a real facade). The named ones are: the
 number of upper floors, the floor height, the ground floor and attic heights, the tiles (bays) per floor, the tile
-width, and the facade's width and height. Each is found from the nodes' roles (`facaid.grammar.procedure.ROLES`)
+width, the window width and height, the side margin (the wall between a row of tiles and the facade's edge), and the
+facade's width and height. Each is found from the nodes' roles (`facaid.grammar.procedure.ROLES`)
 and names the node paths it stands for, so that a page can link a parameter to its part of the picture.
 
 Setting one edits the tree consistently: the tree is first *normalised* (every size becomes the length it lays out
@@ -20,7 +21,7 @@ from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
 from facaid.resizing import repeat_unit, resize
 
-__all__ = ["NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
+__all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
 
 # name: (label, role, axis): the length (px) of the nodes of that role along the axis their parent splits
 _LENGTHS = {
@@ -29,7 +30,13 @@ _LENGTHS = {
     "attic_height": ("attic height", "attic", "y"),
     "tile_width": ("tile (bay) width", "tile", "x"),
 }
-NAMES = ("floors", "floor_height", "ground_height", "attic_height", "bays", "tile_width", "width", "height")
+# name: (label, axis): the window units' (role window) width or height, whichever way their parent splits
+_WINDOW = {"window_width": ("window width", "x"), "window_height": ("window height", "y")}
+NAMES = ("floors", "floor_height", "ground_height", "attic_height", "bays", "tile_width", "window_width",
+         "window_height", "margin", "width", "height")
+# the axis each length is measured along (the counts have none)
+AXES = {**{n: a for n, (_, _, a) in _LENGTHS.items()}, **{n: a for n, (_, a) in _WINDOW.items()}, "margin": "x",
+        "width": "x", "height": "y"}
 
 
 @dataclass
@@ -130,6 +137,23 @@ def _bays(proc: Procedure, inst: _Instances) -> tuple[int, list[str]] | None:
     return None
 
 
+def _margins(proc: Procedure, inst: _Instances) -> list[tuple[str, Node]]:
+    """The side margins: the wall leaves that begin or end a split along x holding tiles (a row of bays between the
+    facade's edges), outermost rows only, with their paths."""
+    out = []
+    for path, node in proc.nodes():
+        if node.rule != "split" or node.axis != "x" or len(node.children) < 3 or not inst.outer.get(id(node)):
+            continue
+        inner = node.children[1:-1]
+        if not any(n.role == "tile" for c in inner for _, n in c.walk()):
+            continue
+        for i in (0, len(node.children) - 1):
+            c = node.children[i]
+            if c.rule == "leaf" and c.label == "facade" and c.role is None:
+                out.append((f"{path}/{i}", c))
+    return out
+
+
 def named_parameters(proc: Procedure) -> list[Parameter]:
     """The named parameters this procedure has (those whose roles it holds), in `NAMES` order."""
     inst = _Instances(proc)
@@ -148,6 +172,15 @@ def named_parameters(proc: Procedure) -> list[Parameter]:
                                  [p for p, _ in nodes]))
         if name == "ground_height" and (bays := _bays(proc, inst)):
             out.append(Parameter("bays", "tiles per floor", bays[0], "count", True, 1, MAX_COUNT, bays[1]))
+    windows = [(p, n) for p, n in proc.nodes() if n.role == "window" and inst.outer.get(id(n))]
+    for name, (label, axis) in _WINDOW.items():
+        if windows:
+            w, h = inst.extent[id(windows[0][1])]
+            out.append(Parameter(name, label, round(w if axis == "x" else h, 2), "px", False, 1.0, MAX_EXTENT,
+                                 [p for p, _ in windows]))
+    if margins := _margins(proc, inst):
+        out.append(Parameter("margin", "side margin", round(inst.extent[id(margins[0][1])][0], 2), "px", False, 0.0,
+                             MAX_EXTENT, [p for p, _ in margins]))
     out.append(Parameter("width", "facade width", float(proc.width), "px", False, 8.0, MAX_EXTENT, ["root"]))
     out.append(Parameter("height", "facade height", float(proc.height), "px", False, 8.0, MAX_EXTENT, ["root"]))
     order = {n: i for i, n in enumerate(NAMES)}
@@ -239,10 +272,14 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
     out = normalised(proc)
     inst = _Instances(out)
     nodes = _nodes(out)
-    if name in _LENGTHS:
-        _, role, axis = _LENGTHS[name]
+    if name in _LENGTHS or name in _WINDOW or name == "margin":
+        axis = AXES[name]
         targets = [nodes[path] for path in p.nodes]
-        _grow(out, axis, {id(n): value - inst.extent[id(n)][0 if axis == "x" else 1] for n in targets})
+        side = 0 if axis == "x" else 1
+        if name in _WINDOW:  # windows of other sizes (the ground floor's, a dormer) change by as much
+            _grow(out, axis, {id(n): value - p.value for n in targets})
+        else:
+            _grow(out, axis, {id(n): value - inst.extent[id(n)][side] for n in targets})
     else:
         role, axis = ("floor", "y") if name == "floors" else ("tile", "x")
         if name == "bays":  # every row of tiles, scaled in proportion

@@ -1,10 +1,12 @@
 """Named parameters: read off the roles, set back consistently, and the CLI that does both."""
 
 import json
+import re
 
 import numpy as np
 import pytest
 
+from facaid.cga import procedure_cga
 from facaid.cli import main
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar.execute import execute, to_segmentation
@@ -79,6 +81,45 @@ def test_bays_and_size():
     assert _values(out)["tile_width"] == pytest.approx(40)
     resized = set_parameter(proc, "width", 320)
     assert resized.width == 320
+
+
+def _windowed():
+    """Three floors of four tiles between two 10 px margins, each tile a window unit (window over a sill) in the
+    wall."""
+    unit = Node.split("y", [(Size("flt", 30), Node.leaf("window")), (Size("abs", 5), Node.leaf("sill"))],
+                      role="window")
+    column = Node.split("y", [(Size("flt", 10), Node.leaf("facade")), (Size("abs", 35), unit),
+                              (Size("flt", 15), Node.leaf("facade"))])
+    tile = Node.split("x", [(Size("flt", 10), Node.leaf("facade")), (Size("abs", 20), column),
+                            (Size("flt", 10), Node.leaf("facade"))], role="tile")
+    row = Node.split("x", [(Size("abs", 10), Node.leaf("facade")),
+                           (Size("flt", 160), Node.repeat("x", 4, [(Size("flt", 40), tile)], role="bay")),
+                           (Size("abs", 10), Node.leaf("facade"))], role="floor")
+    return Procedure(180, 180, Node.repeat("y", 3, [(Size("flt", 60), row)], role="floors"))
+
+
+def _leaf_sizes(proc, label):
+    return sorted({(round(x1 - x0, 2), round(y1 - y0, 2)) for lab, x0, y0, x1, y1 in execute(proc) if lab == label})
+
+
+def test_window_size_and_margin_are_named_and_set():
+    proc = _windowed()
+    got = _values(proc)
+    assert got["window_width"] == pytest.approx(20) and got["window_height"] == pytest.approx(35)
+    assert got["margin"] == pytest.approx(10)
+    wider = set_parameter(proc, "window_width", 24)
+    assert _values(wider)["window_width"] == pytest.approx(24)
+    assert _leaf_sizes(wider, 2) == [(24, 30)] and wider.width == pytest.approx(180 + 4 * 4)  # every window, wider
+    assert _values(wider)["tile_width"] == pytest.approx(got["tile_width"] + 4)  # the tile holds it
+    taller = set_parameter(proc, "window_height", 45)
+    assert _leaf_sizes(taller, 5) == [(20, 5)] and _leaf_sizes(taller, 2) == [(20, 40)]  # the sill keeps its 5 px
+    assert taller.height == pytest.approx(180 + 3 * 10) and taller.width == proc.width
+    margins = set_parameter(proc, "margin", 15)
+    assert _values(margins)["margin"] == pytest.approx(15) and margins.width == pytest.approx(190)
+    assert _leaf_sizes(margins, 2) == _leaf_sizes(proc, 2)  # the windows keep their size
+    text = procedure_cga(wider)
+    # in the CGA, each length sizes the parts whose split runs along it: the unit's height and the margins here
+    assert re.search(r"^attr window_height = ", text, flags=re.M) and re.search(r"^attr margin = ", text, flags=re.M)
 
 
 @pytest.mark.parametrize("style", STYLE_NAMES)
