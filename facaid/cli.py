@@ -311,7 +311,9 @@ def cmd_export(args: argparse.Namespace) -> None:
     if args.metres_per_pixel is not None and not export.scaled:
         raise CliError(f"--metres-per-pixel sets the scale of the exports in metres; a {ext} file is in pixels")
     if args.photo and not export.photo:
-        raise CliError(f"--photo is the texture of a .glb or .gltf; a {ext} file has none")
+        raise CliError(f"--photo is the texture of a .glb or .gltf, or under an .overlay.png; a {ext} file has none")
+    if export.needs_photo and not args.photo:
+        raise CliError(f"a {ext} file is drawn over the photo: give it with --photo")
     proc = Procedure.from_dict(_read_json(args.input))
     photo = _open_photo(args.photo) if args.photo else None
     if photo is not None and abs(photo.width * proc.height / (photo.height * proc.width) - 1) > 0.02:
@@ -627,7 +629,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the scale of the metric formats (default: a storey, from the floors or the rows of windows, "
                         "is 3 m tall; 12 m for the whole facade when it has neither)")
     x.add_argument("--photo", help="the rectified photo the procedure was drawn on, shown on the fronts of a .glb or "
-                                   ".gltf")
+                                   ".gltf, or under an .overlay.png")
     x.set_defaults(func=cmd_export)
 
     rc = sub.add_parser("rectify", help="propose a photo's four facade corners, or rectify it from four corners",

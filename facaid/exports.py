@@ -1,5 +1,7 @@
-"""What `facaid export` writes, by the output's extension: the procedure itself, its label map as a picture, and
-the formats of other tools, the 3D ones in metres at a scale each file states."""
+"""What `facaid export` writes, by the output's extension: the procedure itself, the rectangles it draws (ours, COCO,
+LabelMe, CVAT), its label map as a picture (alone or over the photo), and the formats of other tools, the 3D ones in
+metres at a scale each file states. The same set as the site's downloads (`webapp.facades.downloads`), where the
+OBJ and its MTL come zipped (`mesh.zip`) and the textured glTF is `facade-photo.glb`."""
 
 from __future__ import annotations
 
@@ -20,6 +22,7 @@ class Export:
     write: Callable[[Procedure, Path, float | None, Image.Image | None], list[Path]]  # the files written
     scaled: bool = True  # in metres, at --metres-per-pixel
     photo: bool = False  # takes --photo
+    needs_photo: bool = False  # and cannot do without it
 
 
 def _text(path: Path, text: str | bytes) -> list[Path]:
@@ -39,6 +42,25 @@ def _png(proc, path, scale, photo):
     from facaid.render import render_segmentation
 
     render_segmentation(to_segmentation(proc)).save(path, "PNG")
+    return [path]
+
+
+def _segmentation(fmt: str):
+    def write(proc, path, scale, photo):
+        from facaid.grammar.execute import to_segmentation
+        from facaid.interchange import write as write_annotations
+
+        picture = path.name[: -len(export_for(path)[0])] + "-labels.png"  # its label map, named as the site names it
+        return _text(path, write_annotations(to_segmentation(proc), fmt, image=picture))
+    return write
+
+
+def _overlay(proc, path, scale, photo):
+    from facaid.grammar.execute import to_segmentation
+    from facaid.render import overlay
+    from facaid.segmentation import rasterize
+
+    overlay(photo, rasterize(to_segmentation(proc))).save(path, "PNG")
     return [path]
 
 
@@ -85,7 +107,14 @@ def _cityjson(proc, path, scale, photo):
 
 EXPORTS: dict[str, Export] = {  # the longest extension that a file name ends in wins
     ".json": Export("the procedure JSON", _json, scaled=False),
+    ".segmentation.json": Export("the labelled rectangles it draws", _segmentation("segmentation"), scaled=False),
+    ".coco.json": Export("those rectangles as COCO object detection annotations", _segmentation("coco"),
+                         scaled=False),
+    ".labelme.json": Export("those rectangles as a LabelMe file", _segmentation("labelme"), scaled=False),
+    ".cvat.xml": Export("those rectangles as CVAT for images XML", _segmentation("cvat"), scaled=False),
     ".png": Export("the label map as a picture", _png, scaled=False),
+    ".overlay.png": Export("the label map over --photo, half opaque", _overlay, scaled=False, photo=True,
+                           needs_photo=True),
     ".svg": Export("the label map as vector rectangles", _svg, scaled=False),
     ".cga": Export("CityEngine CGA rules", _cga),
     ".obj": Export("a relief mesh (OBJ, with its MTL beside it)", _obj),

@@ -16,6 +16,7 @@ from facaid.exports import EXPORTS, export_for
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
+from facaid.interchange import read as read_annotations
 from facaid.labels import LABEL_ID
 
 
@@ -34,6 +35,8 @@ def source(tmp_path, proc):
 def read_back(path, proc):
     """The number of elements each format's reader finds in the file (labelled rectangles, nodes, windows)."""
     name = path.name
+    if name.endswith((".segmentation.json", ".coco.json", ".labelme.json", ".cvat.xml")):
+        return len(read_annotations(path.read_bytes(), size=(round(proc.width), round(proc.height))).rects)
     if name.endswith(".city.json"):
         doc = json.loads(path.read_text())
         return sum(s["type"] == "Window" for s in doc["CityObjects"]["facade"]["geometry"][0]["semantics"]["surfaces"])
@@ -59,11 +62,14 @@ def test_every_extension_writes_its_format(tmp_path, source, proc, capsys):
     rects = len(to_segmentation(proc).rects)
     windows = sum(r.label in (LABEL_ID["window"], LABEL_ID["shop"]) for r in to_segmentation(proc).rects)
     expected = {".json": rects, ".png": (444, 797), ".svg": rects, ".obj": True, ".glb": rects, ".gltf": rects,
-                ".ifc": windows, ".city.json": windows}
+                ".ifc": windows, ".city.json": windows, ".overlay.png": (444, 797)}
+    photo = tmp_path / "photo.png"
+    Image.new("RGB", (proc.width, proc.height), (120, 80, 40)).save(photo)
     for ext in EXPORTS:
         out = tmp_path / f"house{ext}"
-        assert main(["export", str(source), "--out", str(out), *(["--metres-per-pixel", "0.02"] if EXPORTS[ext].scaled
-                                                                  else [])]) == 0, ext
+        extra = ["--metres-per-pixel", "0.02"] if EXPORTS[ext].scaled else []
+        extra += ["--photo", str(photo)] if EXPORTS[ext].needs_photo else []
+        assert main(["export", str(source), "--out", str(out), *extra]) == 0, ext
         printed = capsys.readouterr().out
         assert f"wrote {out}" in printed and EXPORTS[ext].what in printed
         if EXPORTS[ext].scaled:  # every metric export says its scale
@@ -71,7 +77,9 @@ def test_every_extension_writes_its_format(tmp_path, source, proc, capsys):
         if ext == ".cga":
             assert read_back(out, proc) > 3
         else:
-            assert read_back(out, proc) == expected[ext], ext
+            assert read_back(out, proc) == expected.get(ext, rects), ext
+    coco = json.loads((tmp_path / "house.coco.json").read_text())
+    assert coco["images"][0]["file_name"] == "house-labels.png"
 
 
 def test_the_longest_extension_wins():
@@ -94,11 +102,12 @@ def test_the_glb_takes_the_photo(tmp_path, source, proc, capsys):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--out", "{tmp}/f.txt"], "the format comes from the file's extension, one of .json .png"),
+    (["--out", "{tmp}/f.txt"], "the format comes from the file's extension, one of .json .segmentation.json"),
     (["--out", "{tmp}/f.ifc", "--metres-per-pixel", "0"], "--metres-per-pixel: scale must be a number"),
     (["--out", "{tmp}/f.ifc", "--metres-per-pixel", "nan"], "--metres-per-pixel: scale must be a number"),
     (["--out", "{tmp}/f.png", "--metres-per-pixel", "0.02"], "a .png file is in pixels"),
     (["--out", "{tmp}/f.ifc", "--photo", "{tmp}/p.json"], "--photo is the texture of a .glb or .gltf"),
+    (["--out", "{tmp}/f.overlay.png"], "a .overlay.png file is drawn over the photo: give it with --photo"),
     (["--out", "{tmp}/f.glb", "--photo", "{tmp}/missing.png"], "cannot read photo"),
 ])
 def test_bad_arguments_are_an_error_not_a_crash(tmp_path, source, capsys, args, message):
