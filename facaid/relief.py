@@ -72,13 +72,20 @@ def procedure_relief(proc: Procedure, scale: float | None = None, scale_from: st
     given = scale is not None
     scale = checked_scale(proc, scale)
     source = " ".join((scale_from or ("given" if given else f"a storey {STOREY_M:g} m tall")).split())[:200]
-    leaves, nodes = execute_with_nodes(proc)
-    rows, index = leaf_rows(proc, leaves)
+    rows, paths = drawn_leaves(proc)
     if len(rows) > MAX_MESH_RECTS:
         raise MeshTooLarge(f"the procedure draws {len(rows)} rectangles; a mesh is made of at most {MAX_MESH_RECTS}")
+    return Relief(round(proc.width), round(proc.height), scale, source, rows, paths)
+
+
+def drawn_leaves(proc: Procedure) -> tuple[np.ndarray, list[str]]:
+    """The rectangles the procedure draws, as labels.png paints them: (n, 5) int64 rows (label id, x0, y0, x1, y1 in
+    whole pixels; background and empty leaves left out), and each one's node in the tree (``root/1/0``, the same for
+    every copy of a repeated node). They do not overlap: a point of the picture lies in one at most."""
+    leaves, nodes = execute_with_nodes(proc)
+    rows, index = leaf_rows(proc, leaves)
     path_of = {id(node): path for path, node in proc.nodes()}
-    return Relief(round(proc.width), round(proc.height), scale, source, rows,
-                  [path_of[id(nodes[i])] for i in index.tolist()])
+    return rows, [path_of[id(nodes[i])] for i in index.tolist()]
 
 
 NORMALS = ((0, 0, 1), (-1, 0, 0), (1, 0, 0), (0, 1, 0), (0, -1, 0))  # front, left, right, top, bottom

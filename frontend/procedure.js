@@ -1,6 +1,10 @@
 // The procedure page: an editable tree of parameters with live re-rendering, saved as a new version or as a new
-// procedure, the history (procedure-history.js), variations, overlay opacity.
+// procedure, the history (procedure-history.js), variations, overlay opacity, and one selection shared by the
+// picture, the named parameters, the tree and the 3D panel (selection.js): a click on an element of the picture
+// selects its node in the tree and the parameters that stand for it; a click on a parameter's name or a node's
+// outlines what it stands for in the picture.
 import {accuracyText, mountHistory} from "./procedure-history.js";
+import {leafAt, leavesUnder, parametersOf, pictureToProcedure} from "./selection.js";
 
 const script = document.currentScript || document.querySelector("script[data-code]");
 const code = script.dataset.code;
@@ -9,6 +13,11 @@ const versions = mountHistory({code, owner: script.dataset.owner === "1", csrf})
 let proc = JSON.parse(document.getElementById("procedure-data").textContent);
 let renderTimer = null;
 let renderedUrl = null;
+let leaves = [];  // where the shown tree draws each leaf: [label, x0, y0, x1, y1, path] (askNamed's answer)
+let parameters = [];
+let selected = [];  // the node paths selected, what selected them, and the parameter when one did
+let selectedBy = null;
+let selectedName = null;
 
 function label(node) {
   const role = node.role ? ` · ${node.role}` : "";
@@ -30,8 +39,9 @@ function numberInput(value, step, onChange, decimals = 2) {
 
 // Each node shows its breadth-first index (#k), the order in which a re-run from a prefix keeps nodes: clicking
 // it sets the re-run form to keep the nodes up to and including it.
-function buildTree(node, order, sizeInput = null) {
+function buildTree(node, order, sizeInput = null, path = "root") {
   const li = document.createElement("li");
+  li.dataset.path = path;
   const k = order.get(node);
   const badge = document.createElement("span");
   badge.className = "bfs"; badge.textContent = `#${k}`;
@@ -40,7 +50,11 @@ function buildTree(node, order, sizeInput = null) {
     const field = document.getElementById("id_nodes");
     if (field) { field.value = k + 1; field.focus(); }
   });
-  li.append(badge, ` ${label(node)}`);
+  const name = document.createElement("span");
+  name.className = "node-label"; name.textContent = label(node);
+  name.title = "select this node: what it draws is outlined in the picture";
+  name.addEventListener("click", () => select([path], "tree"));
+  li.append(badge, " ", name);
   if (sizeInput) li.append(sizeInput);
   if (node.rule === "repeat" && node.count !== "fill") {
     li.append(" × ", numberInput(node.count, 1, (v) => { node.count = Math.max(1, Math.round(v)); }, 0));
@@ -52,7 +66,7 @@ function buildTree(node, order, sizeInput = null) {
       const span = document.createElement("span");
       const rel = size[0] === "rel";
       span.append(` ${size[0]} `, numberInput(size[1], rel ? 0.01 : 1, (v) => { size[1] = v; }, rel ? 4 : 2));
-      ul.append(buildTree(child, order, span));
+      ul.append(buildTree(child, order, span, `${path}/${i}`));
     });
     li.append(ul);
   }
@@ -73,7 +87,71 @@ function drawTree() {
   const root = document.createElement("ul");
   root.append(buildTree(proc.root, breadthFirst(proc.root)));
   document.getElementById("tree").replaceChildren(root);
+  showSelection();
 }
+
+// ---- the selection -------------------------------------------------------------------------------------------
+function select(paths, by, name = null) {
+  selected = paths;
+  selectedBy = by;
+  selectedName = name;
+  showSelection();
+  if (by === "picture" || by === "3d") {  // the node in the tree, scrolled to within the tree (the page stays)
+    const li = document.querySelector(`#tree li[data-path="${paths[0]}"]`);
+    if (li) {
+      document.getElementById("advanced").open = true;
+      const box = document.getElementById("tree");
+      box.scrollTop += li.getBoundingClientRect().top - box.getBoundingClientRect().top - box.clientHeight / 3;
+    }
+  }
+}
+
+function showSelection() {
+  const one = selected.length === 1 ? selected[0] : null;
+  for (const li of document.querySelectorAll("#tree li.selected")) li.classList.remove("selected");
+  for (const path of selected) document.querySelector(`#tree li[data-path="${path}"]`)?.classList.add("selected");
+  const named = one ? parametersOf(parameters, one) : [];
+  for (const tr of document.querySelectorAll("#named tbody tr")) {
+    tr.classList.toggle("selected", selectedBy === "parameter" ? tr.dataset.name === selectedName
+      : named.includes(tr.dataset.name));
+  }
+  const drawn = leavesUnder(leaves, selected);
+  const what = document.getElementById("selection-info");
+  if (what) {
+    const leaf = one && leaves.find((l) => l[5] === one);
+    what.textContent = !selected.length ? "" : leaf ? `Selected: ${leaf[0]} · ${one}` + (named.length
+      ? ` · ${named.map((n) => parameters.find((p) => p.name === n).label).join(", ")}` : "")
+      : `Selected: ${selected.length === 1 ? one : `${selected.length} nodes`} · ${drawn.length} rectangles`;
+  }
+  drawOutlines(drawn);
+}
+
+function drawOutlines(drawn) {
+  const canvas = document.getElementById("selection");
+  if (!canvas) return;
+  canvas.width = Math.max(1, Math.round(proc.width));
+  canvas.height = Math.max(1, Math.round(proc.height));
+  const ctx = canvas.getContext("2d");
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  const line = Math.max(1, canvas.width / Math.max(1, canvas.clientWidth) * 2);  // 2 px as shown
+  ctx.lineWidth = line;
+  for (const [, x0, y0, x1, y1] of drawn) {
+    ctx.fillStyle = "rgba(255, 230, 0, 0.35)";
+    ctx.fillRect(x0, y0, x1 - x0, y1 - y0);
+    ctx.strokeStyle = "#111";
+    ctx.strokeRect(x0 + line / 2, y0 + line / 2, x1 - x0 - line, y1 - y0 - line);
+  }
+  canvas.dataset.outlined = String(drawn.length);  // for the page's tests
+}
+
+document.getElementById("render").addEventListener("click", (e) => {
+  const img = e.currentTarget;
+  const [x, y] = pictureToProcedure(e.offsetX, e.offsetY, img.clientWidth, img.clientHeight, proc.width, proc.height);
+  const leaf = leafAt(leaves, x, y);
+  select(leaf ? [leaf[5]] : [], "picture");
+});
+// the 3D panel's pick (preview3d.js): the same node, in the saved tree (the one the panel shows)
+document.addEventListener("facaid:select3d", (e) => select(e.detail.path ? [e.detail.path] : [], "3d"));
 
 // The named parameters of the tree shown (edited or not), read or set by the server, which edits the tree so that
 // the rest keeps its size; each answer holds the parameters of the tree it returns.
@@ -86,17 +164,62 @@ async function askNamed(values = {}) {
   if (mine !== namedRequest) return;  // a later edit asked again
   if (!r.ok) { status.textContent = `not set: ${answer.values || JSON.stringify(answer)}`; return; }
   status.textContent = "";
+  leaves = answer.leaves || [];
+  parameters = answer.parameters;
   if (Object.keys(values).length) { proc = answer.data; drawTree(); scheduleRender(); }
   drawNamed(answer.parameters);
+  showSelection();
+}
+
+// Ranges for variations, one row per named parameter that can change (of the saved procedure, which the server
+// varies): both ends given, the variations draw it within them.
+let rangesDrawn = false;
+function drawRanges(parameters) {
+  if (rangesDrawn) return;  // the rows keep what the user typed
+  rangesDrawn = true;
+  document.querySelector("#ranges tbody").replaceChildren(...parameters.filter((p) => p.min !== p.max).map((p) => {
+    const tr = document.createElement("tr");
+    tr.dataset.name = p.name;
+    const th = document.createElement("th");
+    th.textContent = p.label;
+    const cells = ["from", "to"].map((end) => {
+      const input = document.createElement("input");
+      input.type = "number"; input.name = `${p.name}-${end}`; input.min = p.min; input.max = p.max;
+      input.step = p.integer ? 1 : 0.5; input.placeholder = p.integer ? String(p.value) : p.value.toFixed(1);
+      input.style.width = "6rem";
+      const td = document.createElement("td");
+      td.append(input);
+      return td;
+    });
+    const unit = document.createElement("td");
+    unit.className = "meta"; unit.textContent = p.unit === "px" ? "px" : "";
+    tr.append(th, ...cells, unit);
+    return tr;
+  }));
+}
+
+// {name: [from, to]} of the rows with both ends given; a string naming the problem when a row has one end only
+function rangesAsked() {
+  const out = {};
+  for (const tr of document.querySelectorAll("#ranges tbody tr")) {
+    const [lo, hi] = [...tr.querySelectorAll("input")].map((i) => i.value);
+    if (lo === "" && hi === "") continue;
+    if (lo === "" || hi === "") return `${tr.querySelector("th").textContent}: give both ends of the range`;
+    out[tr.dataset.name] = [Number(lo), Number(hi)];
+  }
+  return out;
 }
 
 function drawNamed(parameters) {
+  drawRanges(parameters);
   document.querySelector("#named tbody").replaceChildren(...parameters.map((p) => {
     const tr = document.createElement("tr");
     tr.dataset.name = p.name;
     tr.dataset.nodes = p.nodes.join(" ");
     const th = document.createElement("th");
     th.textContent = p.label;
+    th.title = "select: what it stands for is outlined in the picture";
+    th.addEventListener("click", () => select(p.nodes, "parameter", p.name));
     const input = document.createElement("input");
     input.type = "number"; input.name = p.name; input.min = p.min; input.max = p.max;
     input.step = p.integer ? 1 : 0.5; input.value = p.integer ? String(p.value) : p.value.toFixed(1);
@@ -215,11 +338,19 @@ document.getElementById("opacity")?.addEventListener("input", (e) => {
 
 document.getElementById("vary").addEventListener("click", async () => {
   const seed = Number(document.getElementById("seed").value) || 0;
-  const r = await fetch(`/api/v1/procedures/${code}/variations`, {method: "POST", credentials: "same-origin",
-    headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify({n: 8, seed})});
+  const status = document.getElementById("vary-status");
+  const ranges = rangesAsked();
+  if (typeof ranges === "string") { status.textContent = ranges; return; }
+  const body = {n: 8, seed};
+  if (Object.keys(ranges).length) body.ranges = ranges;
+  const [r, answer] = await send(`/api/v1/procedures/${code}/variations`, "POST", body);
   const grid = document.getElementById("variants");
-  if (!r.ok) { grid.textContent = "could not make variations"; return; }
-  const {variants} = await r.json();
+  if (!r.ok) {
+    status.textContent = `no variations: ${answer.ranges || answer.data || answer.detail || JSON.stringify(answer)}`;
+    return;
+  }
+  status.textContent = "";
+  const {variants} = answer;
   grid.replaceChildren();
   for (const v of variants) {
     const card = document.createElement("div");
@@ -229,7 +360,9 @@ document.getElementById("vary").addEventListener("click", async () => {
     img.alt = v.meta?.variation || "variant";
     const caption = document.createElement("div");
     caption.className = "meta";
-    caption.textContent = `${v.meta?.variation || "variant"} · ${Math.round(v.width)}×${Math.round(v.height)}`;
+    const drawn = Object.entries(v.meta?.parameters || {}).map(([name, value]) => `${name} ${value}`).join(", ");
+    caption.textContent = `${v.meta?.variation || "variant"} · ${Math.round(v.width)}×${Math.round(v.height)}` +
+      (drawn ? ` · ${drawn}` : "");
     const use = document.createElement("button");
     use.textContent = "Edit this one";
     use.title = "load it into the parameters: saving it then makes a new version, or a new procedure";

@@ -118,6 +118,9 @@ def test_the_3d_panel_loads_the_procedure_lit_and_names_its_elements(live_server
     page.mouse.up()
     assert page.evaluate("window.facaidPreview3d.selected.path") == node_path
     assert page.text_content("#preview3d-info") == f"Selected: {tip}"
+    # the page selects the same node: in the tree, and outlined in the picture
+    assert page.get_attribute("#tree li.selected", "data-path") == node_path
+    assert int(page.get_attribute("#selection", "data-outlined")) >= 1
 
     # a drag orbits (a frame drawn), fit to view draws again
     frames = page.evaluate("window.facaidPreview3d.frames")

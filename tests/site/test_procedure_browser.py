@@ -92,6 +92,38 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     assert errors == []
 
 
+def test_variations_within_ranges_of_named_parameters(live_server, alice, browser):
+    """The Variations panel takes a range per named parameter: the eight variations draw within it and say what they
+    drew; a range with one end, or one the parameter cannot take, is refused with the reason."""
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="private")
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1400, "height": 1000}, advanced=False)
+    page.click("#ranges-panel summary")
+    page.wait_for_selector("#ranges tr[data-name=floors] input")
+    names = page.eval_on_selector_all("#ranges tbody tr", "rows => rows.map(r => r.dataset.name)")
+    assert {"floors", "floor_height", "bays", "window_width"} <= set(names)
+    page.fill("input[name=floors-from]", "5")
+    page.fill("input[name=floors-to]", "7")
+    page.click("#vary")
+    page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
+    page.fill("input[name=floor_height-from]", "80")
+    page.click("#vary")
+    page.wait_for_function("document.getElementById('vary-status').textContent !== ''")
+    assert page.text_content("#vary-status") == "floor height: give both ends of the range"
+    page.fill("input[name=floor_height-to]", "90")
+    page.click("#vary")
+    page.wait_for_function("(c => c.length === 8 && c.every(e => e.textContent.includes('floor_height')))("
+                           "[...document.querySelectorAll('#variants .card .meta')])")
+    captions = page.eval_on_selector_all("#variants .card .meta", "els => els.map(e => e.textContent)")
+    floors = [int(c.split("floors ")[1].split(",")[0]) for c in captions]
+    heights = [float(c.split("floor_height ")[1].split(",")[0]) for c in captions]
+    assert len(captions) == 8 and set(floors) <= {5, 6, 7} and len(set(floors)) > 1
+    assert all(80 <= h <= 90 for h in heights)
+    page.fill("input[name=floors-from]", "0")
+    page.click("#vary")
+    page.wait_for_function("document.getElementById('vary-status').textContent.startsWith('no variations')")
+    assert "floors: the range 0-7 leaves 1-256" in page.text_content("#vary-status")
+    assert not errors
+
 def test_nodes_are_numbered_breadth_first_and_a_click_picks_the_re_run_prefix(live_server, alice, facade_photo,
                                                                                browser):
     _, seg = facade_photo
@@ -100,8 +132,8 @@ def test_nodes_are_numbered_breadth_first_and_a_click_picks_the_re_run_prefix(li
         photo__code=seg["photo"], version=seg["version"]))
     page, _ = open_as_alice(browser, live_server, proc, {"width": 1400, "height": 1000})
     page.wait_for_selector("#tree .bfs")
-    shown = page.eval_on_selector_all("#tree li", "els => els.map(li => li.firstChild.textContent + "
-                                                  "li.childNodes[1].textContent)")
+    shown = page.eval_on_selector_all("#tree li", "els => els.map(li => li.firstChild.textContent + ' ' + "
+                                                  "li.querySelector(':scope > .node-label').textContent)")
     bfs = list(Tree.from_dict(data).root.bfs())
     assert len(shown) == len(bfs)
     by_index = {int(t.split(" ", 1)[0][1:]): t.split(" ", 2)[1] for t in shown}
@@ -228,4 +260,60 @@ def test_named_parameters_first_the_tree_in_advanced(live_server, alice, browser
     bad.fill("0")
     bad.dispatch_event("change")
     page.wait_for_function("document.getElementById('named-status').textContent.includes('floor_height')")
+    assert not errors, errors
+
+
+def test_picture_and_tree_select_each_other(live_server, alice, browser, tmp_path):
+    """A click on a window in the picture selects its node in the tree (the advanced panel opens on it) and the
+    parameters that stand for it, and outlines every copy it draws; a click on a parameter's name or on a node
+    outlines what it stands for; a click on no element clears the selection."""
+    from facaid.parameters import named_parameters
+    from facaid.relief import drawn_leaves
+
+    tree = generate(3).procedure
+    proc = Procedure.objects.create(owner=alice, data=tree.to_dict(), visibility="private")
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900}, advanced=False)
+    page.wait_for_selector("#named input[name=floors]")
+    page.wait_for_function("document.getElementById('render').complete")
+    rows, paths = drawn_leaves(tree)
+    i = next(k for k, r in enumerate(rows.tolist()) if r[0] == 2)  # the first window
+    label, x0, y0, x1, y1 = rows[i].tolist()
+    box = page.locator("#render").bounding_box()
+
+    def click_at(x, y):  # a point of the procedure, on the picture wherever it is scrolled to
+        page.locator("#render").click(position={"x": x / tree.width * box["width"],
+                                                "y": y / tree.height * box["height"]})
+
+    click_at((x0 + x1) / 2, (y0 + y1) / 2)
+    path = paths[i]
+    page.wait_for_selector(f'#tree li.selected[data-path="{path}"]')
+    assert page.evaluate("document.getElementById('advanced').open")
+    copies = sum(p == path or p.startswith(path + "/") for p in paths)
+    assert copies > 1 and page.get_attribute("#selection", "data-outlined") == str(copies)  # every copy
+    named = {p.name: p for p in named_parameters(tree)}
+    over = {n for n, p in named.items() if any(path == q or path.startswith(q + "/") for q in p.nodes)}
+    chosen = set(page.eval_on_selector_all("#named tr.selected", "rows => rows.map(r => r.dataset.name)"))
+    assert chosen == over and {"window_width", "floor_height"} <= chosen
+    assert page.text_content("#selection-info").startswith(f"Selected: window · {path} · window width")
+    path_shot = os.environ.get("FACAID_SELECTION_SCREENSHOT") or str(tmp_path / "procedure-selection.png")
+    page.locator(".cols .panel").first.screenshot(path=path_shot)
+
+    # the reverse: a parameter's name outlines every leaf of the nodes it stands for
+    page.click("#named tr[data-name=floor_height] th")
+    under = sum(any(p == q or p.startswith(q + "/") for q in named["floor_height"].nodes) for p in paths)
+    page.wait_for_function(f"document.getElementById('selection').dataset.outlined === '{under}'")
+    assert page.eval_on_selector_all("#named tr.selected", "rows => rows.map(r => r.dataset.name)") == [
+        "floor_height"]
+    # and a node of the tree outlines what it draws: the window's parent, every copy
+    parent = path.rsplit("/", 1)[0]
+    page.click(f'#tree li[data-path="{parent}"] > .node-label')
+    under = sum(p == parent or p.startswith(parent + "/") for p in paths)
+    page.wait_for_function(f"document.getElementById('selection').dataset.outlined === '{under}'")
+    assert page.get_attribute('#tree li.selected', "data-path") == parent and under > copies
+    # a click where the tree draws nothing (the sky, background) clears the selection
+    sky = next((x, y) for y in range(0, round(tree.height), 4) for x in range(0, round(tree.width), 4)
+               if not any(r[1] <= x + 0.5 < r[3] and r[2] <= y + 0.5 < r[4] for r in rows.tolist()))
+    click_at(sky[0] + 0.5, sky[1] + 0.5)
+    page.wait_for_function("document.getElementById('selection-info').textContent === ''")
+    assert not page.query_selector("#tree li.selected") and not page.query_selector("#named tr.selected")
     assert not errors, errors

@@ -13,6 +13,8 @@ from PIL import Image
 
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
+from facaid.grammar import to_segmentation
+from facaid.labels import LABELS
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
@@ -273,6 +275,14 @@ def test_named_parameters_through_the_api(facade_photo, as_alice, as_bob, alice)
     assert r.status_code == 200, r.content
     floors = {p["name"]: p for p in r.json()["parameters"]}["floors"]
     assert floors["integer"] and floors["nodes"]
+    # where each element is drawn, with its node: the rectangles of the executed tree, background left out
+    tree = Tree.from_dict(proc.data)
+    drawn = [r for r in to_segmentation(tree).rects if LABELS[r.label] != "background"]
+    leaves = r.json()["leaves"]
+    nodes = dict(tree.nodes())
+    assert len(leaves) == len(drawn) and all(leaf[5] in nodes and nodes[leaf[5]].label == leaf[0] for leaf in leaves)
+    assert sorted(tuple(leaf[1:5]) for leaf in leaves if leaf[0] != "facade") == sorted(
+        (r.x0, r.y0, r.x1, r.y1) for r in drawn if LABELS[r.label] != "facade")
     target = floors["value"] + 1
     r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": target}}, format="json")
     assert r.status_code == 200, r.content

@@ -31,8 +31,10 @@ from rest_framework.response import Response
 from facaid import interchange
 from facaid.grammar import to_segmentation
 from facaid.grammar.procedure import ProcedureError
+from facaid.labels import LABELS
 from facaid.parameters import named_parameters, set_parameters
 from facaid.rectify import rectify_file
+from facaid.relief import MAX_MESH_RECTS, drawn_leaves
 from facaid.variation import vary
 from webapp.facades import access, downloads, pictures, rendering, services, versions
 from webapp.facades.downloads import DOWNLOADS
@@ -434,11 +436,21 @@ def procedure_variations(request, code):
     return Response({"variants": [v.to_dict() for v in variants]})
 
 
+def _leaves(tree) -> list | None:
+    """Where the tree draws each leaf, for the page's picture-to-tree selection: [label, x0, y0, x1, y1, node path]
+    in whole pixels; None past `MAX_MESH_RECTS` rectangles (a real facade draws a few hundred)."""
+    rows, paths = drawn_leaves(tree)
+    if len(rows) > MAX_MESH_RECTS:
+        return None
+    return [[LABELS[r[0]], *r[1:], path] for r, path in zip(rows.tolist(), paths, strict=True)]
+
+
 @extend_schema(methods=["GET"], request=None, responses={200: dict},
-               summary="The named parameters (floors, floor height, bays, ...): {'parameters': [...]}")
+               summary="The named parameters (floors, floor height, bays, ...) and where each leaf is drawn: "
+                       "{'parameters': [...], 'leaves': [[label, x0, y0, x1, y1, node path], ...]}")
 @extend_schema(methods=["POST"], request=ParametersSerializer, responses={200: dict},
-               summary="Set named parameters: {'data', 'parameters', 'accuracy', 'metrics', 'version'}; with save, the "
-                       "result is the next version (the accuracy is that version's, measured on save)")
+               summary="Set named parameters: {'data', 'parameters', 'leaves', 'accuracy', 'metrics', 'version'}; "
+                       "with save, the result is the next version (the accuracy is that version's, measured on save)")
 @api_view(["GET", "POST"])
 @throttle_classes(HEAVY)
 @permission_classes([AllowAny])
@@ -446,7 +458,8 @@ def procedure_variations(request, code):
 def procedure_parameters(request, code):
     proc = access.get_procedure_for_user(request.user, code)
     if request.method == "GET":
-        return Response({"parameters": [p.to_dict() for p in named_parameters(parse_procedure(proc.data))]})
+        tree = parse_procedure(proc.data)
+        return Response({"parameters": [p.to_dict() for p in named_parameters(tree)], "leaves": _leaves(tree)})
     form = ParametersSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     try:
@@ -455,7 +468,7 @@ def procedure_parameters(request, code):
     except (ProcedureError, ValueError) as exc:
         raise ValidationError({"values": str(exc)}) from None
     answer = {"data": edited.to_dict(), "parameters": [p.to_dict() for p in named_parameters(edited)],
-              "accuracy": None, "metrics": None, "version": None}
+              "leaves": _leaves(edited), "accuracy": None, "metrics": None, "version": None}
     if form.validated_data["save"]:
         proc = access.get_rw_procedure_for_user(request.user, code)
         names = ", ".join(f"{k} {v:g}" for k, v in form.validated_data["values"].items())
