@@ -134,3 +134,18 @@ def test_facaid_export_writes_every_site_download(procedure, as_alice, tmp_path,
         else:
             assert read(out.read_bytes(), size=size) == read(site.content, size=size), name
     capsys.readouterr()
+
+
+def test_the_procedure_json_names_its_scale_where_one_is_known(procedure, as_alice):
+    """In pixels, and where the photo's real size (or metres_per_pixel) gives a scale, its meta names it."""
+    url = f"/api/v1/procedures/{procedure.code}/download/procedure.json"
+    assert "scale" not in json.loads(as_alice.get(url).content)["meta"]  # no real size: a storey is a guess
+    given = json.loads(as_alice.get(url + "?metres_per_pixel=0.02").content)["meta"]["scale"]
+    assert given == {"metres_per_pixel": 0.02, "from": "given"}
+    photo = procedure.photo
+    photo.real_width_m = 12.5
+    photo.save()
+    known = json.loads(as_alice.get(url).content)["meta"]["scale"]
+    assert known["metres_per_pixel"] == pytest.approx(12.5 / photo.width) and "real width, 12.5 m" in known["from"]
+    r = as_alice.get(url + "?metres_per_pixel=abc")
+    assert r.status_code == 400 and "metres_per_pixel" in r.json()

@@ -109,6 +109,15 @@ def _metric(write: Callable[[Procedure, Tree, float | None, str], bytes | str]
     return build
 
 
+def _procedure_json(proc: Procedure, tree: Tree, params: Params) -> str:
+    """The tree in pixels; where a real scale is known (the photo's real size, or ``metres_per_pixel``), its meta
+    names it, ``"scale": {"metres_per_pixel": .., "from": ..}``, so that a tool reading it can measure in metres."""
+    scale, source = _scale(proc, tree, params)
+    if scale is not None:
+        tree.meta = {**tree.meta, "scale": {"metres_per_pixel": scale, "from": source or "given"}}
+    return tree.to_json(indent=2)
+
+
 def _mesh_zip(proc: Procedure, tree: Tree, scale: float | None, source: str) -> bytes:
     obj, mtl = procedure_mesh(tree, scale, mtl_name="facade.mtl", scale_from=source)
     out = io.BytesIO()
@@ -156,8 +165,9 @@ def _annotations(fmt: str) -> Callable[[Procedure, Tree, Params], bytes]:
 
 
 DOWNLOADS: dict[str, Download] = {
-    "procedure.json": Download("the procedure: the tree with its sizes, to edit or reconstruct from",
-                               "application/json", lambda proc, tree, params: tree.to_json(indent=2)),
+    "procedure.json": Download("the procedure: the tree with its sizes in pixels, to edit or reconstruct from; its "
+                               "meta names the metres per pixel where the photo's real size (or metres_per_pixel) "
+                               "gives them", "application/json", _procedure_json),
     "segmentation.json": Download("the labelled rectangles it draws", "application/json",
                                   lambda proc, tree, params: to_segmentation(tree).to_json()),
     "segmentation.coco.json": Download("those rectangles as COCO object detection annotations", "application/json",
