@@ -360,7 +360,10 @@ document.getElementById("vary").addEventListener("click", async () => {
     img.alt = v.meta?.variation || "variant";
     const caption = document.createElement("div");
     caption.className = "meta";
-    const drawn = Object.entries(v.meta?.parameters || {}).map(([name, value]) => `${name} ${value}`).join(", ");
+    const drawn = Object.entries(v.meta?.parameters || {}).map(([name, value]) => {
+      const p = parameters.find((q) => q.name === name);
+      return `${p?.label || name} ${value}${p?.unit === "px" ? " px" : ""}`;
+    }).join(", ");
     caption.textContent = `${v.meta?.variation || "variant"} · ${Math.round(v.width)}×${Math.round(v.height)}` +
       (drawn ? ` · ${drawn}` : "");
     const use = document.createElement("button");

@@ -92,7 +92,7 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     assert errors == []
 
 
-def test_variations_within_ranges_of_named_parameters(live_server, alice, browser):
+def test_variations_within_ranges_of_named_parameters(live_server, alice, browser, tmp_path):
     """The Variations panel takes a range per named parameter: the eight variations draw within it and say what they
     drew; a range with one end, or one the parameter cannot take, is refused with the reason."""
     proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="private")
@@ -111,13 +111,15 @@ def test_variations_within_ranges_of_named_parameters(live_server, alice, browse
     assert page.text_content("#vary-status") == "floor height: give both ends of the range"
     page.fill("input[name=floor_height-to]", "90")
     page.click("#vary")
-    page.wait_for_function("(c => c.length === 8 && c.every(e => e.textContent.includes('floor_height')))("
+    page.wait_for_function("(c => c.length === 8 && c.every(e => e.textContent.includes('floor height')))("
                            "[...document.querySelectorAll('#variants .card .meta')])")
     captions = page.eval_on_selector_all("#variants .card .meta", "els => els.map(e => e.textContent)")
-    floors = [int(c.split("floors ")[1].split(",")[0]) for c in captions]
-    heights = [float(c.split("floor_height ")[1].split(",")[0]) for c in captions]
+    floors = [int(c.split("upper floors ")[1].split(",")[0]) for c in captions]
+    heights = [float(c.split("floor height ")[1].split(" px")[0]) for c in captions]
     assert len(captions) == 8 and set(floors) <= {5, 6, 7} and len(set(floors)) > 1
     assert all(80 <= h <= 90 for h in heights)
+    shot = os.environ.get("FACAID_RANGES_SCREENSHOT") or str(tmp_path / "procedure-ranges.png")
+    page.locator("#vary").locator("xpath=ancestor::div[contains(@class, 'panel')]").screenshot(path=shot)
     page.fill("input[name=floors-from]", "0")
     page.click("#vary")
     page.wait_for_function("document.getElementById('vary-status').textContent.startsWith('no variations')")
