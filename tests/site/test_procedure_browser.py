@@ -71,6 +71,10 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
 
     page.click("#vary")
     page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
+    if shot := os.environ.get("FACAID_PAGE_SCREENSHOT"):  # docs/img/procedure-page.png: the page, tree closed
+        page.click("#advanced summary")
+        page.screenshot(path=shot, full_page=True)
+        page.click("#advanced summary")
 
     # a facade width in metres sets the scale of the CGA rules and the 3D models; cleared, the default again
     cga = page.locator("a[href*='/procedure.cga']")
