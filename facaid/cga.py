@@ -140,6 +140,8 @@ def _attributes(proc: Procedure, boxes: dict, scale: float) -> tuple[list[tuple[
         if not used:
             continue
         metres = p.value * scale
+        if metres < MIN_PART_M:  # no part to size (a margin of 0): no attribute with an empty range
+            continue
         attrs.append((p.name, p.label, metres, max(MIN_PART_M, metres / 2), metres * 2))
         uses.update(dict.fromkeys(used, p.name))
     return attrs, uses

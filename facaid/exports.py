@@ -50,7 +50,7 @@ def _segmentation(fmt: str):
         from facaid.grammar.execute import to_segmentation
         from facaid.interchange import write as write_annotations
 
-        picture = path.name[: -len(export_for(path)[0])] + "-labels.png"  # its label map, named as the site names it
+        picture = path.name[: -len(export_for(path)[0])] + ".png"  # the label map `--out NAME.png` writes beside it
         return _text(path, write_annotations(to_segmentation(proc), fmt, image=picture))
     return write
 

@@ -249,6 +249,15 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
         proc.height = round(proc.height + g, 4)
 
 
+def _along(proc: Procedure, path: str, axis: str) -> Node:
+    """The node at ``path``, or its nearest ancestor whose parent lays its children out along ``axis``: the part
+    whose length along that axis is the node's."""
+    nodes = _nodes(proc)
+    while "/" in path and nodes[path.rsplit("/", 1)[0]].axis != axis:
+        path = path.rsplit("/", 1)[0]
+    return nodes[path]
+
+
 def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
     """A new procedure with one named parameter set (see the module's docstring); raises `ValueError` naming the
     problem for an unknown name, a value out of range or a parameter this procedure cannot change."""
@@ -276,8 +285,10 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         axis = AXES[name]
         targets = [nodes[path] for path in p.nodes]
         side = 0 if axis == "x" else 1
-        if name in _WINDOW:  # windows of other sizes (the ground floor's, a dormer) change by as much
-            _grow(out, axis, {id(n): value - p.value for n in targets})
+        if name in _WINDOW:  # windows of other sizes (the ground floor's, a dormer) change by as much, each
+            # through the part that holds it along the axis (a window in a column split along y: the column), so
+            # that a narrower window makes a narrower column, not a column as wide as its widest part
+            _grow(out, axis, {id(_along(out, path, axis)): value - p.value for path in p.nodes})
         else:
             _grow(out, axis, {id(n): value - inst.extent[id(n)][side] for n in targets})
     else:

@@ -91,6 +91,14 @@ function drawTree() {
 }
 
 // ---- the selection -------------------------------------------------------------------------------------------
+// A new tree (a named edit, a variation loaded): a parameter's selection follows the parameter, any other ends, as
+// the paths may name other nodes now.
+function keepSelection() {
+  const p = selectedBy === "parameter" && parameters.find((q) => q.name === selectedName);
+  if (p) selected = p.nodes;
+  else { selected = []; selectedBy = selectedName = null; }
+}
+
 function select(paths, by, name = null) {
   selected = paths;
   selectedBy = by;
@@ -129,6 +137,9 @@ function showSelection() {
 function drawOutlines(drawn) {
   const canvas = document.getElementById("selection");
   if (!canvas) return;
+  const img = document.getElementById("render");  // over the picture itself, inside its border
+  Object.assign(canvas.style, {left: `${img.offsetLeft + img.clientLeft}px`, top: `${img.offsetTop + img.clientTop}px`,
+    width: `${img.clientWidth}px`, height: `${img.clientHeight}px`});
   canvas.width = Math.max(1, Math.round(proc.width));
   canvas.height = Math.max(1, Math.round(proc.height));
   const ctx = canvas.getContext("2d");
@@ -166,7 +177,12 @@ async function askNamed(values = {}) {
   status.textContent = "";
   leaves = answer.leaves || [];
   parameters = answer.parameters;
-  if (Object.keys(values).length) { proc = answer.data; drawTree(); scheduleRender(); }
+  if (Object.keys(values).length) {
+    proc = answer.data;
+    keepSelection();
+    drawTree();
+    scheduleRender();
+  }
   drawNamed(answer.parameters);
   showSelection();
 }
@@ -369,7 +385,14 @@ document.getElementById("vary").addEventListener("click", async () => {
     const use = document.createElement("button");
     use.textContent = "Edit this one";
     use.title = "load it into the parameters: saving it then makes a new version, or a new procedure";
-    use.addEventListener("click", () => { proc = v; drawTree(); askNamed(); scheduleRender(); });
+    use.addEventListener("click", () => {
+      proc = v;
+      leaves = [];  // until the server says where the variant draws them
+      keepSelection();
+      drawTree();
+      askNamed();
+      scheduleRender();
+    });
     card.append(img, caption, use);
     if (script.dataset.user === "1") {
       const keep = document.createElement("button");

@@ -79,7 +79,7 @@ def test_every_extension_writes_its_format(tmp_path, source, proc, capsys):
         else:
             assert read_back(out, proc) == expected.get(ext, rects), ext
     coco = json.loads((tmp_path / "house.coco.json").read_text())
-    assert coco["images"][0]["file_name"] == "house-labels.png"
+    assert coco["images"][0]["file_name"] == "house.png"  # the label map written by --out house.png
 
 
 def test_the_longest_extension_wins():

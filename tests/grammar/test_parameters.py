@@ -111,6 +111,10 @@ def test_window_size_and_margin_are_named_and_set():
     assert _values(wider)["window_width"] == pytest.approx(24)
     assert _leaf_sizes(wider, 2) == [(24, 30)] and wider.width == pytest.approx(180 + 4 * 4)  # every window, wider
     assert _values(wider)["tile_width"] == pytest.approx(got["tile_width"] + 4)  # the tile holds it
+    narrower = set_parameter(proc, "window_width", 16)  # through its column (split along y): narrower too
+    assert _leaf_sizes(narrower, 2) == [(16, 30)] and narrower.width == pytest.approx(180 - 4 * 4)
+    lower = set_parameter(proc, "window_height", 30)
+    assert _leaf_sizes(lower, 2) == [(20, 25)] and lower.height == pytest.approx(180)  # the wall takes the 5 px
     taller = set_parameter(proc, "window_height", 45)
     assert _leaf_sizes(taller, 5) == [(20, 5)] and _leaf_sizes(taller, 2) == [(20, 40)]  # the sill keeps its 5 px
     assert taller.height == pytest.approx(180 + 3 * 10) and taller.width == proc.width
@@ -122,6 +126,11 @@ def test_window_size_and_margin_are_named_and_set():
     assert re.search(r"^attr window_height = ", text, flags=re.M) and re.search(r"^attr margin = ", text, flags=re.M)
 
 
+def test_a_margin_of_nothing_declares_no_cga_attribute():
+    text = procedure_cga(set_parameter(_windowed(), "margin", 0))
+    assert not re.search(r"^attr margin = ", text, flags=re.M)
+
+
 @pytest.mark.parametrize("style", STYLE_NAMES)
 def test_generated_facades_round_trip(style):
     for seed in range(3):
@@ -131,11 +140,16 @@ def test_generated_facades_round_trip(style):
         for p in named_parameters(proc):
             if p.name in ("width", "height") or p.min == p.max:
                 continue
-            target = p.value + 1 if p.integer else p.value + 10
-            out = set_parameter(proc, p.name, target)
-            assert to_segmentation(out).rects  # executes
-            if p.name != "bays":  # bays in rows of other lengths change in proportion
-                assert _values(out)[p.name] == pytest.approx(target, abs=0.05), (style, seed, p.name)
+            # every parameter grows; the window's size shrinks too (a shorter tile or floor in a row of
+            # other rows gives way to them: not checked here)
+            down = p.name in ("window_width", "window_height")
+            for target in ((p.value + 1,) if p.integer
+                           else (p.value + 10, *((p.value - min(10, p.value / 2),) if down else ()))):
+                out = set_parameter(proc, p.name, target)
+                assert to_segmentation(out).rects  # executes
+                if p.name not in ("bays", "margin"):  # bays in rows of other lengths change in proportion; a
+                    # margin where another row has none gives way to what that row holds
+                    assert _values(out)[p.name] == pytest.approx(target, abs=0.05), (style, seed, p.name, target)
 
 
 def test_bad_values_name_the_problem():

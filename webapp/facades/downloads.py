@@ -113,8 +113,9 @@ def _procedure_json(proc: Procedure, tree: Tree, params: Params) -> str:
     """The tree in pixels; where a real scale is known (the photo's real size, or ``metres_per_pixel``), its meta
     names it, ``"scale": {"metres_per_pixel": .., "from": ..}``, so that a tool reading it can measure in metres."""
     scale, source = _scale(proc, tree, params)
+    tree.meta = {k: v for k, v in tree.meta.items() if k != "scale"}  # never a scale of another download
     if scale is not None:
-        tree.meta = {**tree.meta, "scale": {"metres_per_pixel": scale, "from": source or "given"}}
+        tree.meta["scale"] = {"metres_per_pixel": scale, "from": source or "given"}
     return tree.to_json(indent=2)
 
 
