@@ -249,10 +249,9 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
         proc.height = round(proc.height + g, 4)
 
 
-def _along(proc: Procedure, path: str, axis: str) -> Node:
-    """The node at ``path``, or its nearest ancestor whose parent lays its children out along ``axis``: the part
-    whose length along that axis is the node's."""
-    nodes = _nodes(proc)
+def _along(nodes: dict[str, Node], path: str, axis: str) -> Node:
+    """The node at ``path`` (in ``nodes``, a tree's nodes by path), or its nearest ancestor whose parent lays its
+    children out along ``axis``: the part whose length along that axis is the node's."""
     while "/" in path and nodes[path.rsplit("/", 1)[0]].axis != axis:
         path = path.rsplit("/", 1)[0]
     return nodes[path]
@@ -283,14 +282,13 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
     nodes = _nodes(out)
     if name in _LENGTHS or name in _WINDOW or name == "margin":
         axis = AXES[name]
-        targets = [nodes[path] for path in p.nodes]
-        side = 0 if axis == "x" else 1
         if name in _WINDOW:  # windows of other sizes (the ground floor's, a dormer) change by as much, each
             # through the part that holds it along the axis (a window in a column split along y: the column), so
             # that a narrower window makes a narrower column, not a column as wide as its widest part
-            _grow(out, axis, {id(_along(out, path, axis)): value - p.value for path in p.nodes})
+            _grow(out, axis, {id(_along(nodes, path, axis)): value - p.value for path in p.nodes})
         else:
-            _grow(out, axis, {id(n): value - inst.extent[id(n)][side] for n in targets})
+            side = 0 if axis == "x" else 1
+            _grow(out, axis, {id(n): value - inst.extent[id(n)][side] for n in (nodes[path] for path in p.nodes)})
     else:
         role, axis = ("floor", "y") if name == "floors" else ("tile", "x")
         if name == "bays":  # every row of tiles, scaled in proportion

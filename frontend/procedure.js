@@ -146,10 +146,10 @@ function drawOutlines(drawn) {
   ctx.clearRect(0, 0, canvas.width, canvas.height);
   const line = Math.max(1, canvas.width / Math.max(1, canvas.clientWidth) * 2);  // 2 px as shown
   ctx.lineWidth = line;
+  ctx.fillStyle = "rgba(255, 230, 0, 0.35)";
+  ctx.strokeStyle = "#111";
   for (const [, x0, y0, x1, y1] of drawn) {
-    ctx.fillStyle = "rgba(255, 230, 0, 0.35)";
     ctx.fillRect(x0, y0, x1 - x0, y1 - y0);
-    ctx.strokeStyle = "#111";
     ctx.strokeRect(x0 + line / 2, y0 + line / 2, x1 - x0 - line, y1 - y0 - line);
   }
   canvas.dataset.outlined = String(drawn.length);  // for the page's tests
