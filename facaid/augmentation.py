@@ -7,7 +7,7 @@ import numpy as np
 
 from facaid.labels import FACADE
 from facaid.metrics import scaled_label_map
-from facaid.segmentation import Rect, Segmentation, flatten
+from facaid.segmentation import Rect, Segmentation, flatten, flatten_array
 
 _SCALE = 0.25
 
@@ -69,28 +69,63 @@ ANNOTATOR_SPURIOUS = 2  # boxes added over existing elements
 # calibration). The evaluation's ANNOTATOR_EDGE (1 %) is three times noisier along rows than CMP's annotators.
 CMP_EDGE_X = 0.006
 CMP_EDGE_Y = 0.003
+# Floors and bays spaced as irregularly as on the CMP dev half: the median absolute deviation of the window rows'
+# (columns') pitch from their median, as a share of it, is 0.062 (0.027) there and 0.006 (0) on generated facades;
+# `spacing_warp` with these shares of the height and width gives generated facades 0.063 (0.027)
+# (experiments/2026-12-05-annotate-rich/spacing.py).
+CMP_SPACING_X = 0.0125
+CMP_SPACING_Y = 0.025
+OUTLINE_CUT = 0.25  # a partial facade rectangle loses up to this share of the building's extent on each side
+
+
+SPACING_KNOTS = 9  # the spacing warp's offsets are drawn at this many evenly spaced places along each side
+
+
+def spacing_warp(seg: Segmentation, spacing: float, spacing_y: float, rng: np.random.Generator):
+    """Two monotone maps (x, y) -> moved, piecewise linear: offsets uniform in +-``spacing`` of the width
+    (``spacing_y`` of the height) at
+    `SPACING_KNOTS` evenly spaced places, none at the image's edges. Elements of one row (column) move together:
+    floors (bays) spaced irregularly, as buildings and rectified photos are."""
+    def axis(side: int, share: float):
+        knots = np.linspace(0.0, side, SPACING_KNOTS)
+        moved = knots + np.concatenate([[0.0], rng.uniform(-share, share, SPACING_KNOTS - 2) * side, [0.0]])
+        return lambda v: float(np.interp(v, knots, moved))
+    return axis(seg.width, spacing), axis(seg.height, spacing_y)
 
 
 def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDGE, drop: float = ANNOTATOR_DROP,
-                    spurious: int = ANNOTATOR_SPURIOUS, edge_y: float | None = None) -> Segmentation:
+                    spurious: int = ANNOTATOR_SPURIOUS, edge_y: float | None = None,
+                    spacing: float = 0.0, spacing_y: float | None = None) -> Segmentation:
     """A segmentation annotated the way people annotate (`facaid evaluate-real --perturb SEED`), seeded: each
     element's four edges moved independently by up to ``edge`` of the image's width (x) or height (y; ``edge_y``
-    when given), uniformly; ``drop`` of the elements left out (rounded, at least one when there are ten or more);
-    ``spurious`` boxes added, each over an element left in, of a class drawn among the elements and about the size
-    of the element it covers.
-    Facade (wall) rectangles keep their place: they are the building's outline, not an element. The result holds
-    the input's layers as rectangles, not flattened."""
+    when given), uniformly, after ``spacing`` (a share of the width, ``spacing_y`` of the height; 0 by default)
+    moved whole rows and columns of them (`spacing_warp`); ``drop`` of the elements left out (rounded, at least
+    one when there are ten or more); ``spurious`` boxes added, each over an element left in, of a class drawn among
+    the elements and about the size of the element it covers.
+    Facade (wall) rectangles keep their place: they are the building's outline, not an element. Where they are
+    pieces around the elements (a partition, as a generated facade's leaves are: no wall rectangle under any
+    element), the wall is taken to run under the elements, as a person draws it, so a left-out element leaves wall
+    behind and not a hole. The result holds the input's layers as rectangles, not flattened."""
     edge_y = edge if edge_y is None else edge_y
     if not (0 <= edge <= 0.5 and 0 <= edge_y <= 0.5 and 0 <= drop < 1 and spurious >= 0):
         raise ValueError(f"edges must be in [0, 0.5], drop in [0, 1), spurious >= 0; got {edge}, {edge_y}, {drop}, "
                          f"{spurious}")
+    spacing_y = spacing if spacing_y is None else spacing_y
+    if not (0 <= spacing <= 0.05 and 0 <= spacing_y <= 0.05):
+        raise ValueError(f"spacing must be in [0, 0.05] (a share of the side), got {spacing}, {spacing_y}")
     rng = np.random.default_rng([int(seed), 20421])
     walls = [r for r in seg.rects if r.label == FACADE]
     elements = [r for r in seg.rects if r.label != FACADE]
+    if walls and elements and not _under(walls, elements):
+        rows = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
+        walls = [Rect(FACADE, *map(int, r[1:])) for r in rows if r[0] == FACADE]
     n_drop = int(round(drop * len(elements)))
     keep = sorted(rng.permutation(len(elements))[n_drop:].tolist()) if elements else []
     kept = [elements[i] for i in keep]
     w, h = seg.width, seg.height
+    if spacing > 0 or spacing_y > 0:  # its own stream: the rest of the noise is drawn as without it
+        wx, wy = spacing_warp(seg, spacing, spacing_y, np.random.default_rng([int(seed), 20422]))
+        kept = [Rect(r.label, wx(r.x0), wy(r.y0), wx(r.x1), wy(r.y1)) for r in kept]
 
     def moved(r: Rect) -> Rect | None:
         d = rng.uniform(-1.0, 1.0, size=4) * (edge * w, edge_y * h, edge * w, edge_y * h)
@@ -112,6 +147,40 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
     return Segmentation(w, h, tuple(out))
 
 
-def cmp_annotation(seg: Segmentation, seed: int, *, drop: float = 0.0, spurious: int = 0) -> Segmentation:
-    """`annotator_noise` with the edge spread calibrated on CMP's annotators (`CMP_EDGE_X`, `CMP_EDGE_Y`)."""
-    return annotator_noise(seg, seed, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=drop, spurious=spurious)
+def _under(walls: list[Rect], elements: list[Rect]) -> bool:
+    """Whether some wall rectangle lies (partly) under some element."""
+    a = np.array([(r.x0, r.y0, r.x1, r.y1) for r in walls])[:, None, :]
+    b = np.array([(r.x0, r.y0, r.x1, r.y1) for r in elements])[None, :, :]
+    return bool(((np.minimum(a[..., 2], b[..., 2]) > np.maximum(a[..., 0], b[..., 0]))
+                 & (np.minimum(a[..., 3], b[..., 3]) > np.maximum(a[..., 1], b[..., 1]))).any())
+
+
+def cmp_annotation(seg: Segmentation, seed: int, *, drop: float = 0.0, spurious: int = 0,
+                   irregular: bool = False) -> Segmentation:
+    """`annotator_noise` with the edge spread calibrated on CMP's annotators (`CMP_EDGE_X`, `CMP_EDGE_Y`), and
+    with ``irregular`` its floors' and bays' spacing (`CMP_SPACING_X`, `CMP_SPACING_Y`)."""
+    spacing = (CMP_SPACING_X, CMP_SPACING_Y) if irregular else (0.0, 0.0)
+    return annotator_noise(seg, seed, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=drop, spurious=spurious,
+                           spacing=spacing[0], spacing_y=spacing[1])
+
+
+def outline(seg: Segmentation, seed: int, *, missing: bool) -> Segmentation:
+    """The segmentation with its facade (wall) rectangles left out (``missing``: the elements alone, as a person
+    who drew no wall) or cut to a part of the building (each side of their bounding box moved in by up to
+    `OUTLINE_CUT` of its extent, seeded: a wall drawn over part of it). Elements stay as they are; the wall the
+    cut leaves out is background. Layered as given (partitions' walls taken as running under the elements)."""
+    walls = [r for r in seg.rects if r.label == FACADE]
+    elements = [r for r in seg.rects if r.label != FACADE]
+    if missing or not walls:
+        return Segmentation(seg.width, seg.height, tuple(elements))
+    if elements and not _under(walls, elements):
+        rows = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
+        walls = [Rect(FACADE, *map(int, r[1:])) for r in rows if r[0] == FACADE]
+    rng = np.random.default_rng([int(seed), 20423])
+    x0, y0 = min(r.x0 for r in walls), min(r.y0 for r in walls)
+    x1, y1 = max(r.x1 for r in walls), max(r.y1 for r in walls)
+    cut = rng.uniform(0.0, OUTLINE_CUT, 4) * (x1 - x0, y1 - y0, x1 - x0, y1 - y0)
+    bx0, by0, bx1, by1 = round(x0 + cut[0]), round(y0 + cut[1]), round(x1 - cut[2]), round(y1 - cut[3])
+    kept = [Rect(FACADE, max(r.x0, bx0), max(r.y0, by0), min(r.x1, bx1), min(r.y1, by1)) for r in walls]
+    kept = [r for r in kept if r.x0 < r.x1 and r.y0 < r.y1]
+    return Segmentation(seg.width, seg.height, tuple(kept + elements))

@@ -41,6 +41,10 @@ class TrainConfig:
     noise_sigma: float = 0.006  # the jitter's standard deviation is uniform in [0, this] x the long side
     annotate: float = 0.0  # share of examples whose input is annotated as people annotate: edges moved as on CMP,
     # some elements left out, spurious boxes added (`facaid.training.samples.make_example`); the target stays clean
+    partial: float = 0.0  # share of examples whose input keeps only part of its elements (10-80 % left out): the
+    # facade a person has begun to draw, conditioning the model to continue it; the target is the whole procedure
+    irregular: float = 0.0  # share of examples whose floors and bays are spaced as irregularly as on CMP
+    outline: float = 0.0  # share of examples whose facade rectangle is missing or covers part of the building
     init: str = ""  # a checkpoint directory whose weights start the run (fine-tuning); fresh optimizer and schedule
     count_lr_scale: float = 1.0  # the peer counts' embeddings learn at this multiple of the learning rate (a
     # model widened for them starts them at zero while the rest is trained already)
@@ -69,7 +73,7 @@ class TrainConfig:
             value = getattr(self, name)
             if not nonnegative(value):
                 raise ValueError(f"{name} must be a finite number >= 0 (0 freezes those parameters), got {value!r}")
-        for name in ("noise", "annotate"):
+        for name in ("noise", "annotate", "partial", "irregular", "outline"):
             value = getattr(self, name)
             if not (nonnegative(value) and value <= 1):
                 raise ValueError(f"{name} must be a share between 0 and 1, got {value!r}")

@@ -18,7 +18,7 @@ from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs,
 from facaid.tokenizer import Tokenizer
 from facaid.training.config import load_config
 from facaid.training.objective import lr_at, structure_weighted_loss, validation_loss
-from facaid.training.samples import PooledBatches, SampleStream
+from facaid.training.samples import INPUTS, PooledBatches, SampleStream
 from facaid.training.surgery import ENCODER_STEMS, initial_model
 
 
@@ -105,7 +105,8 @@ def train(config_path: str | Path, out: str | None = None, resume: bool = False,
     # clean inputs, in this process (a second or two): the loss stays comparable across runs
     val = SampleStream(tokenizer, cfg.val_seed).take(cfg.val_count)
     stream = SampleStream(tokenizer, cfg.seed, start=state["sample_index"], workers=cfg.workers,
-                          noise=(cfg.noise, cfg.noise_sigma), styles=cfg.styles, annotate=cfg.annotate)
+                          noise=(cfg.noise, cfg.noise_sigma), styles=cfg.styles,
+                          **{name: getattr(cfg, name) for name in INPUTS})
     stream.skipped = state["skipped"]
     batches = PooledBatches(stream, cfg.batch_size, cfg.pool_batches, cfg.seed, state["batches"])
     stop = min(cfg.steps, until) if until is not None else cfg.steps

@@ -15,17 +15,20 @@ import numpy as np
 import torch
 
 from facaid.augmentation import ANNOTATOR_DROP, ANNOTATOR_SPURIOUS, cmp_annotation, jitter
+from facaid.augmentation import outline as drawn_outline
 from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
 _worker: dict = {}
+PARTIAL_DROP = (0.1, 0.8)  # a partial input leaves out a share of its elements drawn uniformly from this range
+INPUTS = ("annotate", "partial", "irregular", "outline")  # the shares of inputs made as people draw (`make_example`)
 
 
 def _init_worker(tok_config: dict, noise: tuple[float, float], styles: tuple[float, ...] | None,
-                 annotate: float) -> None:
+                 inputs: dict[str, float]) -> None:
     torch.set_num_threads(1)
-    _worker.update(tokenizer=Tokenizer(TokenizerConfig(**tok_config)), noise=noise, styles=styles, annotate=annotate)
+    _worker.update(tokenizer=Tokenizer(TokenizerConfig(**tok_config)), noise=noise, styles=styles, inputs=inputs)
 
 
 def sample_style(seed: int, index: int, styles: tuple[float, ...] | None) -> str | None:
@@ -37,13 +40,20 @@ def sample_style(seed: int, index: int, styles: tuple[float, ...] | None) -> str
 
 
 def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float, float] = (0.0, 0.0),
-                 styles: tuple[float, ...] | None = None, annotate: float = 0.0):
+                 styles: tuple[float, ...] | None = None, annotate: float = 0.0, partial: float = 0.0,
+                 irregular: float = 0.0, outline: float = 0.0):
     """The training example of sample ``index`` of dataset ``seed``: (rows, (ids, local, boxes)), or None when
-    the facade is too long for the model. ``noise`` = (share, sigma): that share of the inputs get their edges
-    jittered (`facaid.augmentation.jitter`, sigma uniform in [0, sigma]), seeded by the sample. ``annotate``: that
-    share of the inputs are annotated as people annotate (`cmp_annotation`: the edge spread calibrated on CMP,
-    up to `ANNOTATOR_DROP` of the elements left out and up to `ANNOTATOR_SPURIOUS` boxes added); the target stays
-    the clean procedure either way. ``styles``: weights of the generator styles (`sample_style`)."""
+    the facade is too long for the model. The target is always the clean procedure; the input is changed, each
+    change drawn for a share of the inputs, seeded by the sample, in this order:
+    ``noise`` = (share, sigma): edges jittered (`facaid.augmentation.jitter`, sigma uniform in [0, sigma]).
+    ``annotate``: annotated as people annotate (`cmp_annotation`: the edge spread calibrated on CMP, up to
+    `ANNOTATOR_DROP` of the elements left out and up to `ANNOTATOR_SPURIOUS` boxes added).
+    ``partial``: only part of the elements kept (a share uniform in `PARTIAL_DROP` left out, the rest's edges moved
+    as on CMP): the facade a person has begun to draw.
+    ``irregular``: floors and bays spaced as irregularly as on CMP (`cmp_annotation` with ``irregular``).
+    ``outline``: the facade rectangle missing (half of those) or covering part of the building
+    (`facaid.augmentation.outline`).
+    ``styles``: weights of the generator styles (`sample_style`)."""
     s = generate(sample_seed(seed, index), sample_style(seed, index, styles))
     c = tokenizer.config
     target = tokenizer.encode_target(s.procedure)
@@ -60,16 +70,28 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
         if rng.random() < annotate:
             drop, spurious = rng.uniform(0.0, ANNOTATOR_DROP), int(rng.integers(ANNOTATOR_SPURIOUS + 1))
             seg = cmp_annotation(seg, int(rng.integers(2**31)), drop=drop, spurious=spurious)
+    if partial > 0:
+        rng = np.random.default_rng([seed, index, 3])
+        if rng.random() < partial:
+            seg = cmp_annotation(seg, int(rng.integers(2**31)), drop=rng.uniform(*PARTIAL_DROP))
+    if irregular > 0:
+        rng = np.random.default_rng([seed, index, 4])
+        if rng.random() < irregular:
+            seg = cmp_annotation(seg, int(rng.integers(2**31)), irregular=True)
+    if outline > 0:
+        rng = np.random.default_rng([seed, index, 5])
+        if rng.random() < outline:
+            seg = drawn_outline(seg, int(rng.integers(2**31)), missing=bool(rng.random() < 0.5))
     try:
         rows = tokenizer.encode_segmentation(seg)
-    except ValueError:  # too many rectangles
+    except ValueError:  # too many rectangles, or nothing the model reads
         return None
     return rows, target
 
 
 def _worker_example(args: tuple[int, int]):
     return make_example(_worker["tokenizer"], *args, noise=_worker["noise"], styles=_worker["styles"],
-                        annotate=_worker["annotate"])
+                        **_worker["inputs"])
 
 
 class SampleStream:
@@ -80,9 +102,12 @@ class SampleStream:
 
     def __init__(self, tokenizer: Tokenizer, seed: int, start: int = 0, workers: int = 0,
                  noise: tuple[float, float] = (0.0, 0.0), styles: tuple[float, ...] | None = None,
-                 annotate: float = 0.0):
+                 **inputs: float):
+        unknown = set(inputs) - set(INPUTS)
+        if unknown:
+            raise TypeError(f"unknown input share(s): {', '.join(sorted(unknown))}")
         self.tokenizer = tokenizer
-        self.annotate = annotate
+        self.inputs = inputs
         self.styles = styles
         self.seed = seed
         self.index = start
@@ -93,10 +118,10 @@ class SampleStream:
         if workers > 0:
             ctx = multiprocessing.get_context("spawn")  # no fork after CUDA or torch threads have started
             self.pool = ctx.Pool(workers, initializer=_init_worker,
-                                 initargs=(tokenizer.config.to_dict(), noise, styles, annotate))
+                                 initargs=(tokenizer.config.to_dict(), noise, styles, inputs))
 
     def example(self, index: int):
-        return make_example(self.tokenizer, self.seed, index, self.noise, self.styles, self.annotate)
+        return make_example(self.tokenizer, self.seed, index, self.noise, self.styles, **self.inputs)
 
     def __next__(self):
         while True:

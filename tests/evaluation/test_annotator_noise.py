@@ -55,6 +55,59 @@ def test_the_noise_keeps_a_valid_segmentation_and_refuses_bad_settings():
     assert all(abs(a.y0 - b.y0) <= 0.02 * grid.height + 0.5 for a, b in pairs)
 
 
+def test_elements_left_out_of_a_partition_leave_wall_not_a_hole():
+    """A generated facade's segmentation is its leaves (wall pieces around the elements): an element left out
+    leaves the wall a person would have drawn under it, and the building's outline does not change."""
+    import numpy as np
+
+    from facaid.segmentation import flatten, rasterize
+
+    seg = generate(4).segmentation
+    clean = rasterize(flatten(seg))
+    partial = annotator_noise(seg, 5, edge=0.0, drop=0.5, spurious=0)
+    elements = [r for r in partial.rects if r.label != FACADE]
+    assert len(elements) < 0.6 * sum(r.label != FACADE for r in seg.rects)
+    given = rasterize(flatten(partial))
+    assert np.array_equal(given == 0, clean == 0)  # no holes: the footprint is the clean one
+    assert ((given == FACADE) & (clean > FACADE)).any()  # the left-out elements are wall
+
+
+def test_irregular_spacing_moves_rows_and_columns_together_within_its_share():
+    """``spacing``: a monotone warp per axis; windows of one row keep one top edge, no edge moves by more than the
+    share of its side (+ rounding), the rest of the noise is drawn as without it; shares above 0.05 are refused."""
+    grid = _grid()
+    moved = annotator_noise(grid, 3, edge=0.0, drop=0.0, spurious=0, spacing=0.02, spacing_y=0.03)
+    windows = [r for r in moved.rects if r.label != FACADE]
+    assert len({r.y0 for r in windows[:6]}) == 1 and len({r.x0 for r in windows[::6]}) == 1  # a row, a column
+    pairs = list(zip(grid.rects[1:], windows, strict=True))
+    assert all(abs(a.x0 - b.x0) <= 0.02 * 600 + 0.5 and abs(a.y1 - b.y1) <= 0.03 * 500 + 0.5 for a, b in pairs)
+    assert any(a.y0 != b.y0 for a, b in pairs) and any(a.x0 != b.x0 for a, b in pairs)
+    assert len({b.y0 - a.y0 for a, b in pairs}) > 1  # floors moved by different amounts: irregular spacing
+    assert annotator_noise(grid, 3, spacing=0.0) == annotator_noise(grid, 3)
+    with pytest.raises(ValueError, match="spacing must be in"):
+        annotator_noise(grid, 3, spacing=0.1)
+
+
+def test_a_drawn_outline_is_missing_or_cut_and_keeps_the_elements():
+    import numpy as np
+
+    from facaid.augmentation import outline
+    from facaid.segmentation import flatten, rasterize
+
+    seg = generate(4).segmentation
+    clean = rasterize(flatten(seg))
+    elements = [r for r in seg.rects if r.label != FACADE]
+    missing = outline(seg, 1, missing=True)
+    assert list(missing.rects) == elements
+    cut = outline(seg, 1, missing=False)
+    assert cut == outline(seg, 1, missing=False) and cut != outline(seg, 2, missing=False)
+    assert [r for r in cut.rects if r.label != FACADE] == elements
+    given = rasterize(flatten(cut))
+    walls = (given == FACADE).sum()
+    assert 0 < walls < (clean == FACADE).sum() + (clean > FACADE).sum()  # part of the building's wall
+    assert np.array_equal(given[clean > FACADE], clean[clean > FACADE])  # every element where it was
+
+
 def test_evaluate_real_reports_compression_source_and_the_gain_over_a_perturbed_input(tmp_path):
     from facaid.evaluation.real import evaluate_real, format_summary
     from facaid.pipeline import default_model

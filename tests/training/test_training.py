@@ -91,8 +91,9 @@ def test_sample_processes_give_the_same_examples_in_the_same_order():
     from facaid.training.samples import SampleStream
 
     tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=160))  # short: some facades are skipped
-    one = SampleStream(tok, seed=5, noise=(0.5, 0.006), annotate=0.5)
-    many = SampleStream(tok, seed=5, workers=2, noise=(0.5, 0.006), annotate=0.5)
+    shares = {"annotate": 0.5, "partial": 0.3, "irregular": 0.3, "outline": 0.3}
+    one = SampleStream(tok, seed=5, noise=(0.5, 0.006), **shares)
+    many = SampleStream(tok, seed=5, workers=2, noise=(0.5, 0.006), **shares)
     try:
         for n in (7, 13):
             a, b = one.take(n), many.take(n)
@@ -138,7 +139,47 @@ def test_inputs_annotated_as_people_do_keep_the_clean_target():
     assert changed >= 4
 
 
-@pytest.mark.parametrize("field", ["noise", "annotate"])
+def test_partial_inputs_keep_part_of_the_elements_and_the_whole_target():
+    """``partial``: the input keeps fewer elements than the clean facade (10-80 % left out), seeded by the sample;
+    the target is still the whole clean procedure."""
+    from facaid.training.samples import make_example
+
+    tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=768))
+    fewer = 0
+    for index in range(6):
+        clean = make_example(tok, 4, index)
+        if clean is None:
+            continue
+        partial = make_example(tok, 4, index, partial=1.0)
+        assert repr(partial) == repr(make_example(tok, 4, index, partial=1.0))
+        assert repr(partial[1]) == repr(clean[1])
+        fewer += (partial[0][:, 0] == 2).sum() < (clean[0][:, 0] == 2).sum()  # fewer window rows
+        assert repr(make_example(tok, 4, index, partial=0.0)) == repr(clean)
+    assert fewer >= 4
+
+
+def test_irregular_spacing_and_drawn_outlines_change_the_input_not_the_target():
+    """``irregular`` moves whole floors and bays (the input changes, the target does not); ``outline`` leaves the
+    facade rectangle out or cuts it (fewer wall pixels); both seeded by the sample; an unknown share is refused."""
+    from facaid.training.samples import SampleStream, make_example
+
+    tok = Tokenizer(TokenizerConfig(max_rects=1000, max_out=768))
+    changed = {"irregular": 0, "outline": 0}
+    for index in range(6):
+        clean = make_example(tok, 4, index)
+        if clean is None:
+            continue
+        for name in changed:
+            ex = make_example(tok, 4, index, **{name: 1.0})
+            assert repr(ex) == repr(make_example(tok, 4, index, **{name: 1.0}))
+            assert repr(ex[1]) == repr(clean[1])
+            changed[name] += repr(ex[0]) != repr(clean[0])
+    assert min(changed.values()) >= 4
+    with pytest.raises(TypeError, match="unknown input share"):
+        SampleStream(tok, seed=1, drawn=0.5)
+
+
+@pytest.mark.parametrize("field", ["noise", "annotate", "partial", "irregular", "outline"])
 def test_shares_of_noisy_inputs_must_be_shares(field):
     from facaid.training.config import TrainConfig
 
