@@ -79,6 +79,8 @@ OUTLINE_CUT = 0.25  # a partial facade rectangle loses up to this share of the b
 
 
 SPACING_KNOTS = 9  # the spacing warp's offsets are drawn at this many evenly spaced places along each side
+MAX_SPACING = 0.05  # the most a spacing share may be: below half the knots' spacing, so the warp stays monotone
+assert MAX_SPACING < 0.5 / (SPACING_KNOTS - 1)
 
 
 def spacing_warp(seg: Segmentation, spacing: float, spacing_y: float, rng: np.random.Generator):
@@ -99,10 +101,11 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
     """A segmentation annotated the way people annotate (`facaid evaluate-real --perturb SEED`), seeded: each
     element's four edges moved independently by up to ``edge`` of the image's width (x) or height (y; ``edge_y``
     when given), uniformly, after ``spacing`` (a share of the width, ``spacing_y`` of the height; 0 by default)
-    moved whole rows and columns of them (`spacing_warp`); ``drop`` of the elements left out (rounded, at least
-    one when there are ten or more); ``spurious`` boxes added, each over an element left in, of a class drawn among
+    moved whole rows and columns of them (`spacing_warp`); ``drop`` of the elements left out (rounded: one of ten
+    at the default); ``spurious`` boxes added, each over an element left in, of a class drawn among
     the elements and about the size of the element it covers.
-    Facade (wall) rectangles keep their place: they are the building's outline, not an element. Where they are
+    Facade (wall) rectangles keep their place but for the spacing warp (which moves them with the elements, so
+    that the building stays one): they are the building's outline, not an element. Where they are
     pieces around the elements (a partition, as a generated facade's leaves are: no wall rectangle under any
     element), the wall is taken to run under the elements, as a person draws it, so a left-out element leaves wall
     behind and not a hole. The result holds the input's layers as rectangles, not flattened."""
@@ -111,12 +114,12 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
         raise ValueError(f"edges must be in [0, 0.5], drop in [0, 1), spurious >= 0; got {edge}, {edge_y}, {drop}, "
                          f"{spurious}")
     spacing_y = spacing if spacing_y is None else spacing_y
-    if not (0 <= spacing <= 0.05 and 0 <= spacing_y <= 0.05):
-        raise ValueError(f"spacing must be in [0, 0.05] (a share of the side), got {spacing}, {spacing_y}")
+    if not (0 <= spacing <= MAX_SPACING and 0 <= spacing_y <= MAX_SPACING):
+        raise ValueError(f"spacing must be in [0, {MAX_SPACING}] (a share of the side), got {spacing}, {spacing_y}")
     rng = np.random.default_rng([int(seed), 20421])
     walls = [r for r in seg.rects if r.label == FACADE]
     elements = [r for r in seg.rects if r.label != FACADE]
-    if walls and elements and not _under(walls, elements):
+    if walls and elements and not _under(walls, elements):  # a partition (no input built otherwise has none)
         rows = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
         walls = [Rect(FACADE, *map(int, r[1:])) for r in rows if r[0] == FACADE]
     n_drop = int(round(drop * len(elements)))
@@ -126,6 +129,8 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
     if spacing > 0 or spacing_y > 0:  # its own stream: the rest of the noise is drawn as without it
         wx, wy = spacing_warp(seg, spacing, spacing_y, np.random.default_rng([int(seed), 20422]))
         kept = [Rect(r.label, wx(r.x0), wy(r.y0), wx(r.x1), wy(r.y1)) for r in kept]
+        walls = [Rect(FACADE, round(wx(r.x0)), round(wy(r.y0)), round(wx(r.x1)), round(wy(r.y1))) for r in walls]
+        walls = [r for r in walls if r.x0 < r.x1 and r.y0 < r.y1]
 
     def moved(r: Rect) -> Rect | None:
         d = rng.uniform(-1.0, 1.0, size=4) * (edge * w, edge_y * h, edge * w, edge_y * h)
@@ -155,13 +160,9 @@ def _under(walls: list[Rect], elements: list[Rect]) -> bool:
                  & (np.minimum(a[..., 3], b[..., 3]) > np.maximum(a[..., 1], b[..., 1]))).any())
 
 
-def cmp_annotation(seg: Segmentation, seed: int, *, drop: float = 0.0, spurious: int = 0,
-                   irregular: bool = False) -> Segmentation:
-    """`annotator_noise` with the edge spread calibrated on CMP's annotators (`CMP_EDGE_X`, `CMP_EDGE_Y`), and
-    with ``irregular`` its floors' and bays' spacing (`CMP_SPACING_X`, `CMP_SPACING_Y`)."""
-    spacing = (CMP_SPACING_X, CMP_SPACING_Y) if irregular else (0.0, 0.0)
-    return annotator_noise(seg, seed, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=drop, spurious=spurious,
-                           spacing=spacing[0], spacing_y=spacing[1])
+def cmp_annotation(seg: Segmentation, seed: int, *, drop: float = 0.0, spurious: int = 0) -> Segmentation:
+    """`annotator_noise` with the edge spread calibrated on CMP's annotators (`CMP_EDGE_X`, `CMP_EDGE_Y`)."""
+    return annotator_noise(seg, seed, edge=CMP_EDGE_X, edge_y=CMP_EDGE_Y, drop=drop, spurious=spurious)
 
 
 def outline(seg: Segmentation, seed: int, *, missing: bool) -> Segmentation:

@@ -14,10 +14,19 @@ import random
 import numpy as np
 import torch
 
-from facaid.augmentation import ANNOTATOR_DROP, ANNOTATOR_SPURIOUS, cmp_annotation, jitter
+from facaid.augmentation import (
+    ANNOTATOR_DROP,
+    ANNOTATOR_SPURIOUS,
+    CMP_SPACING_X,
+    CMP_SPACING_Y,
+    annotator_noise,
+    cmp_annotation,
+    jitter,
+)
 from facaid.augmentation import outline as drawn_outline
 from facaid.generator import TRAINING_STYLES, generate
 from facaid.generator.dataset import sample_seed
+from facaid.labels import FACADE
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
 _worker: dict = {}
@@ -50,7 +59,8 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
     `ANNOTATOR_DROP` of the elements left out and up to `ANNOTATOR_SPURIOUS` boxes added).
     ``partial``: only part of the elements kept (a share uniform in `PARTIAL_DROP` left out, the rest's edges moved
     as on CMP): the facade a person has begun to draw.
-    ``irregular``: floors and bays spaced as irregularly as on CMP (`cmp_annotation` with ``irregular``).
+    ``irregular``: floors and bays spaced as irregularly as on CMP (`annotator_noise`'s spacing warp alone, with
+    `CMP_SPACING_X`, `CMP_SPACING_Y`).
     ``outline``: the facade rectangle missing (half of those) or covering part of the building
     (`facaid.augmentation.outline`).
     ``styles``: weights of the generator styles (`sample_style`)."""
@@ -77,14 +87,17 @@ def make_example(tokenizer: Tokenizer, seed: int, index: int, noise: tuple[float
     if irregular > 0:
         rng = np.random.default_rng([seed, index, 4])
         if rng.random() < irregular:
-            seg = cmp_annotation(seg, int(rng.integers(2**31)), irregular=True)
+            seg = annotator_noise(seg, int(rng.integers(2**31)), edge=0.0, drop=0.0, spurious=0,
+                                  spacing=CMP_SPACING_X, spacing_y=CMP_SPACING_Y)
     if outline > 0:
         rng = np.random.default_rng([seed, index, 5])
         if rng.random() < outline:
             seg = drawn_outline(seg, int(rng.integers(2**31)), missing=bool(rng.random() < 0.5))
+    if not any(r.label != FACADE for r in seg.rects):  # every element left out: nothing to continue
+        return None
     try:
         rows = tokenizer.encode_segmentation(seg)
-    except ValueError:  # too many rectangles, or nothing the model reads
+    except ValueError:  # too many rectangles
         return None
     return rows, target
 
