@@ -76,8 +76,6 @@ CMP_EDGE_Y = 0.003
 CMP_SPACING_X = 0.0125
 CMP_SPACING_Y = 0.025
 OUTLINE_CUT = 0.25  # a partial facade rectangle loses up to this share of the building's extent on each side
-
-
 SPACING_KNOTS = 9  # the spacing warp's offsets are drawn at this many evenly spaced places along each side
 MAX_SPACING = 0.05  # the most a spacing share may be: below half the knots' spacing, so the warp stays monotone
 assert MAX_SPACING < 0.5 / (SPACING_KNOTS - 1)
@@ -85,9 +83,8 @@ assert MAX_SPACING < 0.5 / (SPACING_KNOTS - 1)
 
 def spacing_warp(seg: Segmentation, spacing: float, spacing_y: float, rng: np.random.Generator):
     """Two monotone maps (x, y) -> moved, piecewise linear: offsets uniform in +-``spacing`` of the width
-    (``spacing_y`` of the height) at
-    `SPACING_KNOTS` evenly spaced places, none at the image's edges. Elements of one row (column) move together:
-    floors (bays) spaced irregularly, as buildings and rectified photos are."""
+    (``spacing_y`` of the height) at `SPACING_KNOTS` evenly spaced places, none at the image's edges. Elements of
+    one row (column) move together: floors (bays) spaced irregularly, as buildings and rectified photos are."""
     def axis(side: int, share: float):
         knots = np.linspace(0.0, side, SPACING_KNOTS)
         moved = knots + np.concatenate([[0.0], rng.uniform(-share, share, SPACING_KNOTS - 2) * side, [0.0]])
@@ -119,9 +116,7 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
     rng = np.random.default_rng([int(seed), 20421])
     walls = [r for r in seg.rects if r.label == FACADE]
     elements = [r for r in seg.rects if r.label != FACADE]
-    if walls and elements and not _under(walls, elements):  # a partition (no input built otherwise has none)
-        rows = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
-        walls = [Rect(FACADE, *map(int, r[1:])) for r in rows if r[0] == FACADE]
+    walls = _building_walls(seg, walls, elements)
     n_drop = int(round(drop * len(elements)))
     keep = sorted(rng.permutation(len(elements))[n_drop:].tolist()) if elements else []
     kept = [elements[i] for i in keep]
@@ -152,6 +147,16 @@ def annotator_noise(seg: Segmentation, seed: int, *, edge: float = ANNOTATOR_EDG
     return Segmentation(w, h, tuple(out))
 
 
+def _building_walls(seg: Segmentation, walls: list[Rect], elements: list[Rect]) -> list[Rect]:
+    """The wall rectangles as a person draws them: ``walls`` as given where some lies under an element (layered, as
+    CMP's facade rectangle), else (a partition, as a generated facade's leaves: wall pieces around the elements,
+    and no input built otherwise has none) the building's footprint, running under the elements too."""
+    if not walls or not elements or _under(walls, elements):
+        return walls
+    rows = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
+    return [Rect(FACADE, *map(int, r[1:])) for r in rows if r[0] == FACADE]
+
+
 def _under(walls: list[Rect], elements: list[Rect]) -> bool:
     """Whether some wall rectangle lies (partly) under some element."""
     a = np.array([(r.x0, r.y0, r.x1, r.y1) for r in walls])[:, None, :]
@@ -174,9 +179,7 @@ def outline(seg: Segmentation, seed: int, *, missing: bool) -> Segmentation:
     elements = [r for r in seg.rects if r.label != FACADE]
     if missing or not walls:
         return Segmentation(seg.width, seg.height, tuple(elements))
-    if elements and not _under(walls, elements):
-        rows = flatten_array(seg.width, seg.height, seg.to_array(), wall="footprint")
-        walls = [Rect(FACADE, *map(int, r[1:])) for r in rows if r[0] == FACADE]
+    walls = _building_walls(seg, walls, elements)
     rng = np.random.default_rng([int(seed), 20423])
     x0, y0 = min(r.x0 for r in walls), min(r.y0 for r in walls)
     x1, y1 = max(r.x1 for r in walls), max(r.y1 for r in walls)
