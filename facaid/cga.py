@@ -26,7 +26,7 @@ import math
 from statistics import median_high
 
 from facaid.grammar.execute import execute_with_boxes, leaf_array
-from facaid.grammar.layout import expand, layout, repeat_count
+from facaid.grammar.layout import expand_over, layout, repeat_count
 from facaid.grammar.procedure import Node, Procedure
 from facaid.labels import LABEL_ID, hex_colour
 
@@ -153,22 +153,30 @@ class _Writer:
         _, self.boxes = execute_with_boxes(proc)
         self.attrs, self.uses = _attributes(proc, self.boxes, scale)
         self.index = {id(node): k for k, (_, node) in enumerate(proc.nodes())}
-        self.rules: dict[tuple[int, bool, bool], str] = {}  # (node, flipped x, flipped y) -> its rule's name
+        self.rules: dict[tuple, str] = {}  # (node, flipped x, flipped y, exceptions reaching in) -> its rule's name
+        self.variants: dict[str, int] = {}  # a rule's name -> how many variants of it there are
+        self.dispatchers: set[str] = set()
         self.lines: list[str] = []
 
     def metres(self, pixels: float) -> str:
         return _number(pixels * self.scale, 4)
 
-    def rule(self, node: Node, flips: tuple[bool, bool]) -> str:
+    def rule(self, node: Node, flips: tuple[bool, bool], pending: list | None = None) -> str:
         """The name of the rule that draws ``node`` laid out with these flips (the executor's: from the far end of
-        x, of y), writing it and the rules it calls first."""
+        x, of y) and with ``pending``, the exceptions of repeats above that reach into this instance
+        (`layout.expand_over`; such an instance gets a variant rule, ``…_v1``, ...), writing it and the rules it
+        calls first."""
         if node.is_leaf:
             return LEAF_RULES[node.label]
-        key = (id(node), *flips)
+        variant = tuple((steps, id(o)) for steps, o, _ in pending) if pending else ()
+        key = (id(node), *flips, variant)
         if key in self.rules:
             return self.rules[key]
         name = f"{_camel(node.role or node.rule)}{self.index[id(node)]}"
         name += ("_mx" if flips[0] else "") + ("_my" if flips[1] else "")
+        if variant:
+            self.variants[name] = self.variants.get(name, 0) + 1
+            name += f"_v{self.variants[name]}"
         self.rules[key] = name
         slot = len(self.lines)  # a parent's rule comes before its children's
         self.lines.append("")
@@ -178,25 +186,27 @@ class _Writer:
         # CGA lays children out from the scope's origin: the left, and the bottom, where the procedure starts at the
         # top; a flip lays them out from the other end
         backwards = (flips[0] if along_x else not flips[1])
-        if node.rule == "repeat":
-            body = self.repeat(node, length, flips, backwards)
+        over = expand_over(node, length, pending)
+        if node.rule == "repeat" and not any(over[4] or ()):  # copies that differ in size: written out one by one
+            body = self.repeat(node, length, flips, backwards, over, name)
         else:
-            body = self.split(node, length, flips, backwards)
+            body = self.split(node, length, flips, backwards, over)
         self.lines[slot] = f"{name} -->\n\tsplit({node.axis}) {body}\n"
         return name
 
-    def split(self, node: Node, length: float, flips: tuple[bool, bool], backwards: bool) -> str:
-        sizes, children, reflected = expand(node, length)
+    def split(self, node: Node, length: float, flips: tuple[bool, bool], backwards: bool, over: tuple) -> str:
+        sizes, children, reflected, below, sources = over
         lengths = layout(sizes, length)
         items = []
         kept = _kept(sizes, lengths, MIN_PART_M / self.scale)
-        for size, child, mirrored, part in zip(sizes, children, reflected, kept, strict=True):
+        for i, (size, child, mirrored, part) in enumerate(zip(sizes, children, reflected, kept, strict=True)):
             if part is None:  # under a centimetre: its neighbour has its length
                 continue
             child_flips = flips
             if mirrored:
                 child_flips = (not flips[0], flips[1]) if node.axis == "x" else (flips[0], not flips[1])
-            if id(child) in self.uses and size.mode != "rel":
+            own_size = sources is None or sources[i] is None
+            if id(child) in self.uses and size.mode != "rel" and own_size:
                 text = ("~" if size.mode == "flt" else "") + self.uses[id(child)]
             elif size.mode == "abs":
                 text = self.metres(part)
@@ -204,24 +214,26 @@ class _Writer:
                 text = "'" + _number(part / length if length > 0 else 0.0, 6)
             else:
                 text = "~" + self.metres(part)
-            items.append(f"{text} : {self.rule(child, child_flips)}")
+            items.append(f"{text} : {self.rule(child, child_flips, below[i] if below else None)}")
         if backwards:
             items.reverse()
         return "{ " + " | ".join(items) + " }"
 
-    def repeat(self, node: Node, length: float, flips: tuple[bool, bool], backwards: bool) -> str:
+    def repeat(self, node: Node, length: float, flips: tuple[bool, bool], backwards: bool, over: tuple,
+               name: str) -> str:
         n = repeat_count(node, length)
         k = len(node.children)
-        sizes, children, _ = expand(node, length)
+        sizes, children, _, below, _ = over
         lengths = layout(sizes, length)
         floats = any(s.mode == "flt" for s in node.sizes)
         pattern = []
-        for size, child, part in zip(node.sizes, node.children, lengths[:k], strict=True):
+        for j, (size, child, part) in enumerate(zip(node.sizes, node.children, lengths[:k], strict=True)):
             fixed = floats and size.mode != "flt"
             value = self.uses.get(id(child)) or self.metres(part)
-            pattern.append(f"{'' if fixed else '~'}{value} : {self.rule(child, flips)}")
-        tail = [f"{self.metres(part)} : {self.rule(child, flips)}"
-                for child, part in zip(children[k * n:], lengths[k * n:], strict=True)]
+            item = self.dispatch(node, j, n, children, below, flips, backwards, f"{name}_item{j}")
+            pattern.append(f"{'' if fixed else '~'}{value} : {item}")
+        tail = [f"{self.metres(part)} : {self.rule(child, flips, below[k * n + j] if below else None)}"
+                for j, (child, part) in enumerate(zip(children[k * n:], lengths[k * n:], strict=True))]
         if backwards:
             pattern.reverse()
             tail.reverse()
@@ -230,6 +242,28 @@ class _Writer:
             return group
         items = [*tail, group] if backwards else [group, *tail]
         return "{ " + " | ".join(items) + " }"
+
+    def dispatch(self, node: Node, j: int, n: int, children: list, below: list | None, flips: tuple[bool, bool],
+                 backwards: bool, name: str) -> str:
+        """The rule of pattern item ``j`` of a repeat: the item's own, or, where exceptions change some copies,
+        a rule that picks each copy's variant by ``split.index`` (counted from the far end when the split is
+        written backwards: CGA's y goes up) and the item's own rule for the others."""
+        k = len(node.children)
+        typical = self.rule(node.children[j], flips)
+        cases = []
+        for c in range(n):
+            i = c * k + j
+            deeper = below[i] if below else None
+            if children[i] is node.children[j] and deeper is None:
+                continue
+            index = f"split.total - 1 - split.index == {i}" if backwards else f"split.index == {i}"
+            cases.append(f"\tcase {index} :\n\t\t{self.rule(children[i], flips, deeper)}")
+        if not cases:
+            return typical
+        if name not in self.dispatchers:
+            self.dispatchers.add(name)
+            self.lines.append(f"{name} -->\n" + "\n".join(cases) + f"\n\telse :\n\t\t{typical}\n")
+        return name
 
 
 def _kept(sizes: list, lengths: list[float], least: float) -> list[float | None]:

@@ -13,6 +13,7 @@ from PIL import Image
 
 from facaid.generator import STYLE_NAMES, generate
 from facaid.grammar import Node, Procedure, Size, to_segmentation
+from facaid.grammar.procedure import Override
 from facaid.render import legend, render_segmentation, side_by_side
 
 A, R, F = (lambda v: Size("abs", v)), (lambda v: Size("rel", v)), (lambda v: Size("flt", v))
@@ -53,7 +54,25 @@ def figures() -> dict[str, list[Procedure]]:
         "repeat_fill": [Procedure(200, 120, fill), Procedure(320, 120, fill), Procedure(440, 120, fill)],
         "mirror": [Procedure(260, 60, mirror_c), Procedure(260, 60, mirror_n)],
         "facade": [Procedure(300, 420, nested)],
+        "exceptions": [Procedure(300, 300, _floors([])), Procedure(300, 300, _floors(EXCEPTIONS))],
     }
+
+
+# the exceptions of the picture in docs/grammar.md, on the floors repeat of `_floors`
+EXCEPTIONS = [
+    Override(1, (0, 2, 1, 2), node=L("blind")),  # floor 1, tile 2: the blind closed
+    Override(0, (0, 3, 1, 3), size=A(0), node=L("facade")),  # floor 0, tile 3: no sill
+    Override(3, (0,), size=F(110)),  # floor 3 (the lowest): taller
+    Override(2, (0, 0), node=Node.split("x", [(F(1), L("facade")), (A(34), Node.split("y", [
+        (F(1), L("facade")), (A(60), L("door"))])), (F(1), L("facade"))], role="entrance")),  # a door
+]
+
+
+def _floors(exceptions: list[Override]) -> Node:
+    """Four floors of four tiles; ``exceptions`` on the floors."""
+    floors = Node.repeat("y", 4, [(F(70), Node.repeat("x", 4, [(F(60), _tile())], role="floor"))], role="floors")
+    floors.exceptions = list(exceptions)
+    return Node.split("y", [(A(14), L("molding", role="band")), (F(1), floors)], role="facade")
 
 
 def render_figure(procs: list[Procedure], height: int = 160) -> Image.Image:

@@ -16,9 +16,10 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-from facaid.grammar.layout import expand, layout
+from facaid.grammar.execute import parameter_lengths
+from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
-from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
+from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, recount, validate
 from facaid.resizing import repeat_unit, resize
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
@@ -63,9 +64,15 @@ class _Instances:
         self.extent: dict[int, tuple[float, float]] = {}
         self.parent_axis: dict[int, str | None] = {}
         self.outer: dict[int, bool] = {}  # no ancestor with the same role
+        self.own: dict[int, str] = {}  # id of an exception's node -> its path's last part ("!e")
+        for _, node in proc.nodes():
+            for e, o in enumerate(node.exceptions):
+                if o.node is not None:
+                    self.own[id(o.node)] = f"!{e}"
         self._visit(proc.root, "root", float(proc.width), float(proc.height), None, frozenset())
 
-    def _visit(self, node: Node, path: str, w: float, h: float, axis: str | None, roles: frozenset) -> None:
+    def _visit(self, node: Node, path: str, w: float, h: float, axis: str | None, roles: frozenset,
+               pending: list | None = None) -> None:
         key = id(node)
         if key not in self.path:
             self.path[key], self.extent[key], self.parent_axis[key] = path, (w, h), axis
@@ -74,13 +81,22 @@ class _Instances:
         if node.rule == "leaf":
             return
         length = w if node.axis == "x" else h
-        sizes, children, _ = expand(node, length)
+        sizes, children, _, below, sources = expand_over(node, length, pending)
         lengths = layout(sizes, length)
         inner = roles | {node.role} if node.role else roles
         n = len(node.children)
         for i, (child, extent) in enumerate(zip(children, lengths, strict=True)):
             cw, ch = (extent, h) if node.axis == "x" else (w, extent)
-            self._visit(child, f"{path}/{i % n}", cw, ch, node.axis, inner)
+            if id(child) in self.own and child is not node.children[i % n]:  # an exception's node: its own path
+                owner = next(owner for _, o, owner in self._entries(node, pending) if o.node is child)
+                child_path = f"{self.path[id(owner)]}/{self.own[id(child)]}"
+            else:
+                child_path = f"{path}/{i % n}"
+            self._visit(child, child_path, cw, ch, node.axis, inner, below[i] if below is not None else None)
+
+    @staticmethod
+    def _entries(node: Node, pending: list | None) -> list:
+        return [(None, o, node) for o in node.exceptions] + list(pending or [])
 
 
 def _nodes(proc: Procedure) -> dict[str, Node]:
@@ -91,15 +107,19 @@ def normalised(proc: Procedure) -> Procedure:
     """The same facade with every size set to the length it lays out to in the node's first instance (``rel``
     becomes ``abs``; ``flt`` keeps its mode with its real length as weight). Execution does not change."""
     out = Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
-    inst = _Instances(out)
-    for _, node in out.nodes():
-        if node.rule == "leaf" or node.count == "fill":
-            continue
-        w, h = inst.extent[id(node)]
-        length = w if node.axis == "x" else h
-        lengths = layout(expand(node, length)[0], length)[: len(node.sizes)]
-        node.sizes = [Size("flt" if s.mode == "flt" else "abs", round(v, 4)) for s, v in zip(node.sizes, lengths,
-                                                                                            strict=True)]
+    lengths = iter(parameter_lengths(out))
+
+    def real(size: Size, fill: bool) -> Size:
+        length = next(lengths)
+        if fill or length is None:  # a fill repeat counts with its nominal sizes; an unused size stays
+            return size
+        return Size("flt" if size.mode == "flt" else "abs", round(length, 4))
+
+    for _, node in out.nodes():  # in `Procedure.parameters` order: a node's sizes, then its exceptions'
+        fill = node.count == "fill"
+        node.sizes = [real(s, fill) for s in node.sizes]
+        node.exceptions = [o._replace(size=real(o.size, False)) if o.size is not None else o
+                           for o in node.exceptions]
     return out
 
 
@@ -209,7 +229,7 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
             return
         free = [i for i, c in enumerate(node.children) if not has_target(c)]
         i = next((i for i in free if node.sizes[i].mode == "flt"), free[0] if free else 0)
-        copies = (node.count + (i < node.tail) if node.rule == "repeat"
+        copies = (len(_grown_copies(node, i)) if node.rule == "repeat"
                   else 1 if node.rule == "split" or (node.center and i == len(node.children) - 1) else 2)
         node.sizes[i] = Size(node.sizes[i].mode, round(node.sizes[i].value + extra / copies, 4))
         if not free:
@@ -233,8 +253,8 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
             parts = [grow(c) for c in node.children]
             node.sizes = [Size(s.mode, max(0.0, round(s.value + d, 4))) for s, d in zip(node.sizes, parts,
                                                                                       strict=True)]
-            if node.rule == "repeat":
-                g = node.count * sum(parts) + sum(parts[: node.tail])
+            if node.rule == "repeat":  # a copy an exception sizes keeps its size
+                g = sum(len(_grown_copies(node, j)) * d for j, d in enumerate(parts))
             elif node.rule == "mirror":
                 g = 2 * sum(parts) - (parts[-1] if node.center else 0.0)
             else:
@@ -247,6 +267,12 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
         proc.width = round(proc.width + g, 4)
     else:
         proc.height = round(proc.height + g, 4)
+
+
+def _grown_copies(node: Node, item: int) -> list[int]:
+    """The copies of a repeat's pattern item ``item`` that take the item's own size (no exception sizes them)."""
+    resized = {o.copy for o in node.exceptions if o.path == (item,) and o.size is not None}
+    return [c for c in range(node.count + (item < node.tail)) if c not in resized]
 
 
 def _along(nodes: dict[str, Node], path: str, axis: str) -> Node:
@@ -309,7 +335,7 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
                 raise ValueError(f"{name} {value:g} needs a repeat of {new} copies (1 to {MAX_COUNT})")
             unit, _ = repeat_unit(node, inst.extent[id(node)][0 if axis == "x" else 1])
             own[id(node)] = delta * unit
-            node.count = new
+            recount(out.root, node, new)
         _grow(out, axis, own)
     try:
         validate(out)

@@ -6,8 +6,8 @@ Used by variations (`facaid.variation`) and by the named parameters' width and h
 from __future__ import annotations
 
 from facaid.grammar.execute import first_boxes
-from facaid.grammar.layout import expand, layout
-from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Procedure, validate
+from facaid.grammar.layout import expand_over, layout
+from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Procedure, recount, validate
 
 
 def copy_procedure(proc: Procedure) -> Procedure:
@@ -22,9 +22,16 @@ def regions(proc: Procedure) -> dict[int, float]:
 
 
 def repeat_unit(node, length: float) -> tuple[float, float]:
-    """A counted repeat laid out on ``length``: the length of one copy of its pattern and of its tail."""
-    tail = sum(layout(expand(node, length)[0], length)[len(node.children) * node.count:])
-    return (length - tail) / node.count, tail
+    """A counted repeat laid out on ``length``: the length of one typical copy of its pattern (one that no
+    exception resizes; with none such, the mean copy) and of its tail."""
+    k = len(node.children)
+    lengths = layout(expand_over(node, length, None)[0], length)
+    tail = sum(lengths[k * node.count:])
+    resized = {o.copy for o in node.exceptions if len(o.path) == 1 and o.size is not None}
+    typical = next((c for c in range(node.count) if c not in resized), None)
+    if typical is None:
+        return (length - tail) / node.count, tail
+    return sum(lengths[typical * k:(typical + 1) * k]), tail
 
 
 def resize(proc: Procedure, width: float, height: float) -> Procedure:
@@ -48,7 +55,7 @@ def resize(proc: Procedure, width: float, height: float) -> Procedure:
         lengths = regions(out)
         if id(new) in lengths:
             unit, tail = units[id(orig)]
-            new.count = max(1, min(MAX_COUNT, round((lengths[id(new)] - tail) / unit)))
+            recount(out.root, new, max(1, min(MAX_COUNT, round((lengths[id(new)] - tail) / unit))))
     validate(out)
     return out
 

@@ -42,7 +42,7 @@ class SizingResult:
 
 
 def _modes(proc: Procedure) -> list[str]:
-    return [s.mode for _, node in proc.nodes() for s in node.sizes]
+    return [s.mode for _, node in proc.nodes() for s in node.own_sizes()]
 
 
 def _to_free(values: torch.Tensor, is_rel: torch.Tensor) -> torch.Tensor:

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from facaid.grammar.layout import expand, layout
+from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT
 from facaid.grammar.procedure import MAX_LEAVES, Node, Procedure, ProcedureError
 from facaid.labels import BACKGROUND, LABEL_ID
@@ -29,6 +29,7 @@ class Trace:
     axis: list[str] = field(default_factory=list)  # the axis the parent splits along
     flip: list[bool] = field(default_factory=list)  # laid out from the far end (inside a reflection)
     leaves: list[int] = field(default_factory=list)  # instance indices of the leaves, depth-first
+    extent: list[float] = field(default_factory=list)  # the length the instance lays out to along its parent's axis
 
 
 def spans(lo: float, hi: float, lengths: list[float], flip: bool) -> list[tuple[float, float]]:
@@ -60,16 +61,21 @@ class _Executor:
         self.fill_counts: dict[int, int] = {}
         self.first_boxes: dict[int, tuple[float, float, float, float]] | None = None  # set to record them
         self.leaf_nodes: list[Node] | None = None  # set to record the node of each leaf
-        self.offsets: dict[int, int] = {}
+        self.offsets: dict[int, int] = {}  # id(node) or id(override) -> its first parameter
         if trace is not None:
             k = 0
-            for _, node in proc.root.walk():
+            for _, node in proc.root.walk():  # in `Procedure.parameters` order
                 self.offsets[id(node)] = k
                 k += len(node.sizes)
+                for o in node.exceptions:
+                    if o.size is not None:
+                        self.offsets[id(o)] = k
+                        k += 1
 
     def run(self, node: Node, box: tuple[float, float, float, float], flips: tuple[bool, bool],
-            where: tuple, me: int) -> None:
-        # ``where`` is (parent's where, child index): the node path, formatted only for an error
+            where: tuple, me: int, pending: list | None = None) -> None:
+        # ``where`` is (parent's where, child index): the node path, formatted only for an error; ``pending``: the
+        # exceptions of repeats above that reach into this instance (`layout.expand_over`)
         if self.first_boxes is not None:
             self.first_boxes.setdefault(id(node), box)
         if node.rule == "leaf":
@@ -79,11 +85,13 @@ class _Executor:
         along_x = node.axis == "x"
         lo, hi = (x0, x1) if along_x else (y0, y1)
         key = (id(node), hi - lo)
-        cached = self.layouts.get(key)
+        cached = self.layouts.get(key) if pending is None else None
         if cached is None:
-            sizes, children, reflected = expand(node, hi - lo)
-            cached = self.layouts[key] = (sizes, children, reflected, layout(sizes, hi - lo))
-        sizes, children, reflected, lengths = cached
+            sizes, children, reflected, below, sources = expand_over(node, hi - lo, pending)
+            cached = (sizes, children, reflected, layout(sizes, hi - lo), below, sources)
+            if pending is None:  # an instance that exceptions from above reach into is its own
+                self.layouts[key] = cached
+        sizes, children, reflected, lengths, below, sources = cached
         if node.count == "fill":
             self.fill_counts[id(node)] = (len(children) - node.tail) // len(node.children)
         flip = flips[0] if along_x else flips[1]
@@ -99,17 +107,20 @@ class _Executor:
                 child_id = len(trace.depth)
                 trace.depth.append(trace.depth[me] + 1)
                 trace.parent.append(me)
-                trace.param.append(self.offsets[id(node)] + pidx[i])
+                source = sources[i] if sources is not None else None
+                trace.param.append(self.offsets[id(node)] + pidx[i] if source is None else self.offsets[id(source[1])])
                 trace.mode.append(sizes[i].mode)
                 trace.axis.append(node.axis)
                 trace.flip.append(flip)
+                trace.extent.append(b - a)
             if child.rule == "leaf" and self.first_boxes is None and self.leaf_nodes is None:  # most are: no call
                 if trace is None and len(out) < MAX_LEAVES:
                     out.append((LABEL_ID[child.label], *sub))
                 else:
                     self.leaf(child, sub, (where, i % n_pattern), child_id)
             else:
-                self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), child_id)
+                self.run(child, sub, mirrored if reflected[i] else flips, (where, i % n_pattern), child_id,
+                         below[i] if below is not None else None)
 
     def leaf(self, node: Node, box: tuple[float, float, float, float], where: tuple, me: int) -> None:
         if len(self.out) >= MAX_LEAVES:
@@ -150,8 +161,21 @@ def execute(proc: Procedure, trace: Trace | None = None) -> list[tuple[int, floa
         trace.mode.append("")
         trace.axis.append("")
         trace.flip.append(False)
+        trace.extent.append(0.0)
     ex.run(proc.root, (0.0, 0.0, float(proc.width), float(proc.height)), (False, False), (), 0)
     return ex.out
+
+
+def parameter_lengths(proc: Procedure) -> list[float | None]:
+    """For each parameter (`Procedure.parameters` order), the length its first instance lays out to, depth-first;
+    None for a size no instance uses."""
+    trace = Trace()
+    execute(proc, trace)
+    out: list[float | None] = [None] * len(proc.parameters())
+    for param, extent in zip(trace.param[1:], trace.extent[1:], strict=True):
+        if out[param] is None:
+            out[param] = extent
+    return out
 
 
 def fill_counts(proc: Procedure) -> dict[int, int]:
@@ -168,24 +192,26 @@ def first_boxes(proc: Procedure) -> dict[int, tuple[float, float, float, float]]
     instances all came before them (the boxes are those `execute_with_boxes` records, placed by the same `spans`)."""
     seen: dict[int, tuple[float, float, float, float]] = {}
 
-    def visit(node: Node, box: tuple[float, float, float, float], flip_x: bool, flip_y: bool) -> None:
-        seen[id(node)] = box
+    def visit(node: Node, box: tuple[float, float, float, float], flip_x: bool, flip_y: bool,
+              pending: list | None = None) -> None:
+        seen.setdefault(id(node), box)
         x0, y0, x1, y1 = box
         along_x = node.axis == "x"
         lo, hi = (x0, x1) if along_x else (y0, y1)
-        sizes, children, reflected = expand(node, hi - lo)
+        sizes, children, reflected, below, _ = expand_over(node, hi - lo, pending)
         lengths = layout(sizes, hi - lo)
         for i, (child, (a, b)) in enumerate(zip(children, spans(lo, hi, lengths, flip_x if along_x else flip_y),
                                                 strict=True)):
-            if id(child) in seen:
+            deeper = below[i] if below is not None else None
+            if id(child) in seen and deeper is None:  # an exception below a copy may hold nodes not seen yet
                 continue
             sub = (a, y0, b, y1) if along_x else (x0, a, x1, b)
             if child.rule == "leaf":
                 seen[id(child)] = sub
             elif reflected[i]:
-                visit(child, sub, flip_x != along_x, flip_y == along_x)
+                visit(child, sub, flip_x != along_x, flip_y == along_x, deeper)
             else:
-                visit(child, sub, flip_x, flip_y)
+                visit(child, sub, flip_x, flip_y, deeper)
 
     box = (0.0, 0.0, float(proc.width), float(proc.height))
     if proc.root.rule == "leaf":

@@ -40,6 +40,45 @@ def expand(node, length: float) -> tuple[list, list, list[bool]]:
             [False] * len(node.children) + [True] * len(back))
 
 
+def expand_over(node, length: float, pending: list | None) -> tuple[list, list, list[bool], list | None, list | None]:
+    """`expand` with the exceptions applied: those of ``node`` (a repeat's `Override`s) and ``pending``, the
+    overrides of repeats above it that reach into it, each ``(steps, override, owner)`` with ``steps`` the indices
+    of the expanded children still to follow from ``node`` down. Returns (sizes, children, reflected, below,
+    sources): ``below[i]`` the pending overrides of child ``i`` (None when it has none) and ``sources[i]`` the
+    ``(owner, override)`` whose size child ``i`` takes (None for its own); both None when nothing applies here.
+    An override from further up wins over one from nearer (a cell's exception over its column's)."""
+    sizes, children, reflected = expand(node, length)
+    exceptions = node.exceptions if node.rule == "repeat" else ()
+    if not exceptions and not pending:
+        return sizes, children, reflected, None, None
+    entries = []
+    if exceptions:
+        k, n = len(node.children), repeat_count(node, length)
+        for o in exceptions:
+            if o.copy < n or (o.copy == n and o.path[0] < node.tail):
+                entries.append(((o.copy * k + o.path[0], *o.path[1:]), o, node))
+    if pending:
+        entries.extend(pending)
+    if not entries:
+        return sizes, children, reflected, None, None
+    sizes, children = list(sizes), list(children)
+    below: list = [None] * len(children)
+    sources: list = [None] * len(children)
+    for steps, o, owner in entries:
+        i = steps[0]
+        if i >= len(children):
+            continue  # a copy this length does not lay out
+        if len(steps) > 1:
+            below[i] = (below[i] or []) + [(steps[1:], o, owner)]
+            continue
+        if o.size is not None:
+            sizes[i] = o.size
+            sources[i] = (owner, o)
+        if o.node is not None:
+            children[i] = o.node
+    return sizes, children, reflected, below, sources
+
+
 def layout(sizes: list, length: float) -> list[float]:
     """Lengths of the children of a split of the given length (see the rules in `procedure`). A length below 0
     (a last child laid out where rounding put its start a hair past its end) counts as 0."""
@@ -82,7 +121,7 @@ def count_leaves(root, width: float, height: float, limit: int = MAX_LEAVES) -> 
     memo: dict[tuple[int, float, float], int] = {}
     total = 0
 
-    def count(node, w: float, h: float) -> int:
+    def count(node, w: float, h: float, pending: list | None = None) -> int:
         nonlocal total
         if node.rule == "leaf":
             total += 1
@@ -90,7 +129,7 @@ def count_leaves(root, width: float, height: float, limit: int = MAX_LEAVES) -> 
                 raise _TooMany
             return 1
         key = (id(node), w, h)
-        known = memo.get(key)
+        known = memo.get(key) if pending is None else None  # overrides reaching in make an instance its own
         if known is not None:
             total += known
             if total > limit:
@@ -98,11 +137,13 @@ def count_leaves(root, width: float, height: float, limit: int = MAX_LEAVES) -> 
             return known
         along_x = node.axis == "x"
         length = w if along_x else h
-        sizes, children, _ = expand(node, length)
+        sizes, children, _, below, _ = expand_over(node, length, pending)
         n = 0
-        for child, extent in zip(children, layout(sizes, length), strict=True):
-            n += count(child, extent, h) if along_x else count(child, w, extent)
-        memo[key] = n
+        for i, (child, extent) in enumerate(zip(children, layout(sizes, length), strict=True)):
+            sub = below[i] if below is not None else None
+            n += count(child, extent, h, sub) if along_x else count(child, w, extent, sub)
+        if pending is None:
+            memo[key] = n
         return n
 
     try:

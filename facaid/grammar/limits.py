@@ -6,6 +6,7 @@ MAX_DEPTH = 32
 MAX_NODES = 8192
 MAX_CHILDREN = 64
 MAX_COUNT = 256
+MAX_EXCEPTIONS = 1024  # per repeat
 MAX_LEAVES = 100_000  # rectangles after repeats and mirrors are expanded
 MAX_META_CHARS = 65_536
 MAX_EXTENT = float(MAX_SIDE)  # pixels: a procedure executes to a segmentation, whose sides stop there too

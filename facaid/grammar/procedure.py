@@ -13,6 +13,10 @@ Rules (see docs/grammar.md for pictures):
 - ``mirror``: ``children`` then the same children in reverse order, each copy reflected along the axis;
   with ``center`` the last child is the middle one and is not repeated.
 
+A repeat may list ``exceptions``: copies that differ from the typical one by a delta, each an `Override` of one
+node of one copy (its size, or the node itself: a closed blind, a missing sill, a taller first floor). The copy
+stays a copy of the repeat, so changing the count adds or removes typical copies.
+
 A size spec is ``[mode, value]``: ``abs`` is a length in pixels, ``rel`` a fraction of the parent's length,
 ``flt`` a floating length: floating children share what the others leave, in proportion to their values
 (their nominal pixel lengths). When fixed sizes overflow the parent they are scaled down to fit and the
@@ -32,6 +36,7 @@ from facaid.grammar.limits import (
     MAX_CHILDREN,
     MAX_COUNT,
     MAX_DEPTH,
+    MAX_EXCEPTIONS,
     MAX_EXTENT,
     MAX_LEAVES,
     MAX_META_CHARS,
@@ -64,9 +69,9 @@ ROLES = (
 )
 
 __all__ = [
-    "AXES", "FORMAT", "FORMAT_VERSION", "GRAMMAR_VERSION", "MAX_CHILDREN", "MAX_COUNT", "MAX_DEPTH", "MAX_EXTENT",
-    "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES", "Node", "Procedure", "ProcedureError",
-    "Size", "parse_procedure", "validate",
+    "AXES", "FORMAT", "FORMAT_VERSION", "GRAMMAR_VERSION", "MAX_CHILDREN", "MAX_COUNT", "MAX_DEPTH", "MAX_EXCEPTIONS",
+    "MAX_EXTENT", "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES", "Node", "Override",
+    "Procedure", "ProcedureError", "Size", "parse_procedure", "recount", "validate",
 ]
 
 
@@ -76,6 +81,26 @@ class ProcedureError(ValueError):
     def __init__(self, path: str, message: str):
         super().__init__(f"node {path}: {message}")
         self.path = path
+
+
+class Override(NamedTuple):
+    """One exception of a repeat: in copy ``copy`` (0-based; ``copy == count`` names the tail), the node reached by
+    ``path`` (the pattern item, then the index of each expanded child below it, as `layout.expand` lays them out)
+    takes the size ``size`` and/or is replaced by ``node``. An override of a copy that a ``"fill"`` repeat does not
+    lay out at its length has no effect, like CGA's ``case split.index == k`` with fewer parts."""
+
+    copy: int
+    path: tuple[int, ...]
+    size: Size | None = None
+    node: Node | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"copy": self.copy, "path": list(self.path)}
+        if self.size is not None:
+            out["size"] = [self.size.mode, self.size.value]
+        if self.node is not None:
+            out["node"] = self.node.to_dict()
+        return out
 
 
 class Size(NamedTuple):
@@ -97,6 +122,7 @@ class Node:
     tail: int = 0  # repeat only
     center: bool = False  # mirror only
     role: str | None = None
+    exceptions: list[Override] = field(default_factory=list)  # repeat only: copies that differ
 
     # --- construction helpers -------------------------------------------------------------------------
     @staticmethod
@@ -121,17 +147,34 @@ class Node:
     def copy(self) -> Node:
         """A deep copy (sizes are immutable and shared)."""
         return Node(self.rule, self.label, self.axis, list(self.sizes), [c.copy() for c in self.children],
-                    self.count, self.tail, self.center, self.role)
+                    self.count, self.tail, self.center, self.role,
+                    [o._replace(node=o.node.copy()) if o.node is not None else o for o in self.exceptions])
 
     @property
     def is_leaf(self) -> bool:
         return self.rule == "leaf"
 
     def walk(self, path: str = "root") -> Iterator[tuple[str, Node]]:
-        """Depth-first pre-order over (path, node)."""
+        """Depth-first pre-order over (path, node): the children, then the nodes of the exceptions (the node of
+        exception ``e`` of ``root/1`` is ``root/1/!e``)."""
         yield path, self
         for i, child in enumerate(self.children):
             yield from child.walk(f"{path}/{i}")
+        for e, o in enumerate(self.exceptions):
+            if o.node is not None:
+                yield from o.node.walk(f"{path}/!{e}")
+
+    def subtrees(self) -> list[Node]:
+        """The children, then the exceptions' nodes."""
+        if not self.exceptions:
+            return self.children
+        return self.children + [o.node for o in self.exceptions if o.node is not None]
+
+    def own_sizes(self) -> list[Size]:
+        """The sizes this node holds as parameters: its children's, then its exceptions' (`Procedure.parameters`)."""
+        if not self.exceptions:
+            return self.sizes
+        return self.sizes + [o.size for o in self.exceptions if o.size is not None]
 
     def bfs(self) -> Iterator[Node]:
         queue = [self]
@@ -140,7 +183,7 @@ class Node:
             node = queue[i]
             i += 1
             yield node
-            queue.extend(node.children)
+            queue.extend(node.subtrees())
 
     # --- JSON -----------------------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
@@ -154,6 +197,8 @@ class Node:
         if self.rule == "repeat":
             out["count"] = self.count
             out["tail"] = self.tail
+            if self.exceptions:
+                out["exceptions"] = [o.to_dict() for o in self.exceptions]
         if self.rule == "mirror":
             out["center"] = self.center
         out["sizes"] = [[s.mode, s.value] for s in self.sizes]
@@ -202,20 +247,24 @@ class Procedure:
 
     def parameters(self) -> list[float]:
         """Every sizing parameter, in depth-first node order and size order within a node."""
-        return [s.value for _, node in self.root.walk() for s in node.sizes]
+        return [s.value for _, node in self.root.walk() for s in node.own_sizes()]
 
     def with_parameters(self, values: list[float]) -> Procedure:
         """A copy with the sizing parameters replaced (same order as `parameters`), validated."""
         values = [float(v) for v in values]
-        expected = sum(len(node.sizes) for _, node in self.root.walk())
+        expected = sum(len(node.own_sizes()) for _, node in self.root.walk())
         if len(values) != expected:
             raise ValueError(f"expected {expected} parameters, got {len(values)}")
         it = iter(values)
 
         def copy(node: Node) -> Node:
             sizes = [Size(s.mode, next(it)) for s in node.sizes]
-            return Node(node.rule, node.label, node.axis, sizes, [copy(c) for c in node.children],
-                        node.count, node.tail, node.center, node.role)
+            sized = [o._replace(size=Size(o.size.mode, next(it))) if o.size is not None else o
+                     for o in node.exceptions]  # in `own_sizes` order: the node's, then its exceptions'
+            children = [copy(c) for c in node.children]
+            exceptions = [o._replace(node=copy(o.node)) if o.node is not None else o for o in sized]
+            return Node(node.rule, node.label, node.axis, sizes, children, node.count, node.tail, node.center,
+                        node.role, exceptions)
 
         out = Procedure(self.width, self.height, copy(self.root), dict(self.meta))
         validate(out)
@@ -228,19 +277,20 @@ def _is_number(v: Any) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool)
 
 
-def _check_size(path: str, i: int, mode: str, value: Any) -> None:
+def _check_size(path: str, i: int, mode: str, value: Any, what: str | None = None) -> None:
+    what = what or f"sizes[{i}]"
     if mode not in MODES:
-        raise ProcedureError(path, f"sizes[{i}] has unknown mode {mode!r}; expected one of {', '.join(MODES)}")
+        raise ProcedureError(path, f"{what} has unknown mode {mode!r}; expected one of {', '.join(MODES)}")
     if not _is_number(value):
-        raise ProcedureError(path, f"sizes[{i}] value must be a number, got {value!r}")
+        raise ProcedureError(path, f"{what} value must be a number, got {value!r}")
     if not finite(value):
-        raise ProcedureError(path, f"sizes[{i}] value must be finite, got {value!r}")
+        raise ProcedureError(path, f"{what} value must be finite, got {value!r}")
     if value < 0:
-        raise ProcedureError(path, f"sizes[{i}] is negative ({value!r})")
+        raise ProcedureError(path, f"{what} is negative ({value!r})")
     if mode == "rel" and value > 1:
-        raise ProcedureError(path, f"sizes[{i}] is a relative size above 1 ({value!r})")
+        raise ProcedureError(path, f"{what} is a relative size above 1 ({value!r})")
     if value > MAX_EXTENT:
-        raise ProcedureError(path, f"sizes[{i}] is too large ({value!r} > {MAX_EXTENT:g})")
+        raise ProcedureError(path, f"{what} is too large ({value!r} > {MAX_EXTENT:g})")
 
 
 def _texts(value: Any) -> Iterator[str]:
@@ -288,7 +338,7 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
         raise ProcedureError(path, f"unknown role {role!r}; expected one of {', '.join(ROLES)}")
     allowed = {"rule", "role", "label"} if rule == "leaf" else {"rule", "role", "axis", "sizes", "children"}
     if rule == "repeat":
-        allowed |= {"count", "tail"}
+        allowed |= {"count", "tail", "exceptions"}
     if rule == "mirror":
         allowed |= {"center"}
     extra = sorted(set(obj) - allowed)
@@ -334,7 +384,119 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
             raise ProcedureError(path, f"center must be true or false, got {center!r}")
         node.center = center
     node.children = [_parse_node(c, f"{path}/{i}", depth + 1, counter) for i, c in enumerate(children_in)]
+    if rule == "repeat" and "exceptions" in obj:
+        node.exceptions = _parse_exceptions(obj["exceptions"], node, path, depth, counter)
     return node
+
+
+def _expanded_count(node: Node) -> int:
+    """How many children a node lays out (a ``"fill"`` repeat: as many as it may)."""
+    k = len(node.children)
+    if node.rule == "repeat":
+        return k * (MAX_COUNT if node.count == "fill" else node.count) + node.tail
+    if node.rule == "mirror":
+        return 2 * k - node.center
+    return k
+
+
+def _pattern_child(node: Node, i: int) -> Node:
+    """The node expanded child ``i`` of ``node`` is (`layout.expand`'s order)."""
+    k = len(node.children)
+    if node.rule == "mirror" and i >= k:
+        return node.children[k - (2 if node.center else 1) - (i - k)]
+    return node.children[i % k]
+
+
+def recount(root: Node, node: Node, count: int) -> None:
+    """Set the count of the repeat ``node`` (in the tree under ``root``) to ``count``, in place, keeping every
+    exception on the copies that stay: copies are added or removed at the end (the new ones typical), the tail keeps
+    its exceptions, and so do the paths of repeats above that run through ``node``."""
+    old, k = node.count, len(node.children)
+
+    def moved(copy: int) -> int | None:
+        if copy == old:  # the tail
+            return count
+        return copy if copy < count else None
+
+    kept = []
+    for o in node.exceptions:
+        c = moved(o.copy)
+        if c is not None:
+            kept.append(o._replace(copy=c))
+    node.exceptions = kept
+    for _, above in root.walk():
+        if not above.exceptions or above is node:
+            continue
+        kept = []
+        for o in above.exceptions:
+            steps, target = list(o.path), above.children[o.path[0]]
+            for s in range(1, len(steps)):
+                if target is node:
+                    c = moved(steps[s] // k)
+                    if c is None:
+                        break
+                    steps[s] = c * k + steps[s] % k
+                target = _pattern_child(target, steps[s])
+            else:
+                kept.append(o._replace(path=tuple(steps)))
+        above.exceptions = kept
+    node.count = count
+
+
+def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: list[int]) -> list[Override]:
+    if not isinstance(items, list):
+        raise ProcedureError(path, f"exceptions must be a list, got {type(items).__name__}")
+    if len(items) > MAX_EXCEPTIONS:
+        raise ProcedureError(path, f"too many exceptions ({len(items)}; at most {MAX_EXCEPTIONS})")
+    out: list[Override] = []
+    seen: set[tuple[int, tuple[int, ...]]] = set()
+    last = MAX_COUNT if node.count == "fill" else node.count
+    for e, item in enumerate(items):
+        where = f"exceptions[{e}]"
+        if not isinstance(item, dict):
+            raise ProcedureError(path, f"{where} must be an object, got {type(item).__name__}")
+        extra = sorted(set(item) - {"copy", "path", "size", "node"})
+        if extra:
+            raise ProcedureError(path, f"{where} has unexpected key(s): {', '.join(extra)}")
+        copy, steps = item.get("copy"), item.get("path")
+        if not (isinstance(copy, int) and not isinstance(copy, bool)) or not 0 <= copy <= last:
+            raise ProcedureError(path, f"{where}.copy must be a copy of the repeat, 0 to {last}, got {copy!r}")
+        if (not isinstance(steps, list) or not 1 <= len(steps) <= MAX_DEPTH
+                or not all(isinstance(i, int) and not isinstance(i, bool) and i >= 0 for i in steps)):
+            raise ProcedureError(path, f"{where}.path must be a list of 1 to {MAX_DEPTH} indices, got {steps!r}")
+        if steps[0] >= len(node.children):
+            raise ProcedureError(path, f"{where}.path[0] must be a pattern item, 0 to {len(node.children) - 1}, "
+                                       f"got {steps[0]}")
+        if copy == node.count and steps[0] >= node.tail:
+            raise ProcedureError(path, f"{where}.copy {copy} is the tail, which lays out "
+                                       + (f"items 0 to {node.tail - 1}" if node.tail else "nothing"))
+        target = node.children[steps[0]]
+        for k, i in enumerate(steps[1:], 1):
+            if target.rule == "leaf":
+                raise ProcedureError(path, f"{where}.path[{k}] goes below a leaf")
+            if i >= _expanded_count(target):
+                raise ProcedureError(path, f"{where}.path[{k}] is {i}, but that node lays out "
+                                           f"{_expanded_count(target)} children")
+            target = _pattern_child(target, i)
+        if (copy, tuple(steps)) in seen:
+            raise ProcedureError(path, f"{where} names copy {copy} at path {steps} twice")
+        seen.add((copy, tuple(steps)))
+        size = None
+        if "size" in item:
+            s = item["size"]
+            if not (isinstance(s, list) and len(s) == 2):
+                raise ProcedureError(path, f"{where}.size must be a [mode, value] pair, got {s!r}")
+            _check_size(path, e, s[0], s[1], what=f"{where}.size")
+            size = Size(s[0], s[1])
+        sub = None
+        if "node" in item:
+            if depth + len(steps) > MAX_DEPTH:
+                raise ProcedureError(path, f"{where}: tree too deep (more than {MAX_DEPTH} levels)")
+            sub = _parse_node(item["node"], f"{path}/!{e}", depth + len(steps), counter)
+        if size is None and sub is None:
+            raise ProcedureError(path, f"{where} changes nothing: give it a size, a node or both")
+        out.append(Override(copy, tuple(steps), size, sub))
+    return out
 
 
 def parse_procedure(obj: Any) -> Procedure:

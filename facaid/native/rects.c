@@ -161,21 +161,32 @@ int64_t facaid_flatten(int64_t width, int64_t height, const int64_t *rows, int64
     return flatten(width, height, rows, n, priority, mode, result, cap);
 }
 
-/* Executing. The tree comes in breadth-first order, 8 int64 a node: rule (0 leaf, 1 split, 2 repeat, 3 mirror),
- * axis (0 x, 1 y), count (-1 "fill"), tail, center, label id, index of the first child, number of children; a
- * node's children are consecutive, and node k > 0 has its size (mode 0 abs, 1 rel, 2 flt; value) at k - 1. The
- * arithmetic is `facaid.grammar.layout`'s, operation for operation, in doubles (compiled without contraction). */
+/* Executing. The tree comes in breadth-first order, 10 int64 a node: rule (0 leaf, 1 split, 2 repeat, 3 mirror),
+ * axis (0 x, 1 y), count (-1 "fill"), tail, center, label id, index of the first child, number of children, index
+ * of the first exception, number of exceptions; a node's children are consecutive, and node k > 0 has its size
+ * (mode 0 abs, 1 rel, 2 flt; value) at k - 1 (an exception's node, queued after the children, has an unused one).
+ * An exception is 6 int64: copy, index of its path in ``steps``, the path's length, size mode (-1: none), index of
+ * its node (-1: none), and its size value's index in ``ovalues``. The arithmetic is `facaid.grammar.layout`'s,
+ * operation for operation, in doubles (compiled without contraction). */
 enum { LEAF, SPLIT, REPEAT, MIRROR };
 enum { ABS, REL, FLT };
+#define NODE 10
+#define OVER 6
 
 typedef struct {
     const int64_t *nodes;
     const int64_t *modes;
     const double *values;
+    const int64_t *overs; /* the exceptions */
+    const int64_t *steps; /* their paths */
+    const double *ovalues; /* their sizes */
     int64_t max_count, max_leaves, n_leaves, room;
     double *leaves; /* room x 5: label, x0, y0, x1, y1 */
     int error;
 } Exec;
+
+/* an exception on its way down: which one, and how many steps of its path are behind it */
+typedef struct { int64_t id, pos; } Pending;
 
 static double nominal(const Exec *e, int64_t k, double length) {
     return e->modes[k - 1] == REL ? e->values[k - 1] * length : e->values[k - 1];
@@ -187,9 +198,58 @@ static int64_t child_of(const int64_t *nd, int64_t first, int64_t nk, int64_t ba
     return nd[0] == MIRROR && i >= nk ? first + back - (i - nk) : first + i % nk;
 }
 
-static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, int flip_x, int flip_y) {
+/* The children of an instance that exceptions reach (`layout.expand_over`): per expanded child its node, size
+ * mode and value, and the exceptions that go on into it. */
+typedef struct {
+    int64_t *kid, *mode;
+    double *value;
+    Pending *entry; /* the exceptions that apply here, own first, each with the index of the child it names */
+    int64_t *at, n_entries;
+} Over;
+
+static void over_free(Over *o) { free(o->kid); free(o->mode); free(o->value); free(o->entry); free(o->at); }
+
+static int over_make(const Exec *e, const int64_t *nd, int64_t first, int64_t nk, int64_t back, int64_t n,
+                     int64_t reps, const Pending *pending, int64_t n_pending, Over *o) {
+    int64_t n_own = nd[0] == REPEAT ? nd[9] : 0, cap = n_own + n_pending;
+    o->kid = malloc((size_t)n * sizeof(int64_t));
+    o->mode = malloc((size_t)n * sizeof(int64_t));
+    o->value = malloc((size_t)n * sizeof(double));
+    o->entry = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(Pending));
+    o->at = malloc((size_t)(cap > 0 ? cap : 1) * sizeof(int64_t));
+    o->n_entries = 0;
+    if (!o->kid || !o->mode || !o->value || !o->entry || !o->at) return -1;
+    for (int64_t i = 0; i < n; i++) {
+        int64_t c = child_of(nd, first, nk, back, i);
+        o->kid[i] = c; o->mode[i] = e->modes[c - 1]; o->value[i] = e->values[c - 1];
+    }
+    for (int64_t j = 0; j < n_own; j++) { /* own exceptions: the first step is copy x pattern + item */
+        int64_t id = nd[8] + j;
+        const int64_t *ov = e->overs + OVER * id;
+        int64_t item = e->steps[ov[1]];
+        if (ov[0] < reps || (ov[0] == reps && item < nd[3])) {
+            o->entry[o->n_entries] = (Pending){id, 0};
+            o->at[o->n_entries++] = ov[0] * nk + item;
+        }
+    }
+    for (int64_t j = 0; j < n_pending; j++) {
+        o->entry[o->n_entries] = pending[j];
+        o->at[o->n_entries++] = e->steps[e->overs[OVER * pending[j].id + 1] + pending[j].pos];
+    }
+    for (int64_t j = 0; j < o->n_entries; j++) { /* in order: an exception from further up wins */
+        const int64_t *ov = e->overs + OVER * o->entry[j].id;
+        int64_t i = o->at[j];
+        if (i >= n || o->entry[j].pos + 1 < ov[2]) continue; /* no such copy here, or it goes on further down */
+        if (ov[3] >= 0) { o->mode[i] = ov[3]; o->value[i] = e->ovalues[ov[5]]; }
+        if (ov[4] >= 0) o->kid[i] = ov[4];
+    }
+    return 0;
+}
+
+static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, int flip_x, int flip_y,
+                const Pending *pending, int64_t n_pending) {
     if (e->error) return;
-    const int64_t *nd = e->nodes + 8 * k;
+    const int64_t *nd = e->nodes + NODE * k;
     if (nd[0] == LEAF) {
         if (e->n_leaves >= e->max_leaves) { e->error = -3; return; }
         if (e->n_leaves == e->room) {
@@ -224,12 +284,19 @@ static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, 
     } else {
         n = nk;
     }
+    int64_t back = nk - (nd[4] ? 2 : 1);
+    Over ov = {0};
+    int over = n_pending > 0 || (nd[0] == REPEAT && nd[9] > 0);
+    if (over && over_make(e, nd, first, nk, back, n, reps, pending, n_pending, &ov)) {
+        over_free(&ov);
+        e->error = -1;
+        return;
+    }
     /* `layout` */
     double length = span > 0.0 ? span : 0.0, fixed = 0.0, weights = 0.0, scale, share;
-    int64_t back = nk - (nd[4] ? 2 : 1);
     for (int64_t i = 0; i < n; i++) {
-        int64_t c = child_of(nd, first, nk, back, i), m = e->modes[c - 1];
-        double v = e->values[c - 1];
+        int64_t c = child_of(nd, first, nk, back, i), m = over ? ov.mode[i] : e->modes[c - 1];
+        double v = over ? ov.value[i] : e->values[c - 1];
         if (m == FLT) weights += v;
         else fixed += m == REL ? v * length : v;
     }
@@ -242,31 +309,44 @@ static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, 
     }
     int flip = along_x ? flip_x : flip_y;
     double pos = flip ? hi : lo;
+    Pending *below = NULL;
+    if (over && ov.n_entries) {
+        below = malloc((size_t)ov.n_entries * sizeof(Pending));
+        if (!below) { over_free(&ov); e->error = -1; return; }
+    }
     for (int64_t i = 0; i < n; i++) {
         int reflected = nd[0] == MIRROR && i >= nk;
-        int64_t c = child_of(nd, first, nk, back, i), m = e->modes[c - 1];
-        double v = e->values[c - 1], size, a, b;
+        int64_t c = over ? ov.kid[i] : child_of(nd, first, nk, back, i), m = over ? ov.mode[i] : e->modes[c - 1];
+        double v = over ? ov.value[i] : e->values[c - 1], size, a, b;
         size = m == FLT ? v * share : m == REL ? v * length * scale : v * scale;
         if (flip) { a = i == n - 1 ? lo : pos - size; b = pos; pos = a; }
         else { a = pos; b = i == n - 1 ? hi : pos + size; pos = b; }
         int fx = flip_x, fy = flip_y;
         if (reflected) { if (along_x) fx = !fx; else fy = !fy; }
-        if (along_x) run(e, c, a, y0, b, y1, fx, fy);
-        else run(e, c, x0, a, x1, b, fx, fy);
-        if (e->error) return;
+        int64_t n_below = 0;
+        for (int64_t j = 0; below && j < ov.n_entries; j++) /* the exceptions that go on into this child */
+            if (ov.at[j] == i && ov.entry[j].pos + 1 < e->overs[OVER * ov.entry[j].id + 2])
+                below[n_below++] = (Pending){ov.entry[j].id, ov.entry[j].pos + 1};
+        if (along_x) run(e, c, a, y0, b, y1, fx, fy, below, n_below);
+        else run(e, c, x0, a, x1, b, fx, fy, below, n_below);
+        if (e->error) break;
     }
+    free(below);
+    if (over) over_free(&ov);
 }
 
 /* Execute the tree on [0, extent_x) x [0, extent_y) (the procedure's size), round the leaves' edges to whole
  * pixels (half to even), clip them to the width x height image, drop background and empty ones and flatten the rest
  * (mode as in `facaid_flatten`). Returns the row count as `facaid_flatten` does, or -3 for more than max_leaves
  * leaves, -4 for a "fill" repeat whose pattern has no length (the Python executor then reports either). */
-int64_t facaid_execute(const int64_t *nodes, const int64_t *modes, const double *values, double extent_x,
-                       double extent_y, int64_t width, int64_t height, int64_t max_count, int64_t max_leaves,
-                       const int64_t *priority, int mode, int64_t *result, int64_t cap) {
-    Exec e = {nodes, modes, values, max_count, max_leaves, 0, 1024, malloc(1024 * 5 * sizeof(double)), 0};
+int64_t facaid_execute(const int64_t *nodes, const int64_t *modes, const double *values, const int64_t *overs,
+                       const int64_t *steps, const double *ovalues, double extent_x, double extent_y, int64_t width,
+                       int64_t height, int64_t max_count, int64_t max_leaves, const int64_t *priority, int mode,
+                       int64_t *result, int64_t cap) {
+    Exec e = {nodes, modes, values, overs, steps, ovalues, max_count, max_leaves, 0, 1024,
+              malloc(1024 * 5 * sizeof(double)), 0};
     if (!e.leaves) return -1;
-    run(&e, 0, 0.0, 0.0, extent_x, extent_y, 0, 0);
+    run(&e, 0, 0.0, 0.0, extent_x, extent_y, 0, 0, NULL, 0);
     if (e.error) { free(e.leaves); return e.error; }
     int64_t *rows = malloc((size_t)(e.n_leaves > 0 ? e.n_leaves : 1) * 5 * sizeof(int64_t)), n = 0;
     if (!rows) { free(e.leaves); return -1; }

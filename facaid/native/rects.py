@@ -26,6 +26,13 @@ _RULES = {"leaf": 0, "split": 1, "repeat": 2, "mirror": 3}
 _SIZE_MODES = {"abs": 0, "rel": 1, "flt": 2}
 
 
+class _Unused:  # the size an exception's node holds in the arrays: never read
+    mode, value = "abs", 0.0
+
+
+_UNUSED = _Unused()
+
+
 def _declare(lib: ctypes.CDLL) -> None:
     lib.facaid_flatten.restype = ctypes.c_int64
     lib.facaid_flatten.argtypes = [ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_int64, ctypes.c_void_p,
@@ -33,7 +40,8 @@ def _declare(lib: ctypes.CDLL) -> None:
     lib.facaid_rects_json.restype = ctypes.c_int64
     lib.facaid_rects_json.argtypes = [ctypes.c_void_p, ctypes.c_int64, ctypes.c_char_p, ctypes.c_void_p, ctypes.c_int64]
     lib.facaid_execute.restype = ctypes.c_int64
-    lib.facaid_execute.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double,
+    lib.facaid_execute.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
+                                   ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double,
                                    ctypes.c_double, ctypes.c_int64, ctypes.c_int64, ctypes.c_int64, ctypes.c_int64,
                                    ctypes.c_void_p, ctypes.c_int, ctypes.c_void_p, ctypes.c_int64]
 
@@ -68,25 +76,38 @@ def _call(fn, cap: int, row: tuple[int, ...] = (5,), dtype=np.int64) -> np.ndarr
         cap = n
 
 
-def _tree(root) -> tuple[list, np.ndarray, np.ndarray, np.ndarray]:
-    """The tree as `rects.c` reads it: (nodes breadth first, node records, size modes, size values)."""
+def _tree(root) -> tuple[list, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The tree as `rects.c` reads it: (nodes breadth first, node records, size modes, size values, exceptions,
+    their paths, their size values)."""
     nodes: list[int] = []
     sizes: list = []
+    overs: list[int] = []
+    steps: list[int] = []
+    ovalues: list[float] = []
     queue = [root]
     for node in queue:  # breadth first: a node's children are consecutive, and node k's size is at k - 1
         kids = node.children
         if node.rule == "leaf":  # most nodes are
-            nodes += (0, 0, 0, 0, 0, LABEL_ID[node.label] if node.label else 0, 0, 0)
+            nodes += (0, 0, 0, 0, 0, LABEL_ID[node.label] if node.label else 0, 0, 0, 0, 0)
             continue
         count = node.count
         nodes += (_RULES[node.rule], node.axis == "y", -1 if count == "fill" else count or 0, node.tail,
-                  node.center, 0, len(queue), len(kids))
+                  node.center, 0, len(queue), len(kids), len(overs) // 6, len(node.exceptions))
         queue += kids
         sizes += node.sizes
+        for o in node.exceptions:  # their nodes queue after the children, with an unused size each
+            overs += (o.copy, len(steps), len(o.path), -1 if o.size is None else _SIZE_MODES[o.size.mode],
+                      -1 if o.node is None else len(queue), len(ovalues))
+            steps += o.path
+            ovalues.append(0.0 if o.size is None else o.size.value)
+            if o.node is not None:
+                queue.append(o.node)
+                sizes.append(_UNUSED)
     modes = [_SIZE_MODES[s.mode] for s in sizes] or [0]
     values = [s.value for s in sizes] or [0.0]
     return (queue, np.array(nodes, dtype=np.int64), np.array(modes, dtype=np.int64),
-            np.array(values, dtype=np.float64))
+            np.array(values, dtype=np.float64), np.array(overs or [0], dtype=np.int64),
+            np.array(steps or [0], dtype=np.int64), np.array(ovalues or [0.0], dtype=np.float64))
 
 
 def executed_rows(root, extent: tuple[float, float], max_count: int, max_leaves: int,
@@ -98,10 +119,11 @@ def executed_rows(root, extent: tuple[float, float], max_count: int, max_leaves:
     lib = library()
     if lib is None:
         return None
-    queue, tree, modes, values = _tree(root)
+    queue, tree, modes, values, overs, steps, ovalues = _tree(root)
     width, height = round(extent[0]), round(extent[1])
     return _call(lambda out, cap: lib.facaid_execute(
-        tree.ctypes.data, modes.ctypes.data, values.ctypes.data, float(extent[0]), float(extent[1]), width, height,
+        tree.ctypes.data, modes.ctypes.data, values.ctypes.data, overs.ctypes.data, steps.ctypes.data,
+        ovalues.ctypes.data, float(extent[0]), float(extent[1]), width, height,
         max_count, max_leaves, _PRIORITY.ctypes.data, _MODES[wall], out.ctypes.data, cap), max(1024, 8 * len(queue)))
 
 

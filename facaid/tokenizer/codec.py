@@ -85,8 +85,11 @@ class Tokenizer:
         return out
 
     def encode_procedure(self, proc: Procedure) -> tuple[list[int], list[int]]:
-        """(token ids with BOS and EOS, local index of each token within its node group)."""
+        """(token ids with BOS and EOS, local index of each token within its node group). A repeat's exceptions are
+        not in the model's grammar (the structure reader writes them): such a tree raises ValueError."""
         v, c = self.vocab, self.config
+        if any(n.exceptions for _, n in proc.nodes()):
+            raise ValueError("the model's grammar has no exceptions of repeats; this procedure has some")
         ids, local = [BOS], [0]
         fills = fill_counts(proc) if any(n.count == "fill" for _, n in proc.nodes()) else {}
         queue: deque[Node] = deque([proc.root])

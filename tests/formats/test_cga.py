@@ -5,11 +5,12 @@ import re
 
 import numpy as np
 import pytest
+from grammar_helpers import example, facade
 
 from facaid.cga import LEAF_RULES, default_scale, procedure_cga
 from facaid.generator import generate
 from facaid.grammar.execute import execute
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.procedure import Node, Override, Procedure, Size
 from facaid.labels import LABEL_ID, PALETTE
 
 COLOUR_LABEL = {"#{:02x}{:02x}{:02x}".format(*rgb): name for name, rgb in PALETTE.items()}
@@ -17,9 +18,25 @@ RULE_LABEL = {rule: label for label, rule in LEAF_RULES.items()}
 
 
 def parse_rules(text: str) -> dict[str, str]:
-    rules = dict(re.findall(r"^(\w+) -->\n\t(.+)$", text, flags=re.M))
+    """Each rule's body: one line, or the lines of a ``case`` rule joined by newlines."""
+    rules = {name: "\n".join(line.strip() for line in body.strip("\n").split("\n"))
+             for name, body in re.findall(r"^(\w+) -->\n((?:\t.*\n?)+)", text, flags=re.M)}
     assert "@StartRule\nFacade -->" in text
     return rules
+
+
+def pick_case(body: str, index: int, total: int) -> str:
+    """The rule a ``case split.index == i : A ... else : B`` body picks for this part of its split."""
+    lines = body.split("\n")
+    for condition, rule in zip(lines[::2], lines[1::2], strict=True):
+        if condition == "else :":
+            return rule
+        found = re.fullmatch(r"case (split\.total - 1 - )?split\.index == (\d+) :", condition)
+        assert found, condition
+        here = total - 1 - index if found.group(1) else index
+        if here == int(found.group(2)):
+            return rule
+    raise AssertionError(f"no case for part {index} of {total}: {body}")
 
 
 def parse_group(tokens: list[str], i: int) -> tuple[tuple, int]:
@@ -90,10 +107,13 @@ def run_cga(text: str, width_m: float, height_m: float, **overrides: float
     attrs = attributes(text) | overrides
     leaves = []
 
-    def apply(name: str, box: tuple[float, float, float, float]) -> None:
+    def apply(name: str, box: tuple[float, float, float, float], index: int = 0, total: int = 1) -> None:
         if name in RULE_LABEL and name not in rules:
             raise AssertionError(f"label rule {name} is not written")
         body = rules[name]
+        if body.startswith("case "):
+            apply(pick_case(body, index, total), box, index, total)
+            return
         if body == "NIL":
             return
         colour = re.fullmatch(r'color\("(#[0-9a-f]{6})"\)', body)
@@ -110,18 +130,22 @@ def run_cga(text: str, width_m: float, height_m: float, **overrides: float
                   for t in tokens]
         group, end = parse_group(tokens, 0)
         assert end == len(tokens)
-        place(group, split.group(1), box)
+        parts: list[tuple[str, tuple[float, float, float, float]]] = []
+        place(group, split.group(1), box, parts)
+        for k, (item, sub) in enumerate(parts):  # split.index counts every shape of the split, groups flattened
+            if (sub[2] - sub[0] if split.group(1) == "x" else sub[3] - sub[1]) > 0:
+                apply(item, sub, k, len(parts))
 
-    def place(group: tuple, axis: str, box: tuple[float, float, float, float]) -> None:
+    def place(group: tuple, axis: str, box: tuple[float, float, float, float], parts: list) -> None:
         x0, y0, x1, y1 = box
         lo, hi = (x0, x1) if axis == "x" else (y0, y1)
         pos = lo
         for item, length in lay_out(group, hi - lo):
             sub = (pos, y0, pos + length, y1) if axis == "x" else (x0, pos, x1, pos + length)
             if isinstance(item, tuple):
-                place(item, axis, sub)
-            elif length > 0:
-                apply(item, sub)
+                place(item, axis, sub, parts)
+            else:
+                parts.append((item, sub))
             pos += length
         assert pos == pytest.approx(hi, abs=1e-3)
 
@@ -282,3 +306,20 @@ def test_no_part_of_a_split_is_under_a_centimetre():
     drawn = run_cga(text, 2.0, 2.0)
     window = [leaf for leaf in drawn if leaf[0] == "window"][0]
     assert window[1] == pytest.approx(0.0) and window[3] == pytest.approx(1.004, abs=1e-3)  # it took the 4 mm
+
+
+def test_exceptions_become_variants_picked_by_split_index():
+    """A repeat whose copies differ by a node keeps its repeat split and picks each copy's rule by
+    ``split.index`` (counted from the top along y, where CGA's y goes up); copies that differ in size are written
+    out; either way the rules draw the procedure's rectangles, and the wrong pick fails the check."""
+    deep = facade([Override(1, (0, 3, 1, 1), node=Node.leaf("blind")), Override(0, (0, 4), node=Node.leaf("door"))],
+                  bays=[Override(2, (0, 1, 0), node=Node.leaf("deco"))])
+    text = procedure_cga(deep, scale=0.02)
+    assert "case split.total - 1 - split.index == 1 :" in text and "case split.index == 3 :" in text
+    assert "}*" in text and "_v1" in text
+    assert_same_leaves(deep, text, 0.02)
+    broken = text.replace("split.index == 3 :", "split.index == 2 :")
+    with pytest.raises(AssertionError):
+        assert_same_leaves(deep, broken, 0.02)
+    sized = example()
+    assert_same_leaves(sized, procedure_cga(sized, scale=0.02), 0.02)

@@ -1,0 +1,282 @@
+"""Repeats that allow exceptions: a copy that differs from its siblings by a delta (its size, or one node of it
+replaced) stays a copy of the repeat. Checked against the plain split the same facade is written as, in the C
+executor against the Python one, the torch executor against both, and JSON against its schema."""
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+from grammar_helpers import example, facade, leaf, plain_facade
+
+import facaid.grammar as grammar_pkg
+from facaid.generator import generate_procedure
+from facaid.grammar.differentiable import compile_plan, execute_plan
+from facaid.grammar.execute import execute, first_boxes, flat_rows, leaf_array
+from facaid.grammar.layout import count_leaves
+from facaid.grammar.procedure import (
+    Node,
+    Override,
+    Procedure,
+    ProcedureError,
+    Size,
+    _expanded_count,
+    _pattern_child,
+    recount,
+    validate,
+)
+from facaid.native import rects
+from facaid.parameters import named_parameters, normalised, set_parameter
+from facaid.segmentation import flatten_array_numpy, rasterize
+from facaid.tokenizer import Tokenizer
+
+needs_c = pytest.mark.skipif(rects.library() is None, reason="no C compiler to build the rectangles library")
+
+
+def label_map(proc: Procedure) -> np.ndarray:
+    from facaid.grammar.execute import to_segmentation
+    return rasterize(to_segmentation(proc))
+
+
+def test_a_repeat_with_exceptions_draws_the_facade_written_out():
+    assert np.array_equal(label_map(example()), label_map(plain_facade()))
+    assert not np.array_equal(label_map(example()), label_map(facade([])))
+
+
+def test_json_round_trip_and_schema():
+    jsonschema = pytest.importorskip("jsonschema")
+    proc = example()
+    text = proc.to_json()
+    again = Procedure.from_json(text)
+    assert again.to_json() == text
+    assert again.root.children[1].exceptions[0] == Override(1, (0, 3, 1, 1), None, leaf("blind"))
+    schema = json.loads((Path(grammar_pkg.__file__).parent / "procedure.schema.json").read_text())
+    jsonschema.validate(json.loads(text), schema)
+    bad = json.loads(text)
+    bad["root"]["children"][1]["exceptions"][0].pop("node")
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(bad, schema)
+    with pytest.raises(ProcedureError, match="changes nothing"):
+        Procedure.from_dict(bad)
+
+
+def _mutated(change) -> dict:
+    obj = example().to_dict()
+    change(obj["root"]["children"][1]["exceptions"])
+    return obj
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (lambda e: e[0].update(copy=5), r"copy must be a copy of the repeat, 0 to 4"),
+    (lambda e: e[0].update(copy=True), r"copy must be a copy"),
+    (lambda e: e[0].update(path=[]), r"path must be a list of 1 to 32 indices"),
+    (lambda e: e[0].update(path=[1]), r"path\[0\] must be a pattern item, 0 to 0"),
+    (lambda e: e[0].update(path=[0, 5]), r"path\[1\] is 5, but that node lays out 5 children"),
+    (lambda e: e[0].update(path=[0, 3, 1, 1, 0]), r"path\[4\] goes below a leaf"),
+    (lambda e: e[0].update(size=["rel", 2]), r"exceptions\[0\].size is a relative size above 1"),
+    (lambda e: e[0].update(colour="red"), r"unexpected key\(s\): colour"),
+    (lambda e: e.append(dict(e[0])), r"names copy 1 at path \[0, 3, 1, 1\] twice"),
+    (lambda e: e[0].update(copy=4, path=[0]), r"copy 4 is the tail, which lays out nothing"),
+    (lambda e: e[0]["node"].update(label="tree"), r"node root/1/!0: leaf label 'tree'"),
+])
+def test_bad_exceptions_are_refused_by_name(change, message):
+    with pytest.raises(ProcedureError, match=message):
+        Procedure.from_dict(_mutated(change))
+
+
+def test_exceptions_only_on_repeats():
+    obj = example().to_dict()
+    obj["root"]["exceptions"] = []
+    with pytest.raises(ProcedureError, match="unexpected key"):
+        Procedure.from_dict(obj)
+
+
+def test_the_tail_is_the_copy_after_the_last():
+    """``copy == count`` names the tail; an item the tail does not lay out is refused."""
+    row = Node.repeat("x", 3, [(Size("abs", 8), leaf("pillar")), (Size("flt", 50), leaf("window"))], tail=1)
+    row.exceptions = [Override(3, (0,), node=leaf("deco"))]
+    proc = Procedure(200, 50, row)
+    validate_round_trip(proc)
+    assert [lab for lab, *_ in execute(proc)][-1] == 8  # deco
+    row.exceptions = [Override(3, (1,), node=leaf("deco"))]
+    with pytest.raises(ProcedureError, match="is the tail, which lays out items 0 to 0"):
+        Procedure.from_dict(proc.to_dict())
+
+
+def validate_round_trip(proc: Procedure) -> None:
+    assert Procedure.from_json(proc.to_json()).to_json() == proc.to_json()
+
+
+def test_a_fill_repeat_ignores_copies_it_does_not_lay_out():
+    row = Node.repeat("x", "fill", [(Size("flt", 50), leaf("window"))])
+    row.exceptions = [Override(1, (0,), node=leaf("door")), Override(6, (0,), node=leaf("shop"))]
+    narrow, wide = Procedure(200, 50, row), Procedure(400, 50, row)
+    assert [lab for lab, *_ in execute(narrow)] == [2, 3, 2, 2]
+    assert [lab for lab, *_ in execute(wide)] == [2, 3, 2, 2, 2, 2, 11, 2]
+    assert count_leaves(row, 400, 50) == 8
+
+
+def test_an_exception_from_further_up_wins():
+    """A column's exception (on the row) and a cell's (on the floors) at the same node: the cell's applies."""
+    proc = facade([Override(2, (0, 1), node=leaf("door"))], bays=[Override(1, (0,), node=leaf("shop"))])
+    labels = [lab for lab, *_ in execute(proc)]
+    assert labels.count(3) == 1 and labels.count(11) == 3  # a door in floor 2, a shop in the other three
+
+
+def test_parameters_include_the_exceptions_sizes():
+    proc = example()
+    values = proc.parameters()
+    assert len(values) == sum(len(n.sizes) for _, n in proc.nodes()) + 3
+    assert proc.with_parameters(values).to_dict() == proc.to_dict()
+    moved = proc.with_parameters([v * 1.1 for v in values])
+    assert moved.root.children[1].exceptions[1].size == Size("flt", 120 * 1.1)
+    paths = [p for p, _ in proc.nodes()]
+    assert "root/1/!0" in paths and "root/1/!2" in paths
+
+
+def test_first_boxes_reach_the_exceptions_nodes():
+    proc = example()
+    boxes = first_boxes(proc)
+    blind = proc.root.children[1].exceptions[0].node
+    assert boxes[id(blind)][1] > 100  # the blind's box is on floor 1, not where the typical copy was first seen
+
+
+def random_exceptions(proc: Procedure, rng: np.random.Generator, n: int = 6) -> Procedure:
+    """``proc`` with up to ``n`` random exceptions on its repeats: a size, a leaf of another label or both, at a
+    random depth of a random copy."""
+    proc = Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
+    repeats = [node for _, node in proc.nodes() if node.rule == "repeat"]
+    if not repeats:
+        return proc
+    labels = ["window", "blind", "facade", "door", "balcony", "deco"]
+    for _ in range(n):
+        node = repeats[rng.integers(len(repeats))]
+        copies = 8 if node.count == "fill" else node.count
+        path = [int(rng.integers(len(node.children)))]
+        target = node.children[path[0]]
+        while target.rule != "leaf" and rng.random() < 0.6:
+            i = int(rng.integers(min(_expanded_count(target), 40)))
+            path.append(i)
+            target = _pattern_child(target, i)
+        size = Size("flt" if rng.random() < 0.5 else "abs", float(rng.uniform(2, 60))) if rng.random() < 0.6 else None
+        new = leaf(labels[rng.integers(len(labels))]) if size is None or rng.random() < 0.5 else None
+        override = Override(int(rng.integers(copies)), tuple(path), size, new)
+        if all((o.copy, o.path) != (override.copy, override.path) for o in node.exceptions):
+            node.exceptions.append(override)
+    return Procedure.from_dict(proc.to_dict())
+
+
+def reference_rows(proc: Procedure, wall: str = "pieces") -> np.ndarray:
+    return flatten_array_numpy(round(proc.width), round(proc.height), leaf_array(proc, execute(proc)), wall)
+
+
+@needs_c
+@pytest.mark.parametrize("style", [None, "wings", "tenement", "commercial"])
+def test_the_c_executes_exceptions_as_python_does(style):
+    rng = np.random.default_rng(7)
+    changed = 0
+    for seed in range(40):
+        plain = generate_procedure(seed, style)
+        proc = random_exceptions(plain, rng)
+        assert np.array_equal(flat_rows(proc), reference_rows(proc))
+        got = rects.executed_rows(proc.root, (proc.width, proc.height), 256, 100_000, wall="footprint")
+        assert np.array_equal(got, reference_rows(proc, "footprint"))
+        changed += not np.array_equal(flat_rows(proc), flat_rows(plain))
+    assert changed > 20  # the exceptions do change most of these facades
+
+
+@needs_c
+def test_the_c_executes_the_example():
+    proc = example()
+    assert np.array_equal(flat_rows(proc), reference_rows(proc))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_torch_executor_shares_and_separates_parameters(seed):
+    """Moved parameters (the exceptions' sizes among them) give the numeric executor's boxes, and gradients
+    reach the exceptions' sizes."""
+    proc = random_exceptions(generate_procedure(seed), np.random.default_rng(seed), n=10)
+    plan = compile_plan(proc)
+    rng = np.random.default_rng(seed)
+    values = [v if s == "rel" else v * rng.uniform(0.7, 1.3)
+              for v, s in zip(proc.parameters(), [s.mode for _, n in proc.nodes() for s in n.own_sizes()],
+                              strict=True)]
+    want = torch.tensor([leaf[1:] for leaf in execute(proc.with_parameters(values))], dtype=torch.float64)
+    params = torch.tensor(values, dtype=torch.float64, requires_grad=True)
+    got = execute_plan(plan, params)
+    torch.testing.assert_close(got, want, rtol=0, atol=1e-7)
+    got.sum().backward()
+    assert params.grad is not None
+
+
+def test_gradcheck_with_exceptions():
+    proc = example()
+    plan = compile_plan(proc)
+    params = plan.values.clone().requires_grad_(True)
+    torch.autograd.gradcheck(lambda x: execute_plan(plan, x, with_overflow=True), (params,))
+    sizes = len(proc.parameters())
+    grad = torch.autograd.functional.jacobian(lambda x: execute_plan(plan, x), plan.values)
+    assert grad.shape[-1] == sizes
+    taller = sum(len(n.sizes) for _, n in proc.nodes() if n is proc.root or n is proc.root.children[1]) + 1
+    assert grad[..., taller].abs().sum() > 0  # floor 3's own height moves boxes
+
+
+def test_copies_keep_sharing_their_pattern():
+    """An exception adds its own leaves only: the typical copies still cost one subtree."""
+    proc = example()
+    typical = sum(1 for _, n in facade([]).nodes() if n.rule == "leaf")
+    assert sum(1 for _, n in proc.nodes() if n.rule == "leaf") == typical + 2
+
+
+def test_the_model_grammar_has_no_exceptions():
+    with pytest.raises(ValueError, match="no exceptions"):
+        Tokenizer().encode_procedure(example())
+    Tokenizer().encode_procedure(facade([]))
+
+
+def test_copy_is_deep():
+    proc = example()
+    twin = proc.root.copy()
+    twin.children[1].exceptions[0].node.label = "door"
+    assert proc.root.children[1].exceptions[0].node.label == "blind"
+    assert copy.deepcopy(proc).to_json() == proc.to_json()
+
+
+def _counts(proc: Procedure) -> dict[str, int]:
+    labels = [lab for lab, x0, y0, x1, y1 in execute(proc) if x1 - x0 > 0.5 and y1 - y0 > 0.5]
+    return {name: labels.count(i) for name, i in (("window", 2), ("blind", 7), ("sill", 5))}
+
+
+def test_named_parameters_edit_the_typical_copies():
+    """floors + 1 adds a typical floor, bays + 1 a typical tile to every floor; the exceptions stay where they
+    were (a copy removed takes its own with it), and the lengths change the typical copies only."""
+    proc = example()
+    assert np.array_equal(label_map(normalised(proc)), label_map(proc))
+    assert _counts(proc) == {"window": 19, "blind": 1, "sill": 19}
+    more = set_parameter(proc, "floors", 5)
+    assert _counts(more) == {"window": 24, "blind": 1, "sill": 24}
+    assert more.height == pytest.approx(proc.height + 360 * 90 / 390, abs=0.01)  # one typical floor taller
+    assert [o.copy for o in more.root.children[1].exceptions] == [1, 3, 0]
+    fewer = set_parameter(proc, "floors", 3)
+    assert [o.copy for o in fewer.root.children[1].exceptions] == [1, 0]
+    assert _counts(fewer) == {"window": 14, "blind": 1, "sill": 14}
+    wider = set_parameter(proc, "bays", 6)
+    assert _counts(wider) == {"window": 23, "blind": 1, "sill": 23}
+    typical = {p.name: p.value for p in named_parameters(proc)}["floor_height"]
+    assert typical == pytest.approx(360 * 90 / 390, abs=0.01)  # the typical floor, not the taller one
+    taller = set_parameter(proc, "floor_height", 120)
+    assert {p.name: p.value for p in named_parameters(taller)}["floor_height"] == pytest.approx(120)
+    assert taller.height == pytest.approx(proc.height + 3 * (120 - typical), abs=0.01)
+    own = [o.size.value for o in taller.root.children[1].exceptions if o.size is not None and o.path == (0,)]
+    assert own == [pytest.approx(360 * 120 / 390, abs=0.01)]  # the taller floor keeps its own height
+
+
+def test_a_count_change_keeps_paths_through_the_repeat():
+    """A tile exception of floor 1 sits at tile 3 of the row: with one bay fewer it stays; with tile 3 gone it goes."""
+    proc = facade([Override(1, (0, 3, 1, 1), node=leaf("blind")), Override(1, (0, 1, 1, 1), node=leaf("door"))])
+    row = proc.root.children[1].children[0]
+    recount(proc.root, row, 3)
+    assert [o.path for o in proc.root.children[1].exceptions] == [(0, 1, 1, 1)]
+    validate(proc)
