@@ -31,6 +31,7 @@ class _Unused:  # the size an exception's node holds in the arrays: never read
 
 
 _UNUSED = _Unused()
+_NONE_I, _NONE_F = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.float64)  # a tree without exceptions
 
 
 def _declare(lib: ctypes.CDLL) -> None:
@@ -95,7 +96,7 @@ def _tree(root) -> tuple[list, np.ndarray, np.ndarray, np.ndarray, np.ndarray, n
                   node.center, 0, len(queue), len(kids), len(overs) // 6, len(node.exceptions))
         queue += kids
         sizes += node.sizes
-        for o in node.exceptions:  # their nodes queue after the children, with an unused size each
+        for o in node.exceptions or ():  # their nodes queue after the children, with an unused size each
             overs += (o.copy, len(steps), len(o.path), -1 if o.size is None else _SIZE_MODES[o.size.mode],
                       -1 if o.node is None else len(queue), len(ovalues))
             steps += o.path
@@ -105,9 +106,12 @@ def _tree(root) -> tuple[list, np.ndarray, np.ndarray, np.ndarray, np.ndarray, n
                 sizes.append(_UNUSED)
     modes = [_SIZE_MODES[s.mode] for s in sizes] or [0]
     values = [s.value for s in sizes] or [0.0]
+    if not overs:  # most trees: no arrays to make
+        return (queue, np.array(nodes, dtype=np.int64), np.array(modes, dtype=np.int64),
+                np.array(values, dtype=np.float64), _NONE_I, _NONE_I, _NONE_F)
     return (queue, np.array(nodes, dtype=np.int64), np.array(modes, dtype=np.int64),
-            np.array(values, dtype=np.float64), np.array(overs or [0], dtype=np.int64),
-            np.array(steps or [0], dtype=np.int64), np.array(ovalues or [0.0], dtype=np.float64))
+            np.array(values, dtype=np.float64), np.array(overs, dtype=np.int64), np.array(steps, dtype=np.int64),
+            np.array(ovalues, dtype=np.float64))
 
 
 def executed_rows(root, extent: tuple[float, float], max_count: int, max_leaves: int,
