@@ -146,15 +146,29 @@ def _count_of(inst: _Instances, proc: Procedure, role: str) -> tuple[int, list[s
 
 
 def _bays(proc: Procedure, inst: _Instances) -> tuple[int, list[str]] | None:
-    """How many tiles the first floor that has any holds, and the paths of its outermost tile nodes."""
+    """How many tiles the first floor that has any holds as laid out without exceptions (a copy that an exception
+    replaces is still a tile of its row), and the paths of its outermost tile nodes."""
     for _, floor in proc.nodes():
         if floor.role not in ("floor", "ground") or not inst.outer.get(id(floor)):
             continue
-        tiles = [(p, n) for p, n in floor.walk(inst.path[id(floor)]) if n.role == "tile" and inst.outer[id(n)]]
+        tiles = [(p, n) for p, n in floor.walk(inst.path[id(floor)]) if n.role == "tile" and inst.outer.get(id(n))]
         if tiles:
-            per_floor = sum(inst.count[id(n)] for _, n in tiles) // max(1, inst.count[id(floor)])
-            return per_floor, [p for p, _ in tiles]
+            return _typical_tiles(floor), [p for p, _ in tiles]
     return None
+
+
+def _typical_tiles(node: Node) -> int:
+    """The tiles under ``node`` as its typical copies lay them out: each repeat's count times its pattern's."""
+    if node.role == "tile":
+        return 1
+    if node.rule == "leaf":
+        return 0
+    inner = [_typical_tiles(c) for c in node.children]
+    if node.rule == "repeat":
+        return sum(inner) * (node.count if node.count != "fill" else 1) + sum(inner[: node.tail])
+    if node.rule == "mirror":
+        return 2 * sum(inner) - (inner[-1] if node.center else 0)
+    return sum(inner)
 
 
 def _margins(proc: Procedure, inst: _Instances) -> list[tuple[str, Node]]:
@@ -169,7 +183,7 @@ def _margins(proc: Procedure, inst: _Instances) -> list[tuple[str, Node]]:
             continue
         for i in (0, len(node.children) - 1):
             c = node.children[i]
-            if c.rule == "leaf" and c.label == "facade" and c.role is None:
+            if c.rule == "leaf" and c.label == "facade" and c.role is None and id(c) in inst.extent:
                 out.append((f"{path}/{i}", c))
     return out
 
@@ -314,7 +328,8 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             _grow(out, axis, {id(_along(nodes, path, axis)): value - p.value for path in p.nodes})
         else:
             side = 0 if axis == "x" else 1
-            _grow(out, axis, {id(n): value - inst.extent[id(n)][side] for n in (nodes[path] for path in p.nodes)})
+            _grow(out, axis, {id(n): value - inst.extent[id(n)][side] for n in (nodes[path] for path in p.nodes)
+                              if id(n) in inst.extent})  # a node an exception replaces everywhere has no length
     else:
         role, axis = ("floor", "y") if name == "floors" else ("tile", "x")
         if name == "bays":  # every row of tiles, scaled in proportion
@@ -327,7 +342,11 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         own: dict[int, float] = {}
         change = int(value) - int(p.value)
         for _, node in repeats:
+            if id(node) not in inst.extent:  # a row an exception replaces wherever it would be laid out
+                continue
             delta = change
+            if name == "bays" and not p.value:
+                raise ValueError("bays cannot change here: no floor holds its tiles (edit the tree instead)")
             if name == "bays":  # rows of another length change in proportion, by one at least
                 delta = round(change * node.count / p.value) or (1 if change > 0 else -1 if change < 0 else 0)
             new = node.count + delta

@@ -15,7 +15,7 @@ import numpy as np
 from facaid.grammar.guillotine import chunked_split, clean_cuts, cut_rects, least_crossed_cut, partition
 from facaid.grammar.procedure import Node, Procedure, Size
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS
-from facaid.segmentation import Segmentation
+from facaid.segmentation import Segmentation, decompose_grid
 
 
 def _sizes(lengths: list[int], labels: list[int | None]) -> list[Size]:
@@ -63,3 +63,12 @@ def procedure_from_segmentation(seg: Segmentation) -> Procedure:
     rects = partition(seg)
     root = _build(rects, (0, 0, seg.width, seg.height), prefer_y=True)
     return Procedure(seg.width, seg.height, root, {"source": "guillotine decomposition"})
+
+
+def tree_of_label_map(label_map: np.ndarray, prefer_y: bool = True) -> Node:
+    """The exact tree of a label map (H, W) of label ids, background included: executing it on a W x H region
+    paints the map back, pixel for pixel."""
+    h, w = label_map.shape
+    rects = decompose_grid(label_map.astype(np.int64) + 1)  # + 1: background is kept as a rectangle too
+    rects[:, 0] -= 1
+    return _build(rects, (0, 0, w, h), prefer_y)

@@ -400,10 +400,16 @@ def _expanded_count(node: Node) -> int:
 
 
 def _pattern_child(node: Node, i: int) -> Node:
-    """The node expanded child ``i`` of ``node`` is (`layout.expand`'s order)."""
+    """The node expanded child ``i`` of ``node`` is (`layout.expand`'s order), or the node an exception of ``node``
+    puts in its place (an exception of a whole copy's item: a path through it goes on in that node)."""
     k = len(node.children)
     if node.rule == "mirror" and i >= k:
         return node.children[k - (2 if node.center else 1) - (i - k)]
+    if node.exceptions:
+        copy, item = divmod(i, k)
+        for o in node.exceptions:
+            if o.node is not None and o.copy == copy and o.path == (item,):
+                return o.node
     return node.children[i % k]
 
 

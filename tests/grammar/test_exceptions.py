@@ -165,6 +165,10 @@ def random_exceptions(proc: Procedure, rng: np.random.Generator, n: int = 6) -> 
         override = Override(int(rng.integers(copies)), tuple(path), size, new)
         if all((o.copy, o.path) != (override.copy, override.path) for o in node.exceptions):
             node.exceptions.append(override)
+            try:  # a new whole item can leave an exception from further up without its node
+                Procedure.from_dict(proc.to_dict())
+            except ProcedureError:
+                node.exceptions.pop()
     return Procedure.from_dict(proc.to_dict())
 
 
@@ -280,3 +284,20 @@ def test_a_count_change_keeps_paths_through_the_repeat():
     recount(proc.root, row, 3)
     assert [o.path for o in proc.root.children[1].exceptions] == [(0, 1, 1, 1)]
     validate(proc)
+
+
+@pytest.mark.parametrize("style", [None, "wings", "tenement"])
+def test_every_named_parameter_on_trees_with_exceptions(style):
+    """Read and set on random exceptions: a valid procedure or a ValueError naming the problem, never another
+    error (an exception whose node is never laid out, a copy removed, a path through a replaced item)."""
+    rng = np.random.default_rng(11)
+    for seed in range(12):
+        proc = random_exceptions(generate_procedure(seed, style), rng, n=12)
+        for p in named_parameters(proc):
+            for value in (p.value + 1, p.value - 1, p.value * 1.25):
+                try:
+                    out = set_parameter(proc, p.name, value)
+                except ValueError:
+                    continue
+                validate(out)
+                flat_rows(out)
