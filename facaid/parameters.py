@@ -151,10 +151,24 @@ def _bays(proc: Procedure, inst: _Instances) -> tuple[int, list[str]] | None:
     for _, floor in proc.nodes():
         if floor.role not in ("floor", "ground") or not inst.outer.get(id(floor)):
             continue
-        tiles = [(p, n) for p, n in floor.walk(inst.path[id(floor)]) if n.role == "tile" and inst.outer.get(id(n))]
+        tiles = [(p, n) for p, n in floor.walk(inst.path[id(floor)])
+                 if n.role == "tile" and "!" not in p[len(inst.path[id(floor)]):] and _outer_tile(floor, n)]
         if tiles:
             return _typical_tiles(floor), [p for p, _ in tiles]
     return None
+
+
+def _outer_tile(floor: Node, tile: Node) -> bool:
+    """Whether ``tile`` lies in no other tile of ``floor``'s typical copy."""
+    def inside(node: Node, within: bool) -> bool | None:
+        if node is tile:
+            return not within
+        for c in node.children:
+            found = inside(c, within or node.role == "tile")
+            if found is not None:
+                return found
+        return None
+    return bool(inside(floor, False))
 
 
 def _typical_tiles(node: Node) -> int:

@@ -1,6 +1,10 @@
 """Procedures the grammar and format tests share: a facade whose repeats have exceptions."""
 
+import numpy as np
+
 from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.labels import LABEL_ID
+from facaid.segmentation import Segmentation
 
 
 def leaf(label: str) -> Node:
@@ -45,3 +49,38 @@ def example() -> Procedure:
                    Override(3, (0,), size=Size("flt", 120)),
                    Override(0, (0, 4, 1, 2), size=Size("abs", 0), node=leaf("facade"))],
                   bays=[Override(2, (0,), size=Size("flt", 90))])
+
+
+def real_like(seed: int = 0, floors: int = 5, bays: int = 6) -> Segmentation:
+    """An annotation drawn the way people draw CMP's: layered boxes, edges a few pixels off, a facade box, windows
+    with sills and hoods in rows and columns, one window's blind closed, a balcony on the second floor, a taller
+    ground floor of shops around a door, a cornice band under the roof, and sky above."""
+    rng = np.random.default_rng(seed)
+    tile, storey, top, ground = 70, 95, 60, 130
+    width, height = 30 * 2 + bays * tile, top + floors * storey + ground
+    rects = [("facade", 0, 20, width, height), ("molding", 0, top - 16, width, top - 4)]
+
+    def j(v: float) -> int:
+        return int(round(v + rng.normal(0, 1.2)))
+
+    for i in range(floors):
+        y = top + i * storey
+        if i == 1:
+            rects.append(("balcony", 24, y + 70, width - 24, y + 84))
+        for b in range(bays):
+            x = 30 + b * tile
+            rects.append(("cornice", j(x + 14), j(y + 10), j(x + 56), j(y + 18)))
+            rects.append(("window", j(x + 18), j(y + 20), j(x + 52), j(y + 72)))
+            rects.append(("sill", j(x + 15), j(y + 72), j(x + 55), j(y + 77)))
+            if (i, b) == (3, 2):
+                rects.append(("blind", j(x + 18), j(y + 20), j(x + 52), j(y + 72)))
+    y = top + floors * storey
+    for b in range(bays):
+        x = 30 + b * tile
+        if b == bays // 2:
+            rects.append(("door", j(x + 16), j(y + 30), j(x + 54), height))
+        else:
+            rects.append(("shop", j(x + 6), j(y + 24), j(x + 64), j(height - 6)))
+    rows = np.array([(LABEL_ID[label], max(0, x0), max(0, y0), min(width, max(x1, x0 + 2)),
+                      min(height, max(y1, y0 + 2))) for label, x0, y0, x1, y1 in rects], dtype=np.int64)
+    return Segmentation.from_array(width, height, rows)

@@ -15,44 +15,15 @@ from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID
 from facaid.parameters import named_parameters, set_parameter
-from facaid.segmentation import Segmentation, flatten_array
+from facaid.segmentation import Segmentation, flatten_array, region_boxes
 
 _GLASS = (LABEL_ID["window"], LABEL_ID["blind"])
 
 
-def window_boxes(rows: np.ndarray, labels: tuple[int, ...] = _GLASS) -> np.ndarray:
+def window_boxes(rows: np.ndarray) -> np.ndarray:
     """The windows of a flattened segmentation's rows (N, 5: label, x0, y0, x1, y1; a partition of the label map):
-    the bounding boxes (M, 4) of the connected regions of its window and blind pieces (pieces that share an edge
-    over a positive length are connected); with ``labels``, of the pieces of those labels."""
-    rows = np.asarray(rows, dtype=np.int64).reshape(-1, 5)
-    boxes = rows[np.isin(rows[:, 0], labels)][:, 1:]
-    n = len(boxes)
-    if n == 0:
-        return np.zeros((0, 4), dtype=np.int64)
-    parent = np.arange(n)
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    order = np.argsort(boxes[:, 0], kind="stable")  # sweep along x: only boxes that reach each other can touch
-    for a, i in enumerate(order):
-        x0, y0, x1, y1 = boxes[i]
-        for j in order[a + 1:]:
-            if boxes[j, 0] > x1:
-                break
-            ox = min(x1, boxes[j, 2]) - max(x0, boxes[j, 0])
-            oy = min(y1, boxes[j, 3]) - max(y0, boxes[j, 1])
-            if (ox >= 0 and oy > 0) or (ox > 0 and oy >= 0):
-                parent[find(i)] = find(j)
-    roots = np.array([find(i) for i in range(n)])
-    out = []
-    for r in np.unique(roots):
-        b = boxes[roots == r]
-        out.append((b[:, 0].min(), b[:, 1].min(), b[:, 2].max(), b[:, 3].max()))
-    return np.array(out, dtype=np.int64)
+    the bounding boxes (M, 4) of the connected regions of its window and blind pieces."""
+    return region_boxes(rows, _GLASS)
 
 
 def _bands(centres: np.ndarray, sizes: np.ndarray) -> int:

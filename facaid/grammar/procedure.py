@@ -435,14 +435,13 @@ def recount(root: Node, node: Node, count: int) -> None:
             continue
         kept = []
         for o in above.exceptions:
-            steps, target = list(o.path), above.children[o.path[0]]
-            for s in range(1, len(steps)):
-                if target is node:
-                    c = moved(steps[s] // k)
+            steps = list(o.path)
+            for s, target in _along_path(above, o, above.exceptions):
+                if target is node and s + 1 < len(steps):
+                    c = moved(steps[s + 1] // k)
                     if c is None:
                         break
-                    steps[s] = c * k + steps[s] % k
-                target = _pattern_child(target, steps[s])
+                    steps[s + 1] = c * k + steps[s + 1] % k
             else:
                 kept.append(o._replace(path=tuple(steps)))
         above.exceptions = kept
@@ -476,14 +475,6 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
         if copy == node.count and steps[0] >= node.tail:
             raise ProcedureError(path, f"{where}.copy {copy} is the tail, which lays out "
                                        + (f"items 0 to {node.tail - 1}" if node.tail else "nothing"))
-        target = node.children[steps[0]]
-        for k, i in enumerate(steps[1:], 1):
-            if target.rule == "leaf":
-                raise ProcedureError(path, f"{where}.path[{k}] goes below a leaf")
-            if i >= _expanded_count(target):
-                raise ProcedureError(path, f"{where}.path[{k}] is {i}, but that node lays out "
-                                           f"{_expanded_count(target)} children")
-            target = _pattern_child(target, i)
         if (copy, tuple(steps)) in seen:
             raise ProcedureError(path, f"{where} names copy {copy} at path {steps} twice")
         seen.add((copy, tuple(steps)))
@@ -502,7 +493,39 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
         if size is None and sub is None:
             raise ProcedureError(path, f"{where} changes nothing: give it a size, a node or both")
         out.append(Override(copy, tuple(steps), size, sub))
+    for e, o in enumerate(out):  # the paths, once every exception's node is known
+        problem = _path_problem(node, o, out)
+        if problem:
+            raise ProcedureError(path, f"exceptions[{e}].{problem}")
     return out
+
+
+def _along_path(node: Node, o: Override, exceptions: list[Override]) -> Iterator[tuple[int, Node]]:
+    """The nodes an exception's path runs through, (step, node reached) each: the copy's item, then each child as
+    laid out, where an exception of the same copy puts a node at a shorter path or a repeat below puts one in
+    place of a whole item (`_pattern_child`), that node."""
+    own = {e.path: e.node for e in exceptions if e.copy == o.copy and e.node is not None and e is not o}
+    target = own.get(o.path[:1], node.children[o.path[0]])
+    yield 0, target
+    for k in range(1, len(o.path)):
+        if target.rule == "leaf" or o.path[k] >= _expanded_count(target):
+            return
+        target = own.get(o.path[: k + 1]) or _pattern_child(target, o.path[k])
+        yield k, target
+
+
+def _path_problem(node: Node, o: Override, exceptions: list[Override]) -> str | None:
+    """What is wrong with an exception's path (None if nothing): a step below a leaf or past the children."""
+    reached = 0
+    parent = None
+    for k, target in _along_path(node, o, exceptions):
+        reached, parent = k, target
+    if reached == len(o.path) - 1:
+        return None
+    k = reached + 1
+    if parent.rule == "leaf":
+        return f"path[{k}] goes below a leaf"
+    return f"path[{k}] is {o.path[k]}, but that node lays out {_expanded_count(parent)} children"
 
 
 def parse_procedure(obj: Any) -> Procedure:
