@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
+from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE, STRUCTURES
 from facaid.generator import STYLE_NAMES
 from facaid.paths import DEFAULT_CHECKPOINT, DEFAULT_CMP
 
@@ -184,11 +184,15 @@ def cmd_reconstruct(args: argparse.Namespace) -> None:
     seg = Segmentation.from_dict(_read_json(args.input), clip=args.clip)
     model, tokenizer = load_model(args.checkpoint)
     result = reconstruct(seg, model=model, tokenizer=tokenizer, k=args.k, sizing=not args.no_sizing,
-                         seed=args.seed, induce=not args.no_induce)
+                         seed=args.seed, induce=not args.no_induce, structure=args.structure)
     Path(args.out).write_text(result.procedure.to_json(indent=1) + "\n")
     print(f"wrote {args.out}: pixel accuracy {100 * result.accuracy:.2f} % "
           f"(decoded {100 * result.accuracy_decoded:.2f} %), {1000 * result.timings['total']:.0f} ms, "
-          f"{result.source} structure")
+          f"{result.structure} ({result.source} structure)")
+    if result.alternative is not None:
+        other = "exact" if result.structure == "editable" else "editable"
+        print(f"the {other} procedure reproduces {100 * result.alternative_accuracy:.2f} % "
+              f"(--structure {other} writes it)")
     if args.png:
         render_segmentation(to_segmentation(result.procedure), outline=True).save(args.png)
         print(f"wrote {args.png}")
@@ -432,7 +436,8 @@ def cmd_evaluate_real(args: argparse.Namespace) -> None:
         raise CliError(f"--gallery must name a .png file (or be empty for none), got {gallery!r}")
     model, tokenizer = load_model(args.checkpoint)
     result = evaluate_real(model, tokenizer, args.data, k=args.k, limit=args.limit, gallery=gallery,
-                           progress=not args.quiet, induce=not args.no_induce, perturb=args.perturb)
+                           progress=not args.quiet, induce=not args.no_induce, perturb=args.perturb,
+                           structure=args.structure, start=args.start)
     result["checkpoint"] = str(args.checkpoint)
     print(format_summary(result))
     if gallery:
@@ -558,6 +563,9 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--k", type=int, default=DEFAULT_K, help=f"candidates decoded and reranked (default {DEFAULT_K})")
     c.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
     c.add_argument("--no-sizing", action="store_true", help="skip the sizing optimizer")
+    c.add_argument("--structure", choices=STRUCTURES, default="editable",
+                   help="editable: floors of tiles with exceptions, what the named parameters edit (default); "
+                        "exact: the annotation as drawn")
     c.add_argument("--no-induce", action="store_true",
                    help="only the model's structures (no induced structure when they fit badly)")
     c.add_argument("--clip", action="store_true", help="clip rectangles that reach outside the image")
@@ -669,6 +677,9 @@ def build_parser() -> argparse.ArgumentParser:
     r2.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), help="checkpoint directory")
     r2.add_argument("--k", type=int, default=DEFAULT_K, help=f"candidates per facade (default {DEFAULT_K})")
     r2.add_argument("--limit", type=int, help="only the first N facades")
+    r2.add_argument("--start", type=int, default=0, help="skip the first N facades (--start 189: the test half)")
+    r2.add_argument("--structure", choices=STRUCTURES, default="editable",
+                    help="which procedure to score (default editable); the other's accuracy is reported beside")
     r2.add_argument("--no-induce", action="store_true", help="only the model's structures (the model alone)")
     r2.add_argument("--perturb", type=int, metavar="SEED",
                     help="annotate each input as people do first (edges moved up to 1 %% of the side, 10 %% of the "

@@ -10,6 +10,12 @@ Before that (unless a prefix is given or ``induce`` is off) the structure induce
 (`facaid.induce`: guillotine cuts folded into repeats) is sized too and kept if it does better, and then
 the sampling is skipped. ``result.source`` says which kind of structure won.
 
+Two structures (``structure``): the model's, where it wins, is compact and editable already (a generated facade);
+where induction wins (a real facade, whose induced procedure copies the annotation as drawn: the *exact* one), the
+lattice reader (`facaid.lattice`) reads the facade as floors of tiles with exceptions, and that sized is the
+*editable* one. ``structure="editable"`` (the default) returns it with the exact one as ``alternative``;
+``"exact"`` the other way round. Where there is no lattice to read, both are the one procedure.
+
 A shortcut for annotations unlike the model's training data: when the decoded structure reproduces less than
 `FAR_OFF` of the pixels before sizing and the induced one at least `FAR_BEHIND` more, only the induced one is
 sized (``result.shortcut``): sizing the decoded structure could not close that gap, and it is the slowest stage.
@@ -28,11 +34,12 @@ import numpy as np
 import torch
 
 from facaid.decoding import Candidate, decode, ranked_candidates
-from facaid.defaults import DEFAULT_K
+from facaid.defaults import DEFAULT_K, STRUCTURES
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.induce import induce_procedure
 from facaid.labels import FACADE
+from facaid.lattice import read_lattice
 from facaid.metrics import element_leaves, procedure_accuracy, unexplained
 from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
@@ -65,11 +72,17 @@ class Reconstruction:
     source: str = "model"  # "model" (a decoded candidate) or "induced" (facaid.induce)
     shortcut: bool = False  # the decoded structure was far behind the induced one and was not sized
     denoised: bool = False  # the model's structure was kept over a closer-fitting induced one (reads_through_noise)
+    structure: str = "exact"  # what ``procedure`` is: "editable" (floors of tiles: the model's or the lattice's)
+    alternative: Procedure | None = None  # the other structure, where there are two
+    alternative_accuracy: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
-                "timings": self.timings, "retried": self.retried, "source": self.source, "shortcut": self.shortcut,
-                "denoised": self.denoised}
+        out = {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
+               "timings": self.timings, "retried": self.retried, "source": self.source, "shortcut": self.shortcut,
+               "denoised": self.denoised, "structure": self.structure}
+        if self.alternative is not None:
+            out["alternative_accuracy"] = self.alternative_accuracy
+        return out
 
 
 def fit_to_model(seg: Segmentation, tokenizer: Tokenizer) -> Segmentation:
@@ -95,11 +108,15 @@ def default_model(path: str = str(DEFAULT_CHECKPOINT)) -> tuple[FacaidModel, Tok
 def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None = None,
                 tokenizer: Tokenizer | None = None, k: int = DEFAULT_K, sizing: bool = True, seed: int = 0,
                 prefix: list[int] | None = None, retry_below: float = 0.97, retry_k: int = 8,
-                induce: bool = True, progress: Callable[[float, str], None] | None = None) -> Reconstruction:
+                induce: bool = True, progress: Callable[[float, str], None] | None = None,
+                structure: str = "editable") -> Reconstruction:
     """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object).
 
     ``progress(fraction, stage)``, when given, is told each stage as it starts (fractions from 0 to 1, roughly
-    of the time taken): decoding, sizing, and the second chance's sampling when it runs."""
+    of the time taken): decoding, sizing, and the second chance's sampling when it runs. ``structure``: which of
+    the two structures to return (see the module's docstring), the other as ``alternative``."""
+    if structure not in STRUCTURES:
+        raise ValueError(f"structure must be one of {', '.join(STRUCTURES)}, got {structure!r}")
     seg = segmentation if isinstance(segmentation, Segmentation) else Segmentation.from_dict(segmentation)
     if model is None or tokenizer is None:
         model, tokenizer = default_model()
@@ -118,20 +135,20 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     source = "model"
     if sizing:
         tell(0.5, "sizing")
-        structure, read = None, False  # the induced structure, read at most once
+        induced, read = None, False  # the induced structure, read at most once
         if induce and prefix is None and before < FAR_OFF:
-            structure, read = induce_procedure(flat), True
-        induced_before = procedure_accuracy(structure, flat) if structure is not None else None
+            induced, read = induce_procedure(flat), True
+        induced_before = procedure_accuracy(induced, flat) if induced is not None else None
         if induced_before is not None and induced_before >= before + FAR_BEHIND:
-            fitted = fit_sizes(structure, flat, before=induced_before)  # the model's structure is not sized
+            fitted = fit_sizes(induced, flat, before=induced_before)  # the model's structure is not sized
             source, shortcut, before = "induced", True, induced_before
         else:
             fitted = fit_sizes(decoded, flat, before=before)
         if fitted.accuracy < retry_below and induce and prefix is None and not shortcut:
             if not read:
-                structure = induce_procedure(flat)
-            if structure is not None:
-                other = fit_sizes(structure, flat, before=induced_before)
+                induced = induce_procedure(flat)
+            if induced is not None:
+                other = fit_sizes(induced, flat, before=induced_before)
                 if other.accuracy > fitted.accuracy:
                     if reads_through_noise(fitted.procedure, other.procedure, flat):
                         denoised = True  # the induced structure fits closer by copying the annotator's noise
@@ -150,9 +167,31 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
 
         proc, accuracy, iou = decoded, before, procedure_iou(decoded, flat)
     t3 = time.perf_counter()
-    timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, total=t3 - t0)
     proc.meta = {"source": "facaid.reconstruct", "structure": source, "k": k, "accuracy": round(accuracy, 6)}
-    return Reconstruction(proc, before, accuracy, iou, timings, retried, source, shortcut, denoised)
+    result = Reconstruction(proc, before, accuracy, iou, timings, retried, source, shortcut, denoised,
+                            "editable" if source == "model" else "exact")
+    if sizing and source != "model" and prefix is None:
+        tell(0.9, "reading the floors and bays")
+        read = read_lattice(flat)
+        if read is not None:
+            editable = fit_sizes(read, flat)
+            editable.procedure.meta = {"source": "facaid.reconstruct", "structure": "lattice", "k": k,
+                                       "accuracy": round(editable.accuracy, 6)}
+            result = _with_editable(result, editable, structure)
+    t4 = time.perf_counter()
+    timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, lattice=t4 - t3, total=t4 - t0)
+    return result
+
+
+def _with_editable(exact: Reconstruction, editable, structure: str) -> Reconstruction:
+    """``exact`` with the lattice reading (a `SizingResult`) as its other structure, the one ``structure`` names
+    first."""
+    if structure == "exact":
+        exact.alternative, exact.alternative_accuracy = editable.procedure, editable.accuracy
+        return exact
+    return Reconstruction(editable.procedure, editable.accuracy_before, editable.accuracy, editable.iou,
+                          exact.timings, exact.retried, "lattice", False, False, "editable", exact.procedure,
+                          exact.accuracy)
 
 
 def reads_through_noise(model: Procedure, induced: Procedure, seg: Segmentation) -> bool:

@@ -43,21 +43,24 @@ function buildTree(node, order, sizeInput = null, path = "root") {
   const li = document.createElement("li");
   li.dataset.path = path;
   const k = order.get(node);
-  const badge = document.createElement("span");
-  badge.className = "bfs"; badge.textContent = `#${k}`;
-  badge.title = `node ${k} breadth first: a re-run keeping ${k + 1} node${k ? "s" : ""} keeps #0 to #${k}`;
-  badge.addEventListener("click", () => {
-    const field = document.getElementById("id_nodes");
-    if (field) { field.value = k + 1; field.focus(); }
-  });
   const name = document.createElement("span");
   name.className = "node-label"; name.textContent = label(node);
   name.title = "select this node: what it draws is outlined in the picture";
   name.addEventListener("click", () => select([path], "tree"));
-  li.append(badge, " ", name);
+  if (k !== undefined) {  // an exception's node is not among the nodes a re-run keeps
+    const badge = document.createElement("span");
+    badge.className = "bfs"; badge.textContent = `#${k}`;
+    badge.title = `node ${k} breadth first: a re-run keeping ${k + 1} node${k ? "s" : ""} keeps #0 to #${k}`;
+    badge.addEventListener("click", () => {
+      const field = document.getElementById("id_nodes");
+      if (field) { field.value = k + 1; field.focus(); }
+    });
+    li.append(badge, " ");
+  }
+  li.append(name);
   if (sizeInput) li.append(sizeInput);
   if (node.rule === "repeat" && node.count !== "fill") {
-    li.append(" × ", numberInput(node.count, 1, (v) => { node.count = Math.max(1, Math.round(v)); }, 0));
+    li.append(" × ", numberInput(node.count, 1, (v) => { recount(node, Math.max(1, Math.round(v))); }, 0));
   }
   if (node.children && node.children.length) {
     const ul = document.createElement("ul");
@@ -70,7 +73,42 @@ function buildTree(node, order, sizeInput = null, path = "root") {
     });
     li.append(ul);
   }
+  if (node.exceptions && node.exceptions.length) li.append(exceptionList(node, order, path));
   return li;
+}
+
+// A repeat's exceptions, each the copy it changes, the path of the node in it, its size and its node (the node's
+// path is `${path}/!${e}`, as the server names it).
+function exceptionList(node, order, path) {
+  const ul = document.createElement("ul");
+  ul.className = "exceptions";
+  node.exceptions.forEach((o, e) => {
+    const span = document.createElement("span");
+    span.className = "exception";
+    span.title = "an exception of the repeat: this copy differs from the typical one here";
+    span.append(` exception: copy ${o.copy} at ${o.path.join("/")}`);
+    if (o.size) {
+      const rel = o.size[0] === "rel";
+      span.append(` ${o.size[0]} `, numberInput(o.size[1], rel ? 0.01 : 1, (v) => { o.size[1] = v; }, rel ? 4 : 2));
+    }
+    if (o.node) {
+      ul.append(buildTree(o.node, order, span, `${path}/!${e}`));
+    } else {
+      const li = document.createElement("li");
+      li.append(span);
+      ul.append(li);
+    }
+  });
+  return ul;
+}
+
+// A repeat's count set in the tree: the exceptions of copies it no longer lays out go, the tail's follow it.
+function recount(node, count) {
+  const old = node.count;
+  node.exceptions = (node.exceptions || []).filter((o) => o.copy < count || o.copy === old)
+    .map((o) => (o.copy === old ? {...o, copy: count} : o));
+  if (!node.exceptions.length) delete node.exceptions;
+  node.count = count;
 }
 
 function breadthFirst(root) {

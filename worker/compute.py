@@ -14,9 +14,11 @@ Progress = Callable[[float, str], None]
 
 
 def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed: int = 0,
-                prefix: dict | None = None, prefix_nodes: int = 0, progress: Progress | None = None
-                ) -> dict[str, Any]:
-    """Segmentation JSON -> {"procedure": JSON, "accuracy", "accuracy_decoded", "iou", "timings"}.
+                prefix: dict | None = None, prefix_nodes: int = 0, progress: Progress | None = None,
+                structure: str = "editable") -> dict[str, Any]:
+    """Segmentation JSON -> {"procedure": JSON, "accuracy", "accuracy_decoded", "iou", "timings", "structure"}, and
+    for a real facade, the other of its two procedures (``structure`` names the one returned first) as
+    ``"alternative": {"procedure", "accuracy", "structure"}``.
 
     ``prefix`` (a procedure JSON) with ``prefix_nodes`` > 0 keeps that procedure's first nodes (BFS) and lets
     the model continue from them. ``progress(fraction, stage)`` hears of each stage: loading the model (the
@@ -34,9 +36,13 @@ def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed
     if prefix is not None and prefix_nodes > 0:
         prefix_ids = prefix_from_procedure(tokenizer, Procedure.from_dict(prefix), prefix_nodes)
     stages = (lambda fraction, stage: progress(0.2 + 0.8 * fraction, stage)) if progress else None
-    result = run(seg, model=model, tokenizer=tokenizer, k=k, seed=seed, prefix=prefix_ids, progress=stages)
+    result = run(seg, model=model, tokenizer=tokenizer, k=k, seed=seed, prefix=prefix_ids, progress=stages,
+                 structure=structure)
     out = result.to_dict()
     out["procedure"] = result.procedure.to_dict()
+    if result.alternative is not None:
+        out["alternative"] = {"procedure": result.alternative.to_dict(), "accuracy": result.alternative_accuracy,
+                              "structure": "exact" if result.structure == "editable" else "editable"}
     if progress:
         progress(1.0, "done")
     return out

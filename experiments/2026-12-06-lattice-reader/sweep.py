@@ -23,6 +23,7 @@ ap.add_argument("--limit", type=int, default=DEV_FACADES)
 ap.add_argument("--start", type=int, default=0)
 ap.add_argument("--sized", action="store_true")
 ap.add_argument("--json")
+ap.add_argument("--polish", type=int, default=160, help="fit_sizes polish_steps")
 for name in ("JITTER", "LEAF_GAIN", "MIN_AREA", "EDGE", "SLIVER"):
     ap.add_argument(f"--{name.lower()}", type=float)
 ap.add_argument("--typical", action="store_true", help="no exceptions but lengths")
@@ -40,7 +41,7 @@ for rid, seg in records:
     proc = lattice.read_lattice(seg)
     if proc is not None and args.sized:
         from facaid.sizing import fit_sizes
-        proc = fit_sizes(proc, flat).procedure
+        proc = fit_sizes(proc, flat, polish_steps=args.polish).procedure
     dt = time.perf_counter() - t0
     ann = segmentation_lattice(seg)
     rec = {"id": rid, "seconds": dt, "lattice": ann, "eligible": ann[0] >= 2 and ann[1] >= 2}
@@ -48,7 +49,7 @@ for rid, seg in records:
         rec.update(read=False)
     else:
         rec.update(read=True, accuracy=pixel_accuracy(rasterize(to_segmentation(proc)), target),
-                   compression=compression(proc, flat), **editability(proc, ann))
+                   compression=compression(proc, seg), **editability(proc, ann))
     out.append(rec)
     print(rid, {k: (round(v, 3) if isinstance(v, float) else v) for k, v in rec.items() if k != "id"}, flush=True)
 el = [r for r in out if r["eligible"]]

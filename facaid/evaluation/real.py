@@ -25,6 +25,7 @@ from tqdm import tqdm
 
 from facaid.augmentation import annotator_noise
 from facaid.defaults import DEFAULT_K
+from facaid.evaluation.editability import editability, segmentation_lattice
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.metrics import compression, pixel_accuracy
@@ -35,11 +36,12 @@ from facaid.segmentation import Segmentation, flatten, rasterize
 from facaid.tokenizer import Tokenizer
 
 
-def load_records(path: str | Path, limit: int | None = None) -> list[tuple[str, Segmentation]]:
+def load_records(path: str | Path, limit: int | None = None, start: int = 0) -> list[tuple[str, Segmentation]]:
+    """The records from ``start`` on (0-based), at most ``limit`` of them."""
     out = []
     with open(path, encoding="utf-8") as f:
-        for i, line in enumerate(f):
-            if not line.strip():
+        for i, line in enumerate(line for line in f if line.strip()):
+            if i < start:
                 continue
             rec = json.loads(line)
             out.append((rec.get("id", f"line{i + 1}"), Segmentation.from_dict(rec, clip=True)))
@@ -55,8 +57,9 @@ def all_wall(label_map: np.ndarray) -> np.ndarray:
 
 def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *, k: int = DEFAULT_K,
                   limit: int | None = None, gallery: str | Path | None = None, gallery_count: int = 20,
-                  progress: bool = True, induce: bool = True, perturb: int | None = None) -> dict:
-    records = load_records(path, limit)
+                  progress: bool = True, induce: bool = True, perturb: int | None = None,
+                  structure: str = "editable", start: int = 0) -> dict:
+    records = load_records(path, limit, start)
     acc, acc_decoded, base, times = [], [], [], []
     inter = np.zeros(len(LABELS))
     union = np.zeros(len(LABELS))
@@ -71,7 +74,7 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
         given = seg if perturb is None else annotator_noise(seg, perturb * 100_003 + i)
         given_flat = flat if perturb is None else flatten(given)
         t0 = time.perf_counter()
-        result = reconstruct(given_flat, model=model, tokenizer=tokenizer, k=k, induce=induce)
+        result = reconstruct(given_flat, model=model, tokenizer=tokenizer, k=k, induce=induce, structure=structure)
         times.append(time.perf_counter() - t0)
         pred = rasterize(to_segmentation(result.procedure))
         trivial = all_wall(target)
@@ -85,9 +88,13 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
             base_inter[c] += (t & b).sum()
             base_union[c] += (t | b).sum()
         nodes.append(sum(1 for _ in result.procedure.nodes()))
-        record = {"id": rid, "half": "dev" if i < DEV_FACADES else "test", "accuracy": acc[-1], "baseline": base[-1],
-                  "seconds": times[-1], "source": result.source, "shortcut": result.shortcut,
-                  "denoised": result.denoised, "nodes": nodes[-1], "compression": compression(result.procedure, given)}
+        record = {"id": rid, "half": "dev" if start + i < DEV_FACADES else "test", "accuracy": acc[-1],
+                  "baseline": base[-1], "seconds": times[-1], "source": result.source, "shortcut": result.shortcut,
+                  "denoised": result.denoised, "nodes": nodes[-1], "compression": compression(result.procedure, given),
+                  "structure": result.structure, "lattice_seconds": result.timings.get("lattice", 0.0),
+                  **editability(result.procedure, segmentation_lattice(seg))}
+        if result.alternative is not None:  # the other structure, scored against the same target
+            record["alternative_accuracy"] = pixel_accuracy(rasterize(to_segmentation(result.alternative)), target)
         if perturb is not None:  # the perturbed input's own accuracy against the clean annotation
             record["input_accuracy"] = pixel_accuracy(rasterize(given_flat), target)
         per_facade.append(record)
@@ -101,8 +108,11 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
     return {
         "facades": len(records),
         "k": k,
+        "structure": structure,
+        "start": start,
         "induce": induce,
-        "induced_share": float(np.mean([f["source"] == "induced" for f in per_facade])) if per_facade else 0.0,
+        "induced_share": float(np.mean([f["source"] in ("induced", "lattice") for f in per_facade]))
+        if per_facade else 0.0,
         "shortcut_share": float(np.mean([f["shortcut"] for f in per_facade])) if per_facade else 0.0,
         "nodes_median": float(np.median(nodes)) if nodes else 0.0,
         "pixel_accuracy": {"mean": float(np.mean(acc)), "median": float(np.median(acc)),
@@ -132,6 +142,16 @@ def _summary(facades: list[dict]) -> dict:
            "model_share": float(np.mean([f["source"].startswith("model") for f in facades])),
            "denoised_share": float(np.mean([f.get("denoised", False) for f in facades])),
            "seconds_median": float(np.median([f["seconds"] for f in facades]))}
+    if "eligible" in facades[0]:  # the editability figures, over the facades with a lattice of windows
+        eligible = [f for f in facades if f["eligible"]]
+        out["eligible"] = len(eligible)
+        for key in ("floors", "bays", "floors_plus_one", "bays_plus_one"):
+            out[f"{key}_share"] = float(np.mean([f[key] for f in eligible])) if eligible else 0.0
+        out["lattice_seconds_median"] = float(np.median([f["lattice_seconds"] for f in facades]))
+    other = [f["alternative_accuracy"] for f in facades if "alternative_accuracy" in f]
+    if other:
+        out["alternative_accuracy_mean"] = float(np.mean(
+            [f.get("alternative_accuracy", f["accuracy"]) for f in facades]))
     if "input_accuracy" in facades[0]:
         out["input_accuracy_mean"] = float(np.mean([f["input_accuracy"] for f in facades]))
         out["gain_over_input"] = out["accuracy_mean"] - out["input_accuracy_mean"]
@@ -152,7 +172,7 @@ def _grid(images: list[Image.Image], columns: int) -> Image.Image:
 
 def format_summary(result: dict) -> str:
     lines = [
-        f"{result['facades']} CMP facades, best of {result['k']}"
+        f"{result['facades']} CMP facades, best of {result['k']}, the {result.get('structure', 'editable')} procedure"
         + ("" if result.get("perturb") is None else
            f", inputs perturbed as people annotate (seed {result['perturb']})"),
         f"pixel accuracy: mean {100 * result['pixel_accuracy']['mean']:.2f} % (median "
@@ -161,7 +181,7 @@ def format_summary(result: dict) -> str:
         f"{100 * result['baseline_all_wall']['mean']:.2f} %",
         f"mean IoU over the 11 building classes: {100 * result['mean_iou']:.1f} %",
         f"seconds per facade: median {result['seconds_per_facade']['median']:.2f}",
-        f"structure: induced for {100 * result['induced_share']:.1f} % of the facades"
+        f"structure: induced (or read as floors of tiles) for {100 * result['induced_share']:.1f} % of the facades"
         + ("" if result["induce"] else " (induction off: the model alone)")
         + f", alone (the decoded one far behind, not sized) for {100 * result.get('shortcut_share', 0.0):.1f} %"
         + f"; median {result['nodes_median']:.0f} nodes per procedure",
@@ -174,6 +194,13 @@ def format_summary(result: dict) -> str:
                 f"{100 * group['model_share']:.1f} %"
                 + (f" (kept over the induced copy of the input's noise for {100 * group['denoised_share']:.1f} %)"
                    if group.get("denoised_share") else ""))
+        if "eligible" in group:
+            share = {k: f"{100 * group[f'{k}_share']:.0f} %" for k in ("floors", "bays", "floors_plus_one",
+                                                                         "bays_plus_one")}
+            line += (f"; of {group['eligible']} with 2+ rows and columns of windows: floors {share['floors']}, bays "
+                     f"{share['bays']}, floors + 1 works {share['floors_plus_one']}, bays + 1 {share['bays_plus_one']}")
+        if "alternative_accuracy_mean" in group:
+            line += f"; the other structure {100 * group['alternative_accuracy_mean']:.2f} %"
         if "input_accuracy_mean" in group:
             line += (f"; the perturbed input itself {100 * group['input_accuracy_mean']:.2f} % against the clean "
                      f"annotation (gain {100 * group['gain_over_input']:+.2f} points)")

@@ -124,7 +124,8 @@ def test_evaluate_real_reports_compression_source_and_the_gain_over_a_perturbed_
     for result in (clean, noisy):
         assert result["halves"]["test"] == {"facades": 0} and result["halves"]["dev"]["facades"] == 2
         for f in result["per_facade"]:
-            assert f["half"] == "dev" and f["compression"] > 0 and f["source"] in ("model", "induced")
+            assert f["half"] == "dev" and f["compression"] > 0 and f["source"] in ("model", "induced", "lattice")
+            assert f["structure"] == "editable" and {"floors", "bays", "floors_plus_one", "eligible"} <= set(f)
     assert "input_accuracy" not in clean["per_facade"][0]
     group = noisy["summary"]
     assert 0 < group["input_accuracy_mean"] < 1

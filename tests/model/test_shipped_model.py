@@ -25,8 +25,12 @@ def test_a_real_annotation_takes_the_shortcut_to_the_induced_structure(cmp_recor
     from facaid.segmentation import Segmentation, flatten
 
     seg = Segmentation.from_dict(cmp_records[0], clip=True)
-    result = reconstruct(seg, k=2)
-    assert result.shortcut and result.source == "induced"
+    result = reconstruct(seg, k=2, structure="exact")
+    assert result.shortcut and result.source == "induced" and result.structure == "exact"
+    editable = reconstruct(seg, k=2)  # by default: the lattice reading, the exact one beside it
+    assert (editable.structure, editable.source) == ("editable", "lattice")
+    assert editable.alternative_accuracy == result.accuracy and editable.alternative.to_json() == \
+        result.procedure.to_json()
     assert result.procedure.meta["structure"] == "induced" and result.accuracy > 0.9
     assert result.accuracy == procedure_accuracy(result.procedure, flatten(seg))
     longer = reconstruct(seg, k=2, induce=False)  # the model's own structure, sized: far below

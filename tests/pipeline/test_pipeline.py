@@ -19,7 +19,7 @@ def test_reconstruct_returns_a_valid_sized_procedure(tiny):
     result = reconstruct(seg.to_dict(), model=model, tokenizer=tok, k=2)
     validate(result.procedure)
     assert result.accuracy >= result.accuracy_decoded
-    assert set(result.timings) == {"flatten", "decode", "sizing", "total"}
+    assert set(result.timings) == {"flatten", "decode", "sizing", "lattice", "total"}
     assert facaid.reconstruct is reconstruct
 
 
@@ -38,6 +38,28 @@ def test_cli_reconstruct(tiny, tmp_path, capsys):
                         '"y1": 2}]}')
     assert main(["reconstruct", str(seg_path), "--out", str(out), "--checkpoint", str(tmp_path / "ckpt")]) == 2
     assert "0 <= x0 < x1 <= width=5" in capsys.readouterr().err
+
+
+def test_a_real_facade_comes_back_editable_with_the_exact_one_beside(tiny):
+    """Induction wins on a real-like annotation: the lattice reading is the editable procedure, sized, with floors
+    and bays to edit; the exact one rides along, and ``structure="exact"`` swaps them."""
+    from grammar_helpers import real_like
+
+    from facaid.parameters import named_parameters
+
+    model, tok = tiny
+    seg = real_like()
+    editable = reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0)
+    assert (editable.structure, editable.source) == ("editable", "lattice")
+    assert {"floors", "bays"} <= {p.name for p in named_parameters(editable.procedure)}
+    assert editable.accuracy == procedure_accuracy(editable.procedure, flatten(seg)) > 0.94
+    assert editable.alternative is not None and editable.alternative_accuracy > 0.97
+    assert editable.to_dict()["alternative_accuracy"] == editable.alternative_accuracy
+    exact = reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0, structure="exact")
+    assert exact.structure == "exact" and exact.accuracy == editable.alternative_accuracy
+    assert exact.alternative.to_json() == editable.procedure.to_json()
+    with pytest.raises(ValueError, match="structure must be one of editable, exact"):
+        reconstruct(seg, model=model, tokenizer=tok, k=1, structure="tidy")
 
 
 def test_fit_to_model_drops_the_smallest_elements():

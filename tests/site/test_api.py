@@ -170,7 +170,9 @@ def test_job_submission_and_errors(facade_photo, as_alice, as_bob):
     r = as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "k": 2}, format="json")
     assert r.status_code == 202
     job = Job.objects.get(code=r.json()["code"])
-    assert job.status == "queued" and job.params == {"k": 2, "seed": 0}
+    assert job.status == "queued" and job.params == {"k": 2, "seed": 0, "structure": "editable"}
+    bad = as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "structure": "tidy"}, format="json")
+    assert bad.status_code == 400 and "structure" in bad.json()
     assert as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"], "k": 99}, format="json").status_code == 400
     assert as_alice.post("/api/v1/jobs/", {"segmentation": "nope"}, format="json").status_code == 400
     assert as_bob.post("/api/v1/jobs/", {"segmentation": seg["code"]}, format="json").status_code == 404

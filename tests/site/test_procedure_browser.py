@@ -323,3 +323,52 @@ def test_picture_and_tree_select_each_other(live_server, alice, browser, tmp_pat
     page.wait_for_function("document.getElementById('selection-info').textContent === ''")
     assert not page.query_selector("#tree li.selected") and not page.query_selector("#named tr.selected")
     assert not errors, errors
+
+
+WINDOW_ROWS_JS = """async (src) => {
+  const img = new Image(); img.src = src; await img.decode();
+  const c = document.createElement('canvas'); c.width = img.naturalWidth; c.height = img.naturalHeight;
+  const g = c.getContext('2d'); g.drawImage(img, 0, 0);
+  const d = g.getImageData(0, 0, c.width, c.height).data;
+  let rows = 0, inside = false;  // bands of image rows that hold a window pixel (52, 101, 164)
+  for (let y = 0; y < c.height; y++) {
+    let any = false;
+    for (let x = 0; x < c.width && !any; x++) {
+      const i = 4 * (y * c.width + x);
+      any = d[i] === 52 && d[i + 1] === 101 && d[i + 2] === 164;
+    }
+    if (any && !inside) rows++;
+    inside = any;
+  }
+  return rows;
+}"""
+
+
+def test_floors_plus_one_on_a_real_like_facade_adds_a_row_of_windows(live_server, alice, browser, tmp_path):
+    """A real-like facade (drawn as people draw CMP's) reconstructed as a job does it: the editable procedure is
+    the page's, and floors + 1 in its parameters draws one more row of windows at once."""
+    from grammar_helpers import real_like
+    from site_helpers import screenshot
+
+    from facaid.pipeline import reconstruct
+
+    seg = real_like()
+    result = reconstruct(seg, k=2)
+    assert result.structure == "editable"
+    proc = Procedure.objects.create(owner=alice, title="Real-like facade", data=result.procedure.to_dict(),
+                                    accuracy=result.accuracy, metrics={"source": result.source,
+                                                                       "structure": result.structure})
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1300, "height": 1450}, advanced=False)
+    page.wait_for_selector("#named input[name=floors]")
+    before = page.evaluate(WINDOW_ROWS_JS, page.get_attribute("#render", "src"))
+    assert page.input_value("#named input[name=floors]") == "5" and before == 5
+    page.fill("#named input[name=floors]", "6")
+    page.dispatch_event("#named input[name=floors]", "change")
+    page.wait_for_function("document.getElementById('render').src.startsWith('blob:')")
+    assert page.evaluate(WINDOW_ROWS_JS, page.get_attribute("#render", "src")) == before + 1
+    assert page.input_value("#named input[name=bays]") == "6"
+    screenshot(page, "procedure-floors-plus-one.png", tmp_path)
+    page.click("#advanced summary")  # the raw tree lists the exceptions: the closed blind among them
+    listed = page.eval_on_selector_all("#tree .exception", "els => els.map(e => e.parentElement.textContent)")
+    assert any("copy 3 at 0/1/2" in text and "blind" in text for text in listed), listed
+    assert not errors

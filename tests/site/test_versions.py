@@ -317,3 +317,58 @@ def test_variations_by_named_ranges_through_the_api(facade_photo, as_alice, alic
     for bad in ({"ranges": {"storeys": [1, 2]}}, {"ranges": {"floors": [1]}}, {"ranges": {"floors": [3, 2]}}):
         r = as_alice.post(_url(proc, "variations"), bad, format="json")
         assert r.status_code == 400 and "ranges" in r.json(), (bad, r.content)
+
+
+def _real_like_job(client, structure: str | None = None) -> tuple[Procedure, Job]:
+    """A photo of a real-like facade (drawn as people draw CMP's), reconstructed in this process as the worker does
+    it, with the shipped model."""
+    import io
+
+    from grammar_helpers import real_like
+
+    from facaid.render import render_segmentation
+    from tests.site.site_helpers import upload
+    from webapp.facades import tasks
+
+    seg = real_like()
+    out = io.BytesIO()
+    render_segmentation(seg).save(out, "PNG")
+    photo = upload(client, out.getvalue(), title="Real-like").json()
+    made = client.post(f"/api/v1/photos/{photo['code']}/segmentations/", seg.to_dict(), format="json").json()
+    body = {"segmentation": made["code"], "k": 2} | ({"structure": structure} if structure else {})
+    r = client.post("/api/v1/jobs/", body, format="json")
+    assert r.status_code == 202, r.content
+    job = Job.objects.get(code=r.json()["code"])
+    tasks.run_job.apply(args=[job.id])
+    job.refresh_from_db()
+    assert job.status == "done", job.message
+    return Procedure.objects.get(id=job.result_id), job
+
+
+def test_a_real_facade_gets_both_procedures_the_editable_one_current(as_alice, monkeypatch):
+    """The editable reading is the current version, the exact one version 1; the page names both with their
+    accuracies and switches between them by a revert; the parameters edit the editable one."""
+    monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")
+    proc, job = _real_like_job(as_alice)
+    assert job.result_version == 2
+    [v2, v1] = _history(as_alice, proc)
+    assert (v1["metrics"]["structure"], v2["metrics"]["structure"]) == ("exact", "editable")
+    assert v2["metrics"]["source"] == "lattice" and v1["accuracy"] > v2["accuracy"] > 0.94
+    assert v2["note"].startswith("editable: floors of tiles") and v1["note"] == "exact: the annotation as drawn"
+    names = {p["name"]: p["value"] for p in as_alice.get(_url(proc, "parameters")).json()["parameters"]}
+    assert names["floors"] == 5 and names["bays"] == 6
+    page = as_alice.get(f"/procedures/{proc.code}").content.decode()
+    assert "editable structure: floors of tiles with exceptions" in page
+    assert 'id="other-structure"' in page and "The exact procedure (pixel accuracy" in page
+    assert 'data-revert="1" id="switch-structure"' in page and "Switch to the exact one" in page
+    assert as_alice.post(_url(proc, "versions/1/revert")).status_code in (200, 201)
+    page = as_alice.get(f"/procedures/{proc.code}").content.decode()
+    assert "exact structure: the annotation as drawn" in page and "Switch to the editable one" in page
+
+
+def test_the_exact_procedure_first_when_asked(as_alice, monkeypatch):
+    monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")
+    proc, job = _real_like_job(as_alice, "exact")
+    [v2, v1] = _history(as_alice, proc)
+    assert (v1["metrics"]["structure"], v2["metrics"]["structure"]) == ("editable", "exact")
+    assert job.params["structure"] == "exact"

@@ -324,7 +324,7 @@ def job_list(request):
         raise ValidationError({"segmentation": "fork the photo's procedure or upload your own photo to "
                                                "reconstruct it"})
     prefix = access.get_procedure_for_user(request.user, v["prefix_procedure"]) if v["prefix_procedure"] else None
-    job = services.submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"])
+    job = services.submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"], v["structure"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
 
 

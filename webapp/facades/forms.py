@@ -33,6 +33,10 @@ class SegmentationForm(forms.Form):
 class ReconstructForm(forms.Form):
     k = forms.IntegerField(min_value=1, max_value=MAX_K, initial=DEFAULT_K, help_text="candidates decoded and compared")
     seed = forms.IntegerField(min_value=0, max_value=2**31 - 1, initial=0)
+    structure = forms.ChoiceField(
+        choices=[("editable", "editable: floors of tiles, for the parameters"), ("exact", "exact: as drawn")],
+        initial="editable", required=False,
+        help_text="the procedure you get first; the other is kept as an earlier version")
 
 
 class RerunForm(forms.Form):

@@ -7,7 +7,7 @@ from django.contrib.auth.models import AnonymousUser
 from rest_framework import serializers
 
 from facaid import interchange
-from facaid.defaults import DEFAULT_K, MAX_K
+from facaid.defaults import DEFAULT_K, MAX_K, STRUCTURES
 from facaid.grammar import Procedure as ProcedureTree
 from facaid.grammar.procedure import MAX_NODES, ProcedureError
 from facaid.numbers import finite
@@ -263,6 +263,11 @@ class JobCreateSerializer(serializers.Serializer):
     seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
     prefix_procedure = serializers.UUIDField(required=False, allow_null=True, default=None)
     prefix_nodes = serializers.IntegerField(min_value=0, max_value=MAX_PREFIX_NODES, default=0)
+    structure = serializers.ChoiceField(
+        STRUCTURES, default="editable",
+        help_text="which procedure of a real facade becomes current: editable (floors of tiles with exceptions, "
+                  "what the named parameters edit) or exact (the annotation as drawn); the other is kept as an "
+                  "earlier version")
 
 
 class RerunSerializer(serializers.Serializer):

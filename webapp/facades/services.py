@@ -175,12 +175,13 @@ class TooManyJobs(APIException):
 
 
 def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
-               prefix_nodes: int = 0) -> Job:
+               prefix_nodes: int = 0, structure: str = "editable") -> Job:
     """Queue a reconstruction; `TooManyJobs` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
     running, so that one account cannot fill the workers' queue. A re-run from a prefix continues the prefix
     procedure's current version; of the user's own procedure against its own segmentation, its result is that
-    procedure's next version, else a new procedure whose parent it is."""
-    params = {"k": k, "seed": seed}
+    procedure's next version, else a new procedure whose parent it is. ``structure``: which of a real facade's two
+    procedures is current (`facaid.pipeline.reconstruct`); the other is its first version."""
+    params = {"k": k, "seed": seed, "structure": structure}
     if prefix is not None and prefix_nodes > 0:
         current = prefix.current_version()
         params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id,

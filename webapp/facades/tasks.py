@@ -15,7 +15,7 @@ from django.utils import timezone
 from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
 from webapp.facades import jobs, versions
-from webapp.facades.models import Job, Procedure, ProcedureVersion, Visibility
+from webapp.facades.models import Change, Job, Procedure, ProcedureVersion, Visibility
 from worker import compute
 from worker.app import RUN_JOB, app
 
@@ -81,7 +81,12 @@ def run_job(self, job_id: int) -> None:
 
 
 # what a job's result says of its tree, kept in the procedure's metrics beside its accuracy
-JOB_METRICS = ("accuracy_decoded", "iou", "timings", "source", "retried", "shortcut")
+JOB_METRICS = ("accuracy_decoded", "iou", "timings", "source", "retried", "shortcut", "structure")
+
+
+# the notes of a real facade's two first versions (`facaid.pipeline.reconstruct`)
+STRUCTURE_NOTES = {"editable": "editable: floors of tiles with exceptions, what the parameters edit",
+                   "exact": "exact: the annotation as drawn"}
 
 
 def _compute(job: Job) -> dict:
@@ -98,7 +103,8 @@ def _compute(job: Job) -> dict:
 
     return compute.reconstruct(job.segmentation.data, settings.FACAID_CHECKPOINT, k=int(params.get("k", DEFAULT_K)),
                                seed=int(params.get("seed", 0)), prefix=prefix,
-                               prefix_nodes=int(params.get("prefix_nodes", 0)), progress=progress)
+                               prefix_nodes=int(params.get("prefix_nodes", 0)), progress=progress,
+                               structure=params.get("structure", "editable"))
 
 
 def _store(job: Job, result: dict) -> None:
@@ -121,11 +127,18 @@ def _store(job: Job, result: dict) -> None:
             title = photo.title or ""
             if params.get("prefix_nodes"):  # told apart from the procedure it continued
                 title = f"{parent or title or 'Procedure'} · re-run keeping {params['prefix_nodes']} nodes"
-            proc = Procedure.objects.create(
-                owner=job.owner, title=title[:200], data=result["procedure"], photo=photo,
-                segmentation=job.segmentation, accuracy=result["accuracy"], metrics=metrics, parent=parent,
-                visibility=params.get("visibility", Visibility.PRIVATE))
-            version = 1
+            proc = Procedure(owner=job.owner, title=title[:200], photo=photo, segmentation=job.segmentation,
+                             parent=parent, visibility=params.get("visibility", Visibility.PRIVATE))
+            other = result.get("alternative")
+            if other:  # a real facade's other procedure: its first version, one revert away
+                proc.data, proc.accuracy = other["procedure"], other["accuracy"]
+                proc.metrics = {"source": "induced" if other["structure"] == "exact" else "lattice",
+                                "structure": other["structure"]}
+                proc.save(change=Change(ProcedureVersion.Kind.CREATED, STRUCTURE_NOTES[other["structure"]]))
+            proc.data, proc.accuracy, proc.metrics = result["procedure"], result["accuracy"], metrics
+            proc.save(change=Change(ProcedureVersion.Kind.CREATED, STRUCTURE_NOTES.get(result.get("structure"), "")
+                                    if other else ""))
+            version = 2 if other else 1
         Job.objects.filter(id=job.id).update(status=Job.Status.DONE, progress=1.0, stage="done", result=proc,
                                              result_version=version, finished=timezone.now())
 

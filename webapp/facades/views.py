@@ -163,7 +163,8 @@ def photo_reconstruct(request, code):
         messages.error(request, "Check the reconstruction settings.")
         return redirect(photo)
     try:
-        job = services.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"])
+        job = services.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"],
+                                  structure=form.cleaned_data["structure"] or "editable")
     except services.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(photo)
@@ -191,11 +192,24 @@ def procedure(request, code):
     photo_visible = access.photo_visible_to(request.user, proc.photo)
     return render(request, "facades/procedure.html", {
         "proc": proc, "owner": owner, "photo_visible": photo_visible, "current": proc.current_version(),
+        "other_structure": _other_structure(proc),
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
         "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
         "max_scale": MAX_SCALE, "scale": _download_scale(proc)})
+
+
+def _other_structure(proc):
+    """The latest version whose tree is the other of a real facade's two structures (editable, exact), if any."""
+    here = (proc.metrics or {}).get("structure")
+    if here not in ("editable", "exact"):
+        return None
+    for version in proc.versions.defer("data").order_by("-version"):
+        there = (version.metrics or {}).get("structure")
+        if there in ("editable", "exact") and there != here:
+            return version
+    return None
 
 
 def _download_scale(proc) -> tuple[float, str] | None:
