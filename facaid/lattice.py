@@ -34,9 +34,14 @@ from facaid.grammar.procedure import MAX_COUNT, Node, Override, Procedure, Size
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
 from facaid.segmentation import Segmentation, decompose_grid, flatten, rasterize, region_boxes
 
+_GLASS = (LABEL_ID["window"], LABEL_ID["blind"])
+ONE_OFF = 1.0  # a delta of one copy (not a column's, not a floor's) pays this many times a leaf's price
+DELETE = 0.0  # an element left out of a copy pays this share of a leaf (an annotator may have missed it)
 JITTER = 0.08  # a floor or column length off the median by more than this share is its own
 LEAF_GAIN = 0.0003  # an exception's leaf must put right this share of the image's pixels
 EXCEPTIONS = True  # False: the typical copies only (with their own lengths), for measuring
+WHOLE = 0.35  # a window region smaller than this share of the median window's height or width is a strip of one
+COLUMN_SUPPORT = 0.5  # a column of windows needs windows in this share of the floors
 GROUND_SHARE = 0.05  # a last row of windows whose band is this much door or shop belongs to the ground floor
 EDGE = 0.06  # a copy that differs only this close (a share of the unit's side) to an edge differs by jitter
 MIN_AREA = 0.01  # regions and leaves under this share of a unit are not read as parts of it
@@ -122,9 +127,14 @@ def _tidy(label_map: np.ndarray) -> np.ndarray:
     # what a later element left of an earlier one (a strip of window under a balcony): a sliver, wall again
     painted = decompose_grid(out.astype(np.int64) + 1)
     painted[:, 0] -= 1
+    glass = region_boxes(painted, _GLASS)  # windows with their blinds, as the lattice sees them
+    whole = (glass[:, 2:] - glass[:, :2]).max(axis=0) if len(glass) else np.zeros(2)
     for label in {int(v) for v in painted[:, 0]} - {ground}:
         for x0, y0, x1, y1 in region_boxes(painted, (label,)):
-            if (x1 - x0) * (y1 - y0) < MIN_AREA * h * w or min(x1 - x0, y1 - y0) < SLIVER * min(h, w):
+            small = (x1 - x0) * (y1 - y0) < MIN_AREA * h * w or min(x1 - x0, y1 - y0) < SLIVER * min(h, w)
+            if label in _GLASS:  # and a strip of a window is not a window of its own
+                small = small or (x1 - x0) < WHOLE * whole[0] or (y1 - y0) < WHOLE * whole[1]
+            if small:
                 region = out[y0:y1, x0:x1]
                 region[region == label] = ground
     return out
@@ -146,6 +156,14 @@ def _near_edges(label_map: np.ndarray, r: int) -> np.ndarray:
     return edge
 
 
+def _windows(node: Node) -> Node:
+    """The tree with its window leaves in the role ``window``, so that the window size is a named parameter."""
+    for _, n in node.walk():
+        if n.rule == "leaf" and n.label == "window":
+            n.role = "window"
+    return node
+
+
 def _leaf_paths(node: Node, path: tuple[int, ...] = ()) -> list[tuple[tuple[int, ...], Node]]:
     """The leaves of a tree of splits with their child-index paths, depth-first (`execute`'s leaf order)."""
     if node.rule == "leaf":
@@ -160,7 +178,7 @@ class _Unit:
     def __init__(self, crops: list[np.ndarray], h: int, w: int):
         self.h, self.w = h, w
         self.map = _tidy(_vote([_resample(c, h, w) for c in crops]))
-        self.tree = tree_of_label_map(self.map)
+        self.tree = _windows(tree_of_label_map(self.map))
         boxes = execute(Procedure(w, h, self.tree))
         self.leaves = [(path, leaf, box[1:]) for (path, leaf), box in zip(_leaf_paths(self.tree), boxes,
                                                                           strict=True)]
@@ -231,14 +249,14 @@ class _Choice:
                 continue  # a sliver of the unit relabelled would be an element of its own
             counts = np.bincount(crop[b:d, a:c][steady[b:d, a:c]], minlength=len(LABELS))
             best, own = int(counts.argmax()), LABEL_ID[leaf.label]
-            price = 0 if best in (FACADE, BACKGROUND) else 1
+            price = ONE_OFF * (1 if best not in (FACADE, BACKGROUND) else DELETE)
             if best != own and self.worth(counts[best] - counts[own], price):
                 relabels.append((path, None, Node.leaf(LABELS[best])))
                 drawn[b:d, a:c] = best
                 cost += price
         relabelled = before - int(((drawn != crop) & steady).sum())
         whole = before - _off(tidy, crop)
-        if self.net(whole, _elements(node)) > max(0.0, self.net(relabelled, cost)):
+        if self.net(whole, ONE_OFF * max(DELETE, _elements(node))) > max(0.0, self.net(relabelled, cost)):
             return [((), None, node)]
         return relabels if self.net(relabelled, cost) > 0 else []
 
@@ -269,7 +287,10 @@ def read_lattice(seg: Segmentation) -> Procedure | None:
     label_map = rasterize(flat)
     height, width = label_map.shape
     fx0, fx1 = _footprint(label_map)
-    windows = region_boxes(flat.to_array(), (LABEL_ID["window"], LABEL_ID["blind"]))
+    windows = region_boxes(flat.to_array(), _GLASS)
+    if len(windows):  # the strips of a window a balcony or a sill left uncovered are not windows of the lattice
+        h, w = windows[:, 3] - windows[:, 1], windows[:, 2] - windows[:, 0]
+        windows = windows[(h >= WHOLE * np.median(h)) & (w >= WHOLE * np.median(w))]
     centres = (windows[:, 0] + windows[:, 2]) / 2
     windows = windows[(centres >= fx0) & (centres < fx1)] - np.array([fx0, 0, fx0, 0])
     main = _read_main(label_map, windows + np.array([fx0, 0, fx0, 0]))
@@ -307,8 +328,15 @@ def _read_main(label_map: np.ndarray, windows: np.ndarray) -> Node | None:
         return None
     n_rows = len(rows) - _ground_rows(label_map, ys)
     ys = ys[: n_rows + 1]
+    row_of = np.concatenate([np.full(len(r), i) for i, r in enumerate(rows[:n_rows])])
     upper = windows[np.concatenate(rows[:n_rows])]
     cols = _bands(upper[:, 0], upper[:, 2])
+    # columns are those most floors have a window in; the others' windows are content of their neighbours' tiles
+    # (a floor whose windows sit half a bay over does not halve every tile)
+    support = [len(set(row_of[c].tolist())) / n_rows for c in cols]
+    strong = [c for c, share in zip(cols, support, strict=True) if share >= COLUMN_SUPPORT]
+    if len(strong) >= 2:
+        cols = strong
     if not 2 <= len(cols) <= MAX_COUNT:
         return None
     lefts = np.array([np.median(upper[c, 0]) for c in cols])

@@ -24,27 +24,34 @@ ap.add_argument("--start", type=int, default=0)
 ap.add_argument("--sized", action="store_true")
 ap.add_argument("--json")
 ap.add_argument("--polish", type=int, default=160, help="fit_sizes polish_steps")
-for name in ("JITTER", "LEAF_GAIN", "MIN_AREA", "EDGE", "SLIVER"):
+ap.add_argument("--perturb", type=int, help="annotate the input as people do first (seed); score against the clean")
+for name in ("JITTER", "LEAF_GAIN", "MIN_AREA", "EDGE", "SLIVER", "COLUMN_SUPPORT", "WHOLE", "ONE_OFF", "DELETE"):
     ap.add_argument(f"--{name.lower()}", type=float)
 ap.add_argument("--typical", action="store_true", help="no exceptions but lengths")
 args = ap.parse_args()
 lattice.EXCEPTIONS = not args.typical
-for name in ("JITTER", "LEAF_GAIN", "MIN_AREA", "EDGE", "SLIVER"):
+for name in ("JITTER", "LEAF_GAIN", "MIN_AREA", "EDGE", "SLIVER", "COLUMN_SUPPORT", "WHOLE", "ONE_OFF", "DELETE"):
     if getattr(args, name.lower()) is not None:
         setattr(lattice, name, getattr(args, name.lower()))
 records = load_records(DEFAULT_CMP, args.limit)[args.start :: args.every]
 out = []
-for rid, seg in records:
+for k, (rid, seg) in enumerate(records):
     flat = flatten(seg)
     target = rasterize(flat)
+    given = seg
+    if args.perturb is not None:
+        from facaid.augmentation import annotator_noise
+        given = annotator_noise(seg, args.perturb * 100_003 + k)
     t0 = time.perf_counter()
-    proc = lattice.read_lattice(seg)
+    proc = lattice.read_lattice(given)
     if proc is not None and args.sized:
         from facaid.sizing import fit_sizes
-        proc = fit_sizes(proc, flat, polish_steps=args.polish).procedure
+        proc = fit_sizes(proc, flatten(given), polish_steps=args.polish).procedure
     dt = time.perf_counter() - t0
     ann = segmentation_lattice(seg)
     rec = {"id": rid, "seconds": dt, "lattice": ann, "eligible": ann[0] >= 2 and ann[1] >= 2}
+    if args.perturb is not None:
+        rec["input_accuracy"] = pixel_accuracy(rasterize(flatten(given)), target)
     if proc is None:
         rec.update(read=False)
     else:
@@ -61,6 +68,8 @@ print(f"floors {share('floors'):.3f} bays {share('bays'):.3f} floors+1 {share('f
       f"bays+1 {share('bays_plus_one'):.3f}")
 acc = [r["accuracy"] for r in out if r["read"]]
 comp = [r["compression"] for r in out if r["read"]]
+if args.perturb is not None:
+    print(f"perturbed input {np.mean([r['input_accuracy'] for r in out if r['read']]):.4f} against the clean")
 print(f"accuracy mean {np.mean(acc):.4f} (read ones), compression median {statistics.median(comp):.2f}, "
       f"seconds median {statistics.median(r['seconds'] for r in out):.3f}")
 if args.json:

@@ -415,21 +415,24 @@ def _pattern_child(node: Node, i: int) -> Node:
 
 def recount(root: Node, node: Node, count: int) -> None:
     """Set the count of the repeat ``node`` (in the tree under ``root``) to ``count``, in place, keeping every
-    exception on the copies that stay: copies are added or removed at the end (the new ones typical), the tail keeps
-    its exceptions, and so do the paths of repeats above that run through ``node``."""
+    exception on its copy: new copies are typical and go after the last typical copy (one that no exception of
+    ``node`` changes), between its like; removed copies are typical ones from the end first, then the last. The
+    tail keeps its exceptions, and the paths of repeats above that run through ``node`` follow their copies."""
     old, k = node.count, len(node.children)
+    changed = {o.copy for o in node.exceptions}
+    typical = [c for c in range(old) if c not in changed]
+    if count >= old:
+        at = typical[-1] + 1 if typical else old
+        new = {c: c if c < at else c + count - old for c in range(old)}
+    else:
+        gone = set((typical[::-1] + [c for c in range(old - 1, -1, -1) if c in changed])[: old - count])
+        new = {c: c - sum(1 for g in gone if g < c) for c in range(old) if c not in gone}
+    new[old] = count  # the tail
 
     def moved(copy: int) -> int | None:
-        if copy == old:  # the tail
-            return count
-        return copy if copy < count else None
+        return new.get(copy)
 
-    kept = []
-    for o in node.exceptions:
-        c = moved(o.copy)
-        if c is not None:
-            kept.append(o._replace(copy=c))
-    node.exceptions = kept
+    paths = {}  # the repeats above first: their paths run through node's copies as they are now
     for _, above in root.walk():
         if not above.exceptions or above is node:
             continue
@@ -444,7 +447,10 @@ def recount(root: Node, node: Node, count: int) -> None:
                     steps[s + 1] = c * k + steps[s + 1] % k
             else:
                 kept.append(o._replace(path=tuple(steps)))
+        paths[id(above)] = (above, kept)
+    for above, kept in paths.values():
         above.exceptions = kept
+    node.exceptions = [o._replace(copy=moved(o.copy)) for o in node.exceptions if moved(o.copy) is not None]
     node.count = count
 
 

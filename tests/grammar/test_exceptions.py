@@ -254,17 +254,18 @@ def _counts(proc: Procedure) -> dict[str, int]:
 
 
 def test_named_parameters_edit_the_typical_copies():
-    """floors + 1 adds a typical floor, bays + 1 a typical tile to every floor; the exceptions stay where they
-    were (a copy removed takes its own with it), and the lengths change the typical copies only."""
+    """floors + 1 adds a typical floor after the last typical one, bays + 1 a typical tile to every floor; the
+    exceptions stay on their copies (floors - 1 takes a typical floor away), and the lengths change the typical
+    copies only."""
     proc = example()
     assert np.array_equal(label_map(normalised(proc)), label_map(proc))
     assert _counts(proc) == {"window": 19, "blind": 1, "sill": 19}
     more = set_parameter(proc, "floors", 5)
     assert _counts(more) == {"window": 24, "blind": 1, "sill": 24}
     assert more.height == pytest.approx(proc.height + 360 * 90 / 390, abs=0.01)  # one typical floor taller
-    assert [o.copy for o in more.root.children[1].exceptions] == [1, 3, 0]
+    assert [o.copy for o in more.root.children[1].exceptions] == [1, 4, 0]  # the new floor after floor 2
     fewer = set_parameter(proc, "floors", 3)
-    assert [o.copy for o in fewer.root.children[1].exceptions] == [1, 0]
+    assert [o.copy for o in fewer.root.children[1].exceptions] == [1, 2, 0]  # a typical floor went
     assert _counts(fewer) == {"window": 14, "blind": 1, "sill": 14}
     wider = set_parameter(proc, "bays", 6)
     assert _counts(wider) == {"window": 23, "blind": 1, "sill": 23}
