@@ -5,8 +5,9 @@ the third window of the fourth floor has its blind closed". `read_lattice` reads
 (after Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013):
 
 1. **Windows**: connected window-or-blind regions of the building (the longest run of columns that are mostly
-   not background: a neighbour's strip is left out), their **rows** and **columns** (bands of centres split where
-   the gap is over half the median window height, width; bands whose extents overlap are one).
+   not background: a neighbour's strip is left out), but for the strips a balcony or sill leaves uncovered
+   (`WHOLE`), their **rows** and **columns** (bands of centres split where the gap is over half the median window
+   height, width; bands whose extents overlap are one; a column needs windows in `COLUMN_SUPPORT` of the floors).
 2. **Floors**: horizontal bands that each hold one row of windows with its companions, cut between two rows where
    the label map is most wall; the last rows whose bands hold doors or shops are the **ground** floor. **Tiles**:
    the columns within the floors, cut the same way; the side margins; the **attic** above the first floor. The
@@ -32,13 +33,14 @@ from facaid.grammar.decompose import tree_of_label_map
 from facaid.grammar.execute import execute
 from facaid.grammar.procedure import MAX_COUNT, Node, Override, Procedure, Size
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
+from facaid.metrics import near_edges
 from facaid.segmentation import Segmentation, decompose_grid, flatten, rasterize, region_boxes
 
 _GLASS = (LABEL_ID["window"], LABEL_ID["blind"])
 ONE_OFF = 1.0  # a delta of one copy (not a column's, not a floor's) pays this many times a leaf's price
 DELETE = 0.0  # an element left out of a copy pays this share of a leaf (an annotator may have missed it)
 JITTER = 0.08  # a floor or column length off the median by more than this share is its own
-LEAF_GAIN = 0.0003  # an exception's leaf must put right this share of the image's pixels
+LEAF_GAIN = 0.0002  # an exception's leaf must put right this share of the image's pixels
 EXCEPTIONS = True  # False: the typical copies only (with their own lengths), for measuring
 WHOLE = 0.35  # a window region smaller than this share of the median window's height or width is a strip of one
 COLUMN_SUPPORT = 0.5  # a column of windows needs windows in this share of the floors
@@ -140,22 +142,6 @@ def _tidy(label_map: np.ndarray) -> np.ndarray:
     return out
 
 
-def _near_edges(label_map: np.ndarray, r: int) -> np.ndarray:
-    """The pixels within ``r`` of an edge between two labels: where a hand-drawn edge may be off by that much."""
-    edge = np.zeros(label_map.shape, dtype=bool)
-    across, down = label_map[:, 1:] != label_map[:, :-1], label_map[1:, :] != label_map[:-1, :]
-    edge[:, 1:] |= across
-    edge[:, :-1] |= across
-    edge[1:, :] |= down
-    edge[:-1, :] |= down
-    for axis in (0, 1):
-        grown = edge.copy()
-        for k in range(1, r + 1):
-            grown |= np.roll(edge, k, axis=axis) | np.roll(edge, -k, axis=axis)
-        edge = grown
-    return edge
-
-
 def _windows(node: Node) -> Node:
     """The tree with its window leaves in the role ``window``, so that the window size is a named parameter."""
     for _, n in node.walk():
@@ -189,8 +175,14 @@ class _Unit:
         return _off(_resample(self.map, *crop.shape), crop)
 
 
+def _jitter_band(crop: np.ndarray) -> np.ndarray:
+    """The pixels of ``crop`` within `EDGE` of its shorter side of an edge: where a hand's jitter is forgiven."""
+    r = max(1, round(EDGE * min(crop.shape)))
+    return near_edges(crop, r, r)
+
+
 def _off(drawn: np.ndarray, crop: np.ndarray) -> int:
-    return int(((drawn != crop) & ~_near_edges(crop, max(1, round(EDGE * min(crop.shape))))).sum())
+    return int(((drawn != crop) & ~_jitter_band(crop)).sum())
 
 
 def _elements(node: Node) -> int:
@@ -236,7 +228,7 @@ class _Choice:
             jitter = max(1.0, EDGE * min(crop.shape))
             return [(path, size, None) for path, size in _resized(reference.tree, node, jitter)]
         drawn = _resample(reference.map, *crop.shape)
-        steady = ~_near_edges(crop, max(1, round(EDGE * min(crop.shape))))
+        steady = ~_jitter_band(crop)
         before = int(((drawn != crop) & steady).sum())
         if not before:
             return []
@@ -455,4 +447,5 @@ def _role(node: Node, role: str) -> Node:
     return node
 
 
-__all__ = ["EDGE", "JITTER", "LEAF_GAIN", "MIN_AREA", "SLIVER", "read_lattice"]
+__all__ = ["COLUMN_SUPPORT", "DELETE", "EDGE", "JITTER", "LEAF_GAIN", "MIN_AREA", "ONE_OFF", "SLIVER", "WHOLE",
+           "read_lattice"]

@@ -166,16 +166,22 @@ def _grow(mask: np.ndarray, r: int, axis: int) -> np.ndarray:
     return (np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)) > 0
 
 
+def near_edges(label_map: np.ndarray, rx: int, ry: int) -> np.ndarray:
+    """The pixels of a label map within ``rx`` (along x) and ``ry`` (along y) of an edge between two labels: where a
+    hand-drawn edge may be off by that much."""
+    border = np.zeros(label_map.shape, dtype=bool)
+    across, down = label_map[:, 1:] != label_map[:, :-1], label_map[1:, :] != label_map[:-1, :]
+    border[:, 1:] |= across
+    border[:, :-1] |= across
+    border[1:, :] |= down
+    border[:-1, :] |= down
+    return _grow(_grow(border, rx, 1), ry, 0)
+
+
 def unexplained(pred: np.ndarray, given: np.ndarray, edge: float = 0.01) -> float:
     """The share of the image where the label map ``pred`` disagrees with ``given`` farther than ``edge`` x the
     image's width (along x) or height (along y) from every edge of ``given``: disagreement that edges moved by an
     annotator's hand cannot explain — whole elements missing, added or misplaced."""
     h, w = given.shape
-    border = np.zeros(given.shape, dtype=bool)
-    across, down = given[:, 1:] != given[:, :-1], given[1:, :] != given[:-1, :]
-    border[:, 1:] |= across
-    border[:, :-1] |= across
-    border[1:, :] |= down
-    border[:-1, :] |= down
-    band = _grow(_grow(border, max(1, round(edge * w)), 1), max(1, round(edge * h)), 0)
+    band = near_edges(given, max(1, round(edge * w)), max(1, round(edge * h)))
     return float(((pred != given) & ~band).mean())
