@@ -219,7 +219,8 @@ class _Choice:
     def own(self, reference: _Unit, crop: np.ndarray) -> list[tuple[tuple[int, ...], Size | None, Node | None]]:
         """What makes ``reference`` into ``crop``, as (path inside the unit, size, node) deltas: where ``crop``'s
         own tree has the reference's shape, the sizes it lays out differently by more than a hand's jitter (they
-        cost no leaf); else its own tree where that earns its leaves; else nothing."""
+        cost no leaf); else the reference's leaves that ``crop`` paints mostly with another label, relabelled, or
+        ``crop``'s own tree, whichever puts more right for its leaves (`net`); else nothing."""
         if not EXCEPTIONS:
             return []
         tidy = _tidy(crop)
