@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass, field
 from facaid.grammar.execute import parameter_lengths
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
-from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, recount, validate
+from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, copies_moved, recount, validate
 from facaid.resizing import repeat_unit, resize
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
@@ -355,6 +355,10 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             raise ValueError(f"{name} cannot change here: no repeat lays out the {role}s (edit the tree instead)")
         own: dict[int, float] = {}
         change = int(value) - int(p.value)
+        # rows of tiles of one count stay in step: their new tiles go where the most laid-out row's go
+        main = max((n for _, n in repeats if id(n) in inst.extent), key=lambda n: inst.count[id(n)], default=None)
+        if main is not None:  # as it is before any row changes
+            main = Node("repeat", count=main.count, exceptions=list(main.exceptions))
         for _, node in repeats:
             if id(node) not in inst.extent:  # a row an exception replaces wherever it would be laid out
                 continue
@@ -368,7 +372,8 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
                 raise ValueError(f"{name} {value:g} needs a repeat of {new} copies (1 to {MAX_COUNT})")
             unit, _ = repeat_unit(node, inst.extent[id(node)][0 if axis == "x" else 1])
             own[id(node)] = delta * unit
-            recount(out.root, node, new)
+            in_step = main is not None and main.count == node.count and name == "bays"
+            recount(out.root, node, new, copies_moved(main, new) if in_step else None)
         _grow(out, axis, own)
     try:
         validate(out)

@@ -413,12 +413,12 @@ def _pattern_child(node: Node, i: int) -> Node:
     return node.children[i % k]
 
 
-def recount(root: Node, node: Node, count: int) -> None:
-    """Set the count of the repeat ``node`` (in the tree under ``root``) to ``count``, in place, keeping every
-    exception on its copy: new copies are typical and go after the last typical copy (one that no exception of
-    ``node`` changes), between its like; removed copies are typical ones from the end first, then the last. The
-    tail keeps its exceptions, and the paths of repeats above that run through ``node`` follow their copies."""
-    old, k = node.count, len(node.children)
+def copies_moved(node: Node, count: int) -> dict[int, int]:
+    """Where each copy of the repeat ``node`` goes when its count becomes ``count`` (a copy absent: removed; the
+    tail, ``node.count``, goes to ``count``): new copies are typical and go after the last typical copy (one that no
+    exception of ``node`` changes), between its like; removed copies are typical ones from the end first, then the
+    last."""
+    old = node.count
     changed = {o.copy for o in node.exceptions}
     typical = [c for c in range(old) if c not in changed]
     if count >= old:
@@ -428,6 +428,16 @@ def recount(root: Node, node: Node, count: int) -> None:
         gone = set((typical[::-1] + [c for c in range(old - 1, -1, -1) if c in changed])[: old - count])
         new = {c: c - sum(1 for g in gone if g < c) for c in range(old) if c not in gone}
     new[old] = count  # the tail
+    return new
+
+
+def recount(root: Node, node: Node, count: int, new: dict[int, int] | None = None) -> None:
+    """Set the count of the repeat ``node`` (in the tree under ``root``) to ``count``, in place, keeping every
+    exception on its copy as `copies_moved` places the copies (or as ``new`` says, a mapping of the same kind:
+    rows of tiles that must stay in step). The tail keeps its exceptions, and the paths of repeats above that run
+    through ``node`` follow their copies."""
+    k = len(node.children)
+    new = copies_moved(node, count) if new is None else new
 
     def moved(copy: int) -> int | None:
         return new.get(copy)

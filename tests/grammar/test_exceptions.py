@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from grammar_helpers import example, facade, leaf, plain_facade
+from grammar_helpers import example, facade, leaf, plain_facade, tile
 
 import facaid.grammar as grammar_pkg
 from facaid.generator import generate_procedure
@@ -302,3 +302,18 @@ def test_every_named_parameter_on_trees_with_exceptions(style):
                     continue
                 validate(out)
                 flat_rows(out)
+
+
+def test_bays_plus_one_keeps_the_rows_of_tiles_in_step():
+    """A new tile goes after the last typical tile of the most laid-out row (the floors'), and in every other row of
+    as many tiles at the same place, so that the ground floor's door stays under its column."""
+    row = Node.repeat("x", 5, [(Size("flt", 60), tile())], role="floor")
+    row.exceptions = [Override(3, (0,), node=leaf("deco")), Override(4, (0,), node=leaf("deco"))]
+    floors = Node.repeat("y", 3, [(Size("flt", 90), row)], role="floors")
+    ground = Node.repeat("x", 5, [(Size("flt", 60), tile(window="shop"))], role="ground")
+    ground.exceptions = [Override(3, (0,), node=leaf("door"))]
+    proc = Procedure(300, 370, Node.split("y", [(Size("flt", 270), floors), (Size("flt", 100), ground)]))
+    wider = set_parameter(proc, "bays", 6)
+    rows = [n for _, n in wider.nodes() if n.rule == "repeat" and n.axis == "x"]
+    assert [o.copy for o in rows[0].exceptions] == [4, 5]  # the floors' own tiles after the new one (copy 3)
+    assert [o.copy for o in rows[1].exceptions] == [4]  # the door moved with its column, not left under the new one
