@@ -31,7 +31,7 @@ import numpy as np
 
 from facaid.grammar.decompose import tree_of_label_map
 from facaid.grammar.execute import execute
-from facaid.grammar.procedure import MAX_COUNT, Node, Override, Procedure, Size
+from facaid.grammar.procedure import MAX_COUNT, Node, Override, Procedure, ProcedureError, Size
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
 from facaid.metrics import near_edges
 from facaid.segmentation import Segmentation, decompose_grid, flatten, rasterize, region_boxes
@@ -290,7 +290,10 @@ def read_lattice(seg: Segmentation) -> Procedure | None:
     if main is None:
         return None
     proc = Procedure(width, height, main, {"source": "facaid.lattice"})
-    return Procedure.from_dict(proc.to_dict())
+    try:
+        return Procedure.from_dict(proc.to_dict())
+    except ProcedureError:  # a reading past the grammar's limits (more exceptions than a repeat holds): none
+        return None
 
 
 def _ground_rows(label_map: np.ndarray, ys: list[int]) -> int:

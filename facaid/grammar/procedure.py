@@ -474,6 +474,9 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
     last = MAX_COUNT if node.count == "fill" else node.count
     for e, item in enumerate(items):
         where = f"exceptions[{e}]"
+        counter[0] += 1  # an exception counts as a node: what a tree may hold stays bounded
+        if counter[0] > MAX_NODES:
+            raise ProcedureError(path, f"too many nodes and exceptions (more than {MAX_NODES})")
         if not isinstance(item, dict):
             raise ProcedureError(path, f"{where} must be an object, got {type(item).__name__}")
         extra = sorted(set(item) - {"copy", "path", "size", "node"})

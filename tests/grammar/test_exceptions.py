@@ -317,3 +317,14 @@ def test_bays_plus_one_keeps_the_rows_of_tiles_in_step():
     rows = [n for _, n in wider.nodes() if n.rule == "repeat" and n.axis == "x"]
     assert [o.copy for o in rows[0].exceptions] == [4, 5]  # the floors' own tiles after the new one (copy 3)
     assert [o.copy for o in rows[1].exceptions] == [4]  # the door moved with its column, not left under the new one
+
+
+def test_exceptions_count_towards_the_node_limit():
+    from facaid.grammar.limits import MAX_NODES
+
+    row = Node.repeat("x", 256, [(Size("flt", 1), leaf("window"))])
+    row.exceptions = [Override(c, (0,), size=Size("flt", 2)) for c in range(256)]
+    rows = Node.split("y", [(Size("flt", 1), row.copy()) for _ in range(MAX_NODES // 256 + 1)][:64])
+    with pytest.raises(ProcedureError, match=f"too many nodes and exceptions \\(more than {MAX_NODES}\\)"):
+        Procedure.from_dict(Procedure(4000, 4000, Node.split("x", [(Size("flt", 1), rows.copy())
+                                                                    for _ in range(2)])).to_dict())

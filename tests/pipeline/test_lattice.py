@@ -75,3 +75,9 @@ def test_generated_facades_read_to_valid_procedures(seed):
     if proc is not None:
         Procedure.from_json(proc.to_json())
         assert accuracy(proc, seg) > 0.7
+
+
+def test_a_reading_past_the_grammars_limits_is_no_reading(monkeypatch):
+    """Where the exceptions would overflow what a repeat may hold, the exact procedure stays the only one."""
+    monkeypatch.setattr("facaid.grammar.procedure.MAX_EXCEPTIONS", 1)
+    assert lattice.read_lattice(real_like()) is None
