@@ -40,6 +40,7 @@ PAINT_ORDER: tuple[str, ...] = (
     "deco",
 )
 PRIORITY: tuple[int, ...] = tuple(PAINT_ORDER.index(name) for name in LABELS)  # indexed by label id
+GLASS: tuple[int, ...] = (LABEL_ID["window"], LABEL_ID["blind"])  # a window with its blinds, one element to the eye
 
 # RGB colours used by every renderer of the project (Tango-like, chosen to stay distinct).
 PALETTE: dict[str, tuple[int, int, int]] = {

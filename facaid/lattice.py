@@ -32,11 +32,10 @@ import numpy as np
 from facaid.grammar.decompose import tree_of_label_map
 from facaid.grammar.execute import execute
 from facaid.grammar.procedure import MAX_COUNT, Node, Override, Procedure, ProcedureError, Size
-from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS, PRIORITY
+from facaid.labels import BACKGROUND, FACADE, GLASS, LABEL_ID, LABELS, PRIORITY
 from facaid.metrics import near_edges
 from facaid.segmentation import Segmentation, decompose_grid, flatten, rasterize, region_boxes
 
-_GLASS = (LABEL_ID["window"], LABEL_ID["blind"])
 ONE_OFF = 1.0  # a delta of one copy (not a column's, not a floor's) pays this many times a leaf's price
 DELETE = 0.0  # an element left out of a copy pays this share of a leaf (an annotator may have missed it)
 JITTER = 0.08  # a floor or column length off the median by more than this share is its own
@@ -129,12 +128,12 @@ def _tidy(label_map: np.ndarray) -> np.ndarray:
     # what a later element left of an earlier one (a strip of window under a balcony): a sliver, wall again
     painted = decompose_grid(out.astype(np.int64) + 1)
     painted[:, 0] -= 1
-    glass = region_boxes(painted, _GLASS)  # windows with their blinds, as the lattice sees them
+    glass = region_boxes(painted, GLASS)  # windows with their blinds, as the lattice sees them
     whole = (glass[:, 2:] - glass[:, :2]).max(axis=0) if len(glass) else np.zeros(2)
     for label in {int(v) for v in painted[:, 0]} - {ground}:
         for x0, y0, x1, y1 in region_boxes(painted, (label,)):
             small = (x1 - x0) * (y1 - y0) < MIN_AREA * h * w or min(x1 - x0, y1 - y0) < SLIVER * min(h, w)
-            if label in _GLASS:  # and a strip of a window is not a window of its own
+            if label in GLASS:  # and a strip of a window is not a window of its own
                 small = small or (x1 - x0) < WHOLE * whole[0] or (y1 - y0) < WHOLE * whole[1]
             if small:
                 region = out[y0:y1, x0:x1]
@@ -280,7 +279,7 @@ def read_lattice(seg: Segmentation) -> Procedure | None:
     label_map = rasterize(flat)
     height, width = label_map.shape
     fx0, fx1 = _footprint(label_map)
-    windows = region_boxes(flat.to_array(), _GLASS)
+    windows = region_boxes(flat.to_array(), GLASS)
     if len(windows):  # the strips of a window a balcony or a sill left uncovered are not windows of the lattice
         h, w = windows[:, 3] - windows[:, 1], windows[:, 2] - windows[:, 0]
         windows = windows[(h >= WHOLE * np.median(h)) & (w >= WHOLE * np.median(w))]

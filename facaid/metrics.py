@@ -9,7 +9,7 @@ import numpy as np
 from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.labels import BACKGROUND, FACADE, LABELS, PRIORITY
-from facaid.segmentation import Segmentation, rasterize
+from facaid.segmentation import Segmentation, rasterize, region_roots
 
 
 def pixel_accuracy(a: np.ndarray, b: np.ndarray) -> float:
@@ -30,20 +30,8 @@ def class_iou(a: np.ndarray, b: np.ndarray) -> dict[str, float]:
 
 
 def _regions(boxes: np.ndarray) -> int:
-    """The number of connected regions of boxes (N, 4: x0, y0, x1, y1), where two boxes that share an edge or
-    overlap are connected (touching corners are not)."""
-    x0, y0, x1, y1 = boxes.T
-    ox = np.minimum(x1[:, None], x1) - np.maximum(x0[:, None], x0)  # overlap along x (0: edges touch)
-    oy = np.minimum(y1[:, None], y1) - np.maximum(y0[:, None], y0)
-    joined = ((ox >= 0) & (oy > 0)) | ((ox > 0) & (oy >= 0))
-    parent = np.arange(len(boxes))
-    for i, j in zip(*np.nonzero(np.triu(joined, 1)), strict=True):  # union-find
-        while parent[i] != i:
-            i = parent[i]
-        while parent[j] != j:
-            j = parent[j]
-        parent[i] = j
-    return int(sum(parent[i] == i for i in range(len(boxes))))
+    """The number of connected regions of boxes (N, 4: x0, y0, x1, y1), as `region_roots` connects them."""
+    return int(np.sum(region_roots(boxes) == np.arange(len(boxes))))
 
 
 def element_counts(seg: Segmentation) -> np.ndarray:

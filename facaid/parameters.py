@@ -64,11 +64,8 @@ class _Instances:
         self.extent: dict[int, tuple[float, float]] = {}
         self.parent_axis: dict[int, str | None] = {}
         self.outer: dict[int, bool] = {}  # no ancestor with the same role
-        self.own: dict[int, str] = {}  # id of an exception's node -> its path's last part ("!e")
-        for _, node in proc.nodes():
-            for e, o in enumerate(node.exceptions):
-                if o.node is not None:
-                    self.own[id(o.node)] = f"!{e}"
+        # an exception's node is named by its own path (root/1/!0), as `Node.walk` names it, wherever it is laid out
+        self.own = {id(n): p for p, n in proc.nodes() if "!" in p}
         self._visit(proc.root, "root", float(proc.width), float(proc.height), None, frozenset())
 
     def _visit(self, node: Node, path: str, w: float, h: float, axis: str | None, roles: frozenset,
@@ -81,22 +78,15 @@ class _Instances:
         if node.rule == "leaf":
             return
         length = w if node.axis == "x" else h
-        sizes, children, _, below, sources = expand_over(node, length, pending)
+        sizes, children, _, below, _ = expand_over(node, length, pending)
         lengths = layout(sizes, length)
         inner = roles | {node.role} if node.role else roles
         n = len(node.children)
         for i, (child, extent) in enumerate(zip(children, lengths, strict=True)):
             cw, ch = (extent, h) if node.axis == "x" else (w, extent)
-            if id(child) in self.own and child is not node.children[i % n]:  # an exception's node: its own path
-                owner = next(owner for _, o, owner in self._entries(node, pending) if o.node is child)
-                child_path = f"{self.path[id(owner)]}/{self.own[id(child)]}"
-            else:
-                child_path = f"{path}/{i % n}"
+            replaced = id(child) in self.own and child is not node.children[i % n]  # an exception's node: its path
+            child_path = self.own[id(child)] if replaced else f"{path}/{i % n}"
             self._visit(child, child_path, cw, ch, node.axis, inner, below[i] if below is not None else None)
-
-    @staticmethod
-    def _entries(node: Node, pending: list | None) -> list:
-        return [(None, o, node) for o in node.exceptions] + list(pending or [])
 
 
 def _nodes(proc: Procedure) -> dict[str, Node]:
@@ -359,12 +349,12 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         main = max((n for _, n in repeats if id(n) in inst.extent), key=lambda n: inst.count[id(n)], default=None)
         if main is not None:  # as it is before any row changes
             main = Node("repeat", count=main.count, exceptions=list(main.exceptions))
+        if name == "bays" and not p.value:
+            raise ValueError("bays cannot change here: no floor holds its tiles (edit the tree instead)")
         for _, node in repeats:
             if id(node) not in inst.extent:  # a row an exception replaces wherever it would be laid out
                 continue
             delta = change
-            if name == "bays" and not p.value:
-                raise ValueError("bays cannot change here: no floor holds its tiles (edit the tree instead)")
             if name == "bays":  # rows of another length change in proportion, by one at least
                 delta = round(change * node.count / p.value) or (1 if change > 0 else -1 if change < 0 else 0)
             new = node.count + delta

@@ -285,34 +285,34 @@ def aligned_lines(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
     return [np.array(m) for m in lines]
 
 
+def region_roots(boxes: np.ndarray) -> np.ndarray:
+    """For boxes (N, 4: x0, y0, x1, y1), the index of a representative of each one's connected region, where two
+    boxes that share an edge or overlap are connected (touching corners are not)."""
+    x0, y0, x1, y1 = boxes.T
+    ox = np.minimum(x1[:, None], x1) - np.maximum(x0[:, None], x0)  # overlap along x (0: edges touch)
+    oy = np.minimum(y1[:, None], y1) - np.maximum(y0[:, None], y0)
+    joined = ((ox >= 0) & (oy > 0)) | ((ox > 0) & (oy >= 0))
+    parent = np.arange(len(boxes))
+    for i, j in zip(*np.nonzero(np.triu(joined, 1)), strict=True):  # union-find
+        while parent[i] != i:
+            i = parent[i]
+        while parent[j] != j:
+            j = parent[j]
+        parent[i] = j
+    for i in range(len(boxes)):
+        while parent[parent[i]] != parent[i]:
+            parent[i] = parent[parent[i]]
+    return parent
+
+
 def region_boxes(rows: np.ndarray, labels: tuple[int, ...]) -> np.ndarray:
-    """The bounding boxes (M, 4: x0, y0, x1, y1) of the connected regions of the rows (N, 5: label, x0, y0, x1, y1;
-    pieces of a flattened segmentation) whose label is one of ``labels``: pieces that share an edge over a positive
-    length or overlap are connected (touching corners are not)."""
+    """The bounding boxes (M, 4: x0, y0, x1, y1) of the connected regions (`region_roots`) of the rows (N, 5:
+    label, x0, y0, x1, y1; pieces of a flattened segmentation) whose label is one of ``labels``."""
     rows = np.asarray(rows, dtype=np.int64).reshape(-1, 5)
     boxes = rows[np.isin(rows[:, 0], labels)][:, 1:]
-    n = len(boxes)
-    if n == 0:
+    if len(boxes) == 0:
         return np.zeros((0, 4), dtype=np.int64)
-    parent = np.arange(n)
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    order = np.argsort(boxes[:, 0], kind="stable")  # sweep along x: only boxes that reach each other can touch
-    for a, i in enumerate(order):
-        x0, y0, x1, y1 = boxes[i]
-        for j in order[a + 1 :]:
-            if boxes[j, 0] > x1:
-                break
-            ox = min(x1, boxes[j, 2]) - max(x0, boxes[j, 0])
-            oy = min(y1, boxes[j, 3]) - max(y0, boxes[j, 1])
-            if (ox >= 0 and oy > 0) or (ox > 0 and oy >= 0):
-                parent[find(i)] = find(j)
-    roots = np.array([find(i) for i in range(n)])
+    roots = region_roots(boxes)
     out = [(b[:, 0].min(), b[:, 1].min(), b[:, 2].max(), b[:, 3].max())
            for b in (boxes[roots == r] for r in np.unique(roots))]
     return np.array(out, dtype=np.int64)

@@ -13,17 +13,15 @@ import numpy as np
 
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
-from facaid.labels import LABEL_ID
+from facaid.labels import GLASS
 from facaid.parameters import named_parameters, set_parameter
 from facaid.segmentation import Segmentation, flatten_array, region_boxes
-
-_GLASS = (LABEL_ID["window"], LABEL_ID["blind"])
 
 
 def window_boxes(rows: np.ndarray) -> np.ndarray:
     """The windows of a flattened segmentation's rows (N, 5: label, x0, y0, x1, y1; a partition of the label map):
     the bounding boxes (M, 4) of the connected regions of its window and blind pieces."""
-    return region_boxes(rows, _GLASS)
+    return region_boxes(rows, GLASS)
 
 
 def _bands(centres: np.ndarray, sizes: np.ndarray) -> int:

@@ -148,8 +148,7 @@ def _summary(facades: list[dict]) -> dict:
         for key in ("floors", "bays", "floors_plus_one", "bays_plus_one"):
             out[f"{key}_share"] = float(np.mean([f[key] for f in eligible])) if eligible else 0.0
         out["lattice_seconds_median"] = float(np.median([f["lattice_seconds"] for f in facades]))
-    other = [f["alternative_accuracy"] for f in facades if "alternative_accuracy" in f]
-    if other:
+    if any("alternative_accuracy" in f for f in facades):
         out["alternative_accuracy_mean"] = float(np.mean(
             [f.get("alternative_accuracy", f["accuracy"]) for f in facades]))
     if "input_accuracy" in facades[0]:

@@ -437,11 +437,7 @@ def recount(root: Node, node: Node, count: int, new: dict[int, int] | None = Non
     rows of tiles that must stay in step). The tail keeps its exceptions, and the paths of repeats above that run
     through ``node`` follow their copies."""
     k = len(node.children)
-    new = copies_moved(node, count) if new is None else new
-
-    def moved(copy: int) -> int | None:
-        return new.get(copy)
-
+    moved = (copies_moved(node, count) if new is None else new).get  # a copy's new index, None when it goes
     paths = {}  # the repeats above first: their paths run through node's copies as they are now
     for _, above in root.walk():
         if not above.exceptions or above is node:
