@@ -249,6 +249,9 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
         i = next((i for i in free if node.sizes[i].mode == "flt"), free[0] if free else 0)
         copies = (len(_grown_copies(node, i)) if node.rule == "repeat"
                   else 1 if node.rule == "split" or (node.center and i == len(node.children) - 1) else 2)
+        if not copies:  # every copy of the item has its own size: they share the extra
+            _pad_own_sizes(node, i, extra)
+            return
         node.sizes[i] = Size(node.sizes[i].mode, round(node.sizes[i].value + extra / copies, 4))
         if not free:
             pad(node.children[i], extra / copies)
@@ -285,6 +288,15 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
         proc.width = round(proc.width + g, 4)
     else:
         proc.height = round(proc.height + g, 4)
+
+
+def _pad_own_sizes(node: Node, item: int, extra: float) -> None:
+    """Share ``extra`` among the exceptions that size the laid-out copies of a repeat's pattern item ``item``."""
+    laid_out = node.count + (item < node.tail)
+    sized = [k for k, o in enumerate(node.exceptions) if o.path == (item,) and o.size is not None and o.copy < laid_out]
+    for k in sized:
+        o = node.exceptions[k]
+        node.exceptions[k] = o._replace(size=Size(o.size.mode, round(o.size.value + extra / len(sized), 4)))
 
 
 def _grown_copies(node: Node, item: int) -> list[int]:

@@ -27,6 +27,7 @@ from facaid.grammar.procedure import (
     recount,
     validate,
 )
+from facaid.labels import LABEL_ID
 from facaid.native import rects
 from facaid.parameters import named_parameters, normalised, set_parameter
 from facaid.segmentation import flatten_array_numpy, rasterize
@@ -317,6 +318,21 @@ def test_bays_plus_one_keeps_the_rows_of_tiles_in_step():
     rows = [n for _, n in wider.nodes() if n.rule == "repeat" and n.axis == "x"]
     assert [o.copy for o in rows[0].exceptions] == [4, 5]  # the floors' own tiles after the new one (copy 3)
     assert [o.copy for o in rows[1].exceptions] == [4]  # the door moved with its column, not left under the new one
+
+
+def test_a_repeat_whose_copies_all_have_their_own_size_takes_its_share():
+    """floors + 1 pads the neighbour of the floors with the new floor's height; where each copy of the neighbour's
+    repeat has its own size, those sizes share it (there was a division by zero: no copy took the typical size)."""
+    floors = Node.repeat("y", 4, [(Size("flt", 90), Node.repeat("x", 5, [(Size("flt", 60), tile())], role="floor"))],
+                         role="floors")
+    side = Node.repeat("y", 3, [(Size("flt", 120), leaf("deco"))])
+    side.exceptions = [Override(c, (0,), size=Size("flt", h)) for c, h in enumerate((100, 140, 120))]
+    proc = Procedure(360, 360, Node.split("x", [(Size("flt", 300), floors), (Size("abs", 60), side)]))
+    more = set_parameter(proc, "floors", 5)
+    validate(more)
+    assert more.height == 450
+    assert [o.size.value for o in more.root.children[1].exceptions] == [130, 170, 150]
+    assert np.all(label_map(more)[:, 300:] == LABEL_ID["deco"])
 
 
 def test_exceptions_count_towards_the_node_limit():
