@@ -28,7 +28,10 @@ ap.add_argument("--perturb", type=int, help="annotate the input as people do fir
 for name in ("JITTER", "LEAF_GAIN", "MIN_AREA", "EDGE", "SLIVER", "COLUMN_SUPPORT", "WHOLE", "ONE_OFF", "DELETE"):
     ap.add_argument(f"--{name.lower()}", type=float)
 ap.add_argument("--typical", action="store_true", help="no exceptions but lengths")
+ap.add_argument("--no_resize", action="store_true", help="no per-copy size deltas")
 args = ap.parse_args()
+if args.no_resize:
+    lattice._resized = lambda *a, **k: []
 lattice.EXCEPTIONS = not args.typical
 for name in ("JITTER", "LEAF_GAIN", "MIN_AREA", "EDGE", "SLIVER", "COLUMN_SUPPORT", "WHOLE", "ONE_OFF", "DELETE"):
     if getattr(args, name.lower()) is not None:
