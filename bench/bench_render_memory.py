@@ -3,7 +3,7 @@
     .venv/bin/python bench/bench_render_memory.py [--repeat 3] [--case NAME ...]
 
 Each case runs in a fresh Python process on a scratch SQLite database: Django is set up, the objects the request
-needs are made (a procedure of the largest declared size, 16,384 px a side; 97,200 leaves; a 40-megapixel photo
+needs are made (a procedure of the largest declared size, 16,384 px a side; 73,947 leaves; a 40-megapixel photo
 as JPEG and as PNG), the same request is made once at a small size to warm imports and caches, then the
 process's peak resident set is reset (Linux `/proc/self/clear_refs`) and the request is made through Django's
 test client. The figure is the peak resident memory above what the process held just before the request
@@ -26,15 +26,15 @@ LIMIT_MB = 300
 
 CASES = {  # name: what the request is
     "render-16384": "POST /api/v1/render, a 16,384 x 16,384 procedure (one wall leaf), anonymous",
-    "render-97200-leaves": "POST /api/v1/render, 16,384 px, 180 x 180 repeated tiles of 3 leaves (97,200 leaves)",
+    "render-73947-leaves": "POST /api/v1/render, 16,384 px, 157 x 157 repeated tiles of 3 leaves (73,947 leaves)",
     "render-declared-20000": "POST /api/v1/render, 20,000 x 20,000 declared (refused: 400)",
     "labels.png-16384": "GET labels.png of a stored public 16,384 px procedure, anonymous",
     "thumbnail-16384": "GET the thumbnail of a stored public 16,384 px procedure (a gallery card), anonymous",
     "labels.png-unrendered-16384": "GET labels.png of a 16,384 px procedure whose pictures were not kept yet",
     "save-16384": "POST /api/v1/procedures/ a 16,384 px procedure (its pictures are rendered as it is saved)",
-    "save-97200-leaves": "POST /api/v1/procedures/ the 97,200-leaf procedure (pictures rendered as it is saved)",
-    "labels.svg-97200-leaves": "GET labels.svg of the 97,200-leaf procedure",
-    "segmentation.json-97200-leaves": "GET segmentation.json of the 97,200-leaf procedure",
+    "save-73947-leaves": "POST /api/v1/procedures/ the 73,947-leaf procedure (pictures rendered as it is saved)",
+    "labels.svg-73947-leaves": "GET labels.svg of the 73,947-leaf procedure",
+    "segmentation.json-73947-leaves": "GET segmentation.json of the 73,947-leaf procedure",
     "overlay.png-40MP-jpeg": "GET overlay.png over a 40-megapixel JPEG photo (8,000 x 5,000)",
     "overlay.png-40MP-png": "GET overlay.png over a 40-megapixel PNG photo",
     "rectify-40MP-png": "POST rectify of a 40-megapixel PNG photo (its four corners)",
@@ -45,7 +45,7 @@ CASES = {  # name: what the request is
     "json-4MB-of-objects": "POST /api/v1/render, 4 MB of [{},{},...] (the most objects a body can hold), anonymous",
     "segmentation-list-100": "GET a photo's 100 segmentation versions of 20,000 rectangles each (a page)",
     "remeasure-40MP": "PATCH the data of a procedure made from a 40 MP segmentation (2,000 windows), re-measured",
-    "compare.png-97200-leaves": "GET the difference picture of two versions of the 97,200-leaf procedure",
+    "compare.png-73947-leaves": "GET the difference picture of two versions of the 73,947-leaf procedure",
 }
 
 CHILD = r"""
@@ -102,16 +102,16 @@ small = facade(100, 80, 0)
 if case == "render-16384":
     warm = lambda: anon.post("/api/v1/render", small, format="json")
     run = lambda: anon.post("/api/v1/render", facade(16384, 16384), format="json")
-elif case == "render-97200-leaves":
-    body = facade(16384, 16384, 180)
+elif case == "render-73947-leaves":
+    body = facade(16384, 16384, 157)
     warm = lambda: anon.post("/api/v1/render", facade(100, 80, 2), format="json")
     run = lambda: anon.post("/api/v1/render", body, format="json")
 elif case == "render-declared-20000":
     warm = lambda: anon.post("/api/v1/render", small, format="json")
     run = lambda: anon.post("/api/v1/render", facade(20000, 20000), format="json")
-elif case in ("labels.png-16384", "labels.svg-97200-leaves", "segmentation.json-97200-leaves"):
+elif case in ("labels.png-16384", "labels.svg-73947-leaves", "segmentation.json-73947-leaves"):
     name = case.split("-")[0]
-    big = stored(facade(16384, 16384, 180 if "leaves" in case else 0))
+    big = stored(facade(16384, 16384, 157 if "leaves" in case else 0))
     little = stored(small)
     warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/download/{name}")
     run = lambda: anon.get(f"/api/v1/procedures/{big.code}/download/{name}")
@@ -127,7 +127,7 @@ elif case == "labels.png-unrendered-16384":
     warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/download/labels.png")
     run = lambda: anon.get(f"/api/v1/procedures/{big.code}/download/labels.png")
 elif case.startswith("save-"):
-    body = {"data": facade(16384, 16384, 180 if "leaves" in case else 0)}
+    body = {"data": facade(16384, 16384, 157 if "leaves" in case else 0)}
     warm = lambda: owner.post("/api/v1/procedures/", {"data": facade(100, 80, 2)}, format="json")
     run = lambda: owner.post("/api/v1/procedures/", body, format="json")
 elif case.startswith("overlay.png"):
@@ -183,9 +183,9 @@ elif case == "remeasure-40MP":
     little = Procedure.objects.create(owner=user, data=small)
     warm = lambda: owner.patch(f"/api/v1/procedures/{little.code}/", {"data": small}, format="json")
     run = lambda: owner.patch(f"/api/v1/procedures/{proc.code}/", {"data": tree}, format="json")
-elif case == "compare.png-97200-leaves":
-    big, little = stored(facade(16384, 16384, 180)), stored(facade(100, 80, 2))
-    for proc, count in ((big, 179), (little, 1)):
+elif case == "compare.png-73947-leaves":
+    big, little = stored(facade(16384, 16384, 157)), stored(facade(100, 80, 2))
+    for proc, count in ((big, 156), (little, 1)):
         proc.data["root"]["count"] = count
         proc.save()  # a second version
     warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/versions/compare.png?a=1&b=2")

@@ -141,7 +141,9 @@ def main() -> None:
         seeded = json.loads(manage(env, "shell", "-c", SEED_SCRIPT).strip().splitlines()[-1])
         job = seeded["job"]
         procs.append(subprocess.Popen([sys.executable, "-m", "gunicorn", "webapp.wsgi", "--bind",
-                                       f"127.0.0.1:{web_port}", "--workers", "2", "--threads", "4"],
+                                       f"127.0.0.1:{web_port}", "--workers", "2", "--threads", "4",
+                                       "--max-requests", "1000", "--max-requests-jitter", "100",
+                                       "--no-control-socket"],
                                       cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
         wait_port(web_port)
         cookie = f"sessionid={seeded['session']}"

@@ -20,7 +20,7 @@ from facaid.grammar.execute import parameter_lengths
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, copies_moved, recount, validate
-from facaid.resizing import repeat_unit, resize
+from facaid.resizing import copy_procedure, repeat_unit, resize
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
 
@@ -331,6 +331,8 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         raise ValueError(f"{name} is a count: a whole number, got {value!r}")
     if not p.min <= value <= p.max:
         raise ValueError(f"{name} must be from {p.min:g} to {p.max:g}, got {value:g}")
+    if value == p.value:  # set to what it is: the same tree (a save of it makes no version)
+        return copy_procedure(proc)
     if name in ("width", "height"):
         return resize(proc, value if name == "width" else proc.width, value if name == "height" else proc.height)
     out = normalised(proc)

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import os
 
-from worker.env import EnvError, env_bool, env_int, env_list, env_str
+from worker.env import EnvError, env_bool, env_float, env_int, env_list, env_str
 
-__all__ = ["EnvError", "env_bool", "env_int", "env_list", "env_rate", "env_str"]
+__all__ = ["EnvError", "env_bool", "env_float", "env_int", "env_list", "env_rate", "env_str"]
 
 RATE_PERIODS = ("s", "m", "h", "d")
 

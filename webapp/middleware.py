@@ -1,7 +1,9 @@
 """Site-wide guards that answer before a view runs or when the database cannot: a request body larger than any
 the site accepts is refused from its Content-Length (413) before a byte of it is read, and a database that is
 locked or unreachable is a 503 that says so instead of a 500. Both answer JSON under /api/ and the site's error page
-elsewhere (`webapp.errors`), drawn without the session or the database."""
+elsewhere (`webapp.errors`), drawn without the session or the database. And every request has a work budget: the
+trees it reads and makes may lay out at most ``FACAID_REQUEST_WORK`` node instances in all and take
+``FACAID_REQUEST_SECONDS`` of CPU (`facaid.grammar.budget`), past which it is a 400 that names the limit."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ import logging
 from django.conf import settings
 from django.db import OperationalError
 
+from facaid.grammar.budget import WorkLimitError, work_budget
 from webapp.errors import error_response
 
 log = logging.getLogger(__name__)
@@ -59,3 +62,20 @@ class BusyDatabaseMiddleware:
         log.warning("database unavailable for %s %s: %s", request.method, request.path, exception)
         return error_response(request, 503, "the database is busy or unavailable; try again in a few seconds",
                               static=True, **{"Retry-After": "5"})
+
+
+class WorkBudgetMiddleware:
+    """One work budget per request (`facaid.grammar.budget`): ``settings.FACAID_REQUEST_WORK`` node instances and
+    ``settings.FACAID_REQUEST_SECONDS`` of CPU; the request that asks for more is a 400 naming the limit."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+
+    def __call__(self, request):
+        with work_budget(settings.FACAID_REQUEST_WORK, settings.FACAID_REQUEST_SECONDS):
+            return self.get_response(request)
+
+    def process_exception(self, request, exception):
+        if not isinstance(exception, WorkLimitError):
+            return None
+        return error_response(request, 400, str(exception))

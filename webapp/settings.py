@@ -9,7 +9,7 @@ from pathlib import Path
 import dj_database_url
 from django.core.exceptions import ImproperlyConfigured
 
-from webapp.env import env_bool, env_int, env_list, env_rate, env_str
+from webapp.env import env_bool, env_float, env_int, env_list, env_rate, env_str
 
 BASE_DIR = Path(__file__).resolve().parent.parent
 VAR_DIR = Path(env_str("FACAID_VAR", str(BASE_DIR / "var")))
@@ -51,6 +51,11 @@ CSRF_FAILURE_VIEW = "webapp.errors.csrf_failure"  # the site's 403 page, saying 
 # lockouts and the API's anonymous throttle count is the one the outermost of them saw (0: REMOTE_ADDR, and a
 # client's own X-Forwarded-For is ignored)
 FACAID_PROXY_COUNT = env_int("FACAID_PROXY_COUNT", 0)
+# what the trees one request reads and makes may cost (facaid.grammar.budget): node instances in all (20 trees at
+# the grammar's limit, MAX_INSTANCES; the most an honest request made was 590,000: 32 variations of the largest CMP
+# reconstruction in 5 ranges) and seconds of the request thread's CPU, checked as each tree is made
+FACAID_REQUEST_WORK = env_int("FACAID_REQUEST_WORK", 2_000_000)
+FACAID_REQUEST_SECONDS = env_float("FACAID_REQUEST_SECONDS", 2.0)
 
 INSTALLED_APPS = [
     "django.contrib.admin",
@@ -80,6 +85,7 @@ MIDDLEWARE = [
     "django.middleware.clickjacking.XFrameOptionsMiddleware",
     "axes.middleware.AxesMiddleware",  # turns a login lockout into the 429 page
     "webapp.middleware.BusyDatabaseMiddleware",
+    "webapp.middleware.WorkBudgetMiddleware",  # the trees one request may read and make (docs/site.md#security)
 ]
 
 ROOT_URLCONF = "webapp.urls"

@@ -39,6 +39,19 @@ def env_int(name: str, default: int, minimum: int | None = None) -> int:
     return value
 
 
+def env_float(name: str, default: float, minimum: float = 0.0) -> float:
+    raw = os.environ.get(name)
+    if raw is None or raw == "":
+        return default
+    try:
+        value = float(raw)
+    except ValueError:
+        raise EnvError(f"{name} must be a number, got {raw!r}") from None
+    if not minimum <= value < float("inf"):
+        raise EnvError(f"{name} must be a finite number of at least {minimum:g}, got {raw!r}")
+    return value
+
+
 def env_seconds(name: str, default: int) -> int | None:
     """A time limit in whole seconds; 0 turns it off (None)."""
     return env_int(name, default, minimum=0) or None

@@ -8,7 +8,10 @@ use it.
 
 from __future__ import annotations
 
-from facaid.grammar.limits import MAX_COUNT, MAX_LEAVES
+import contextlib
+from typing import NamedTuple
+
+from facaid.grammar.limits import MAX_COUNT, MAX_INSTANCES, MAX_LEAVES
 
 
 def nominal(size, length: float) -> float:
@@ -111,42 +114,60 @@ class _TooMany(Exception):
     pass
 
 
-def count_leaves(root, width: float, height: float, limit: int = MAX_LEAVES) -> int:
-    """How many rectangles a tree expands to in a ``width`` x ``height`` image, or ``limit + 1`` as soon as it is
-    more than ``limit``. Counted from the regions' extents without laying out positions: the copies of a repeat
-    (same node, same extent) are counted once, so a tree of a million leaves costs what its distinct nodes do.
-    (The executor places copies at float offsets, so a copy's extent may differ from this one's by a rounding
-    error, which could move a ``"fill"`` count only if its quotient sat exactly on a half: a bound, not a layout.)
-    """
-    memo: dict[tuple[int, float, float], int] = {}
-    total = 0
+class Expansion(NamedTuple):
+    """What laying a tree out costs: the rectangles it draws and the node instances it visits (every node once
+    per copy of it, splits and repeats included; a leaf under a chain of one-child splits costs the chain)."""
 
-    def count(node, w: float, h: float, pending: list | None = None) -> int:
-        nonlocal total
+    leaves: int
+    instances: int
+
+
+def count_expansion(root, width: float, height: float, max_leaves: int = MAX_LEAVES,
+                    max_instances: int = MAX_INSTANCES) -> Expansion:
+    """What a tree expands to in a ``width`` x ``height`` image (`Expansion`), counting stopped as soon as either
+    figure is past its limit (then that figure is its limit + 1). Counted from the regions' extents without laying
+    out positions: the copies of a repeat (same node, same extent) are counted once, so a tree of a million leaves
+    costs what its distinct nodes do. (The executor places copies at float offsets, so a copy's extent may differ
+    from this one's by a rounding error, which could move a ``"fill"`` count only if its quotient sat exactly on a
+    half: a bound, not a layout.)"""
+    memo: dict[tuple[int, float, float], tuple[int, int]] = {}
+    leaves = instances = 0
+
+    def add(n_leaves: int, n_instances: int) -> None:
+        nonlocal leaves, instances
+        leaves += n_leaves
+        instances += n_instances
+        if leaves > max_leaves or instances > max_instances:
+            raise _TooMany
+
+    def count(node, w: float, h: float, pending: list | None = None) -> tuple[int, int]:
         if node.rule == "leaf":
-            total += 1
-            if total > limit:
-                raise _TooMany
-            return 1
+            add(1, 1)
+            return 1, 1
         key = (id(node), w, h)
         known = memo.get(key) if pending is None else None  # overrides reaching in make an instance its own
         if known is not None:
-            total += known
-            if total > limit:
-                raise _TooMany
+            add(*known)
             return known
+        add(0, 1)
         along_x = node.axis == "x"
         length = w if along_x else h
         sizes, children, _, below, _ = expand_over(node, length, pending)
-        n = 0
+        n_leaves, n_instances = 0, 1
         for i, (child, extent) in enumerate(zip(children, layout(sizes, length), strict=True)):
             sub = below[i] if below is not None else None
-            n += count(child, extent, h, sub) if along_x else count(child, w, extent, sub)
+            a, b = count(child, extent, h, sub) if along_x else count(child, w, extent, sub)
+            n_leaves, n_instances = n_leaves + a, n_instances + b
         if pending is None:
-            memo[key] = n
-        return n
+            memo[key] = (n_leaves, n_instances)
+        return n_leaves, n_instances
 
-    try:
-        return count(root, float(width), float(height))
-    except _TooMany:
-        return limit + 1
+    with contextlib.suppress(_TooMany):
+        count(root, float(width), float(height))
+    return Expansion(min(leaves, max_leaves + 1), min(instances, max_instances + 1))
+
+
+def count_leaves(root, width: float, height: float, limit: int = MAX_LEAVES) -> int:
+    """How many rectangles a tree expands to in a ``width`` x ``height`` image, or ``limit + 1`` as soon as it is
+    more than ``limit`` (`count_expansion`)."""
+    return count_expansion(root, width, height, limit, 1 << 62).leaves

@@ -31,13 +31,15 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from facaid.grammar.layout import count_leaves
+from facaid.grammar.budget import charge
+from facaid.grammar.layout import count_expansion
 from facaid.grammar.limits import (
     MAX_CHILDREN,
     MAX_COUNT,
     MAX_DEPTH,
     MAX_EXCEPTIONS,
     MAX_EXTENT,
+    MAX_INSTANCES,
     MAX_LEAVES,
     MAX_META_CHARS,
     MAX_NODES,
@@ -70,8 +72,8 @@ ROLES = (
 
 __all__ = [
     "AXES", "FORMAT", "FORMAT_VERSION", "GRAMMAR_VERSION", "MAX_CHILDREN", "MAX_COUNT", "MAX_DEPTH", "MAX_EXCEPTIONS",
-    "MAX_EXTENT", "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES", "Node", "Override",
-    "Procedure", "ProcedureError", "Size", "parse_procedure", "recount", "validate",
+    "MAX_EXTENT", "MAX_INSTANCES", "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES", "Node",
+    "Override", "Procedure", "ProcedureError", "Size", "parse_procedure", "recount", "validate",
 ]
 
 
@@ -579,5 +581,11 @@ def validate(proc: Procedure) -> None:
 
 
 def _check_expansion(proc: Procedure) -> None:
-    if count_leaves(proc.root, proc.width, proc.height) > MAX_LEAVES:
-        raise ProcedureError("root", f"expands to more than {MAX_LEAVES} rectangles")
+    """The cost model: what executing the tree would cost, bounded before any of it is paid (`count_expansion`,
+    from the distinct nodes only, so a crafted tree is refused in microseconds), and charged to the work budget of
+    the request it is part of (`facaid.grammar.budget`). Each leaf is an instance, so `MAX_LEAVES` holds too."""
+    cost = count_expansion(proc.root, proc.width, proc.height)
+    if cost.instances > MAX_INSTANCES or cost.leaves > MAX_LEAVES:
+        raise ProcedureError("root", f"expands to more than {MAX_INSTANCES} node instances (each node once per copy "
+                                     f"of it, repeats and splits included): the limit of what one tree may cost")
+    charge(cost.instances)

@@ -107,6 +107,11 @@ def test_cli_render_procedure_segmentation_and_overlay(tmp_path, capsys):
          "rects[0] needs 0 <= x0 < x1"),
         ('{"format": "facaid-procedure", "version": 1, "grammar": "facaid-split-1", "width": 10, "height": 10,'
          ' "root": {"rule": "leaf", "label": "sky"}}', "node root: leaf label 'sky'"),
+        ('{"format": "facaid-procedure", "version": 1, "grammar": "facaid-split-1", "width": 4096, "height": 4096,'
+         ' "root": {"rule": "repeat", "axis": "x", "count": 256, "sizes": [["flt", 1]], "children": [{"rule": "repeat",'
+         ' "axis": "y", "count": 256, "sizes": [["flt", 1]], "children": ['
+         + '{"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [' * 29 + '{"rule": "leaf", "label": '
+         '"window"}' + "]}" * 29 + "]}]}}", "expands to more than 100000 node instances"),  # issue 56's crafted tree
     ],
 )
 def test_cli_rejects_bad_input_with_a_message(tmp_path, capsys, content, message):

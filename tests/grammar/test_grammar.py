@@ -166,7 +166,7 @@ def test_expansion_limit():
     rep2 = {"rule": "repeat", "axis": "y", "count": 256, "tail": 0, "sizes": [["flt", 1]], "children": [rep]}
     doc = {"format": "facaid-procedure", "version": 1, "grammar": "facaid-split-1", "width": 1000, "height": 1000,
            "root": {"rule": "repeat", "axis": "x", "count": 2, "tail": 0, "sizes": [["flt", 1]], "children": [rep2]}}
-    with pytest.raises(ProcedureError, match="more than 100000 rectangles"):
+    with pytest.raises(ProcedureError, match="more than 100000 node instances"):
         Procedure.from_dict(doc)
 
 
@@ -234,5 +234,70 @@ def test_leaf_count_is_the_executed_count_and_stops_past_the_limit():
     huge = Procedure(1000, 1000, Node.repeat("x", 2, [(Size("flt", 1.0), grid)]))  # 131,072 leaves
     assert count_leaves(huge.root, 1000, 1000) == MAX_LEAVES + 1
     assert count_leaves(grid, 1000, 1000, limit=10**6) == 65_536
-    with pytest.raises(ProcedureError, match=f"expands to more than {MAX_LEAVES} rectangles"):
+    with pytest.raises(ProcedureError, match="expands to more than 100000 node instances"):
         validate(huge)
+
+
+def _instances(node, w: float, h: float, pending=None) -> int:
+    """Node instances laid out, counted the slow way: every copy visited."""
+    from facaid.grammar.layout import expand_over, layout
+
+    if node.rule == "leaf":
+        return 1
+    length = w if node.axis == "x" else h
+    sizes, children, _, below, _ = expand_over(node, length, pending)
+    return 1 + sum(_instances(c, e, h, below[i] if below else None) if node.axis == "x"
+                   else _instances(c, w, e, below[i] if below else None)
+                   for i, (c, e) in enumerate(zip(children, layout(sizes, length), strict=True)))
+
+
+def test_the_cost_model_counts_every_instance_and_refuses_a_crafted_tree_before_any_work():
+    """Issue 56's tree: 2 KB, 65,536 leaves (under the rectangle limit), each under 29 one-child splits: 2 million
+    node instances to lay out. Counted from its 32 distinct nodes, refused by name; what generated facades cost is
+    counted exactly, and the largest of them is far under the limit."""
+    from facaid.generator import generate_procedure
+    from facaid.grammar.layout import count_expansion
+    from facaid.grammar.limits import MAX_INSTANCES
+
+    leaf = Node.leaf("window")
+    for _ in range(29):
+        leaf = Node.split("y", [(Size("flt", 1.0), leaf)])
+    crafted = Procedure(4096, 4096, Node.repeat("x", 256, [(Size("flt", 1.0), Node.repeat(
+        "y", 256, [(Size("flt", 1.0), leaf)]))]))
+    assert len(json.dumps(crafted.to_dict())) < 2500
+    assert count_expansion(crafted.root, 4096, 4096, max_instances=10**8) == (65_536, 1 + 256 + 65_536 * 30)
+    assert count_expansion(crafted.root, 4096, 4096).instances == MAX_INSTANCES + 1  # stops at the limit
+    with pytest.raises(ProcedureError, match="more than 100000 node instances"):
+        Procedure.from_dict(crafted.to_dict())
+    most = 0
+    for seed in range(40):
+        proc = generate_procedure(seed)
+        cost = count_expansion(proc.root, proc.width, proc.height)
+        assert cost.instances == _instances(proc.root, proc.width, proc.height)
+        most = max(most, cost.instances)
+    assert most * 20 < MAX_INSTANCES
+
+
+def test_a_work_budget_bounds_the_trees_one_request_makes():
+    from facaid.generator import generate_procedure
+    from facaid.grammar.budget import WorkLimitError, spent, work_budget
+    from facaid.grammar.layout import count_expansion
+    from facaid.parameters import set_parameters
+
+    proc = generate_procedure(3)
+    cost = count_expansion(proc.root, proc.width, proc.height).instances
+    assert spent() is None
+    validate(proc)  # outside a budget nothing is counted
+    with work_budget(3 * cost):
+        validate(proc)
+        assert spent() == cost
+        validate(proc)
+        validate(proc)
+        with pytest.raises(WorkLimitError, match=f"more than {3 * cost:,} node instances in all"):
+            validate(proc)
+    with work_budget(cost + 1), pytest.raises(WorkLimitError):
+        set_parameters(Procedure.from_dict(proc.to_dict()), {"width": proc.width + 10, "height": proc.height + 10})
+    with work_budget(10**9, seconds=0.0), pytest.raises(WorkLimitError, match="more than 0 s of computing"):
+        sum(range(10**5))  # some CPU time
+        validate(proc)
+    assert spent() is None

@@ -119,3 +119,55 @@ def test_no_5xx_and_nothing_stored_by_a_4xx(case, who, real, pick, world):
     assert response.status_code < 500, (who, case.method, case.formatted_path, response.text[:500])
     if 400 <= response.status_code < 500:
         assert rows() == before, (who, case.method, case.formatted_path, response.status_code)
+
+
+def _resolve(node: dict, components: dict) -> dict:
+    while "$ref" in node:
+        node = components[node["$ref"].split("/")[-1]]
+    return node
+
+
+def _numbers(node: dict, components: dict, bad, path=()):
+    """Each number or integer of a request body's schema, as (its path, a body holding ``bad`` there and nothing
+    else: the least nesting that reaches it)."""
+    node = _resolve(node, components)
+    if node.get("type") in ("number", "integer"):
+        yield path, bad
+    for key, sub in node.get("properties", {}).items():
+        if not sub.get("readOnly"):
+            yield from ((p, {key: body}) for p, body in _numbers(sub, components, bad, (*path, key)))
+    if isinstance(node.get("additionalProperties"), dict):
+        yield from ((p, {"floors": body}) for p, body in _numbers(node["additionalProperties"], components, bad,
+                                                                   (*path, "*")))
+    if "items" in node:
+        yield from ((p, [body]) for p, body in _numbers(node["items"], components, bad, (*path, "[]")))
+    for alternative in node.get("allOf", []) + node.get("oneOf", []) + node.get("anyOf", []):
+        yield from _numbers(alternative, components, bad, path)
+
+
+@pytest.mark.django_db
+def test_every_number_of_every_json_body_refuses_booleans_and_strings(world):
+    """Read from the schema: wherever a JSON body takes a number, ``true`` and ``"5"`` are a 400 that says why
+    (DRF's fields would take them as 1 and 5)."""
+    from django.contrib.auth import get_user_model
+    from rest_framework.test import APIClient
+
+    client = APIClient()
+    client.force_login(get_user_model().objects.get(username="alice"))
+    spec = client.get("/api/v1/schema?format=json").json()
+    components = spec["components"]["schemas"]
+    checked = []
+    for template, operations in spec["paths"].items():
+        path = template.replace("{code}", world["codes"]["procedures"][0] if "/procedures/" in template
+                                else world["codes"]["photos"][0])
+        for method, operation in operations.items():
+            body = operation.get("requestBody", {}).get("content", {}).get("application/json")
+            if body is None:
+                continue
+            for bad, says in ((True, "not a boolean"), ("5", "not a string")):
+                for where, data in _numbers(body["schema"], components, bad):
+                    r = getattr(client, method)(path, data, format="json")
+                    assert r.status_code == 400 and says in r.content.decode(), (method, template, where, bad,
+                                                                                 r.status_code, r.content[:300])
+                    checked.append((method, template, where))
+    assert len({c[1] for c in checked}) >= 7 and len(checked) >= 2 * 14  # every operation the schema names

@@ -165,6 +165,55 @@ def test_rerun_takes_the_same_integers_as_a_job(facade_photo, as_alice, alice, b
     assert r.status_code == 202 and r.json()["params"]["prefix_nodes"] == 3
 
 
+# --- what a tree costs ------------------------------------------------------------------------------------------------
+
+def crafted() -> dict:
+    """Issue 56's 2 KB tree: 256 x 256 repeats, each leaf under 29 one-child splits (2 million node instances)."""
+    node = {"rule": "leaf", "label": "window"}
+    for _ in range(29):
+        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
+    inner = {"rule": "repeat", "axis": "y", "count": 256, "sizes": [["flt", 1]], "children": [node]}
+    return {**wall(4096, 4096), "root": {"rule": "repeat", "axis": "x", "count": 256, "sizes": [["flt", 1]],
+                                         "children": [inner]}}
+
+
+def test_a_crafted_tree_is_refused_by_its_cost_on_every_entry_point_and_changes_nothing(as_alice, alice,
+                                                                                        as_charlie):
+    tree = crafted()
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="public")
+    before, stored = counts(), proc.current_version().version
+    answers = [as_charlie.post("/api/v1/render", tree, format="json"),
+               as_alice.post("/api/v1/procedures/", {"data": tree}, format="json"),
+               as_alice.patch(f"/api/v1/procedures/{proc.code}/", {"data": tree}, format="json"),
+               as_alice.post(f"/api/v1/procedures/{proc.code}/save-as-new", {"data": tree}, format="json"),
+               as_charlie.post(f"/api/v1/procedures/{proc.code}/parameters", {"values": {}, "data": tree},
+                               format="json")]
+    for r in answers:
+        assert r.status_code == 400 and "more than 100000 node instances" in json.dumps(r.json()), r.content[:300]
+    assert counts() == before and Procedure.objects.get(id=proc.id).current_version().version == stored
+
+
+def test_a_request_that_makes_too_many_trees_is_a_400_naming_its_budget(as_charlie, alice, settings):
+    """Each tree is bounded, and so is their sum in one request: setting many parameters of a tree at once makes a
+    tree per value."""
+    from facaid.grammar.layout import count_expansion
+
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="public")
+    tree = generate(3).procedure
+    settings.FACAID_REQUEST_WORK = 4 * count_expansion(tree.root, tree.width, tree.height).instances
+    url = f"/api/v1/procedures/{proc.code}/parameters"
+    r = as_charlie.post(url, {"values": {"width": tree.width + 20}}, format="json")
+    assert r.status_code == 200, r.content[:300]
+    values = {"width": tree.width + 20, "height": tree.height + 20, "floor_height": 90, "tile_width": 60}
+    r = as_charlie.post(url, {"values": values}, format="json")
+    assert r.status_code == 400 and "node instances in all" in r.json()["detail"], r.content[:300]
+    r = as_charlie.get(f"/procedures/{proc.code}")
+    assert r.status_code == 200  # the page itself stays in its budget
+    settings.FACAID_REQUEST_WORK, settings.FACAID_REQUEST_SECONDS = 10**9, 1e-9
+    r = as_charlie.post(url, {"values": {"width": tree.width + 20}}, format="json")
+    assert r.status_code == 400 and "s of computing" in r.json()["detail"], r.content[:300]
+
+
 # --- uploads --------------------------------------------------------------------------------------------------------
 
 def test_a_photo_from_a_phone_in_mpo_is_taken_as_its_first_frame(as_alice):

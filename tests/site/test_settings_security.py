@@ -141,3 +141,12 @@ def test_run_script_exports_the_kept_key_unless_one_is_set_and_serves_plain_http
     first_use = min(text.index(".venv/bin/python manage.py"), text.index(".venv/bin/celery"),
                     text.index(".venv/bin/gunicorn"))
     assert text.index("export SECRET_KEY") < first_use and text.index("export FACAID_HTTPS") < first_use
+
+
+def test_run_script_gives_each_server_its_own_control_socket_and_recycles_workers():
+    """Two local servers (two PORTs) each keep their gunicorn control socket under var/: gunicorn's default, one
+    path in the home folder, let stopping one remove the other's (issue 56)."""
+    text = (ROOT / "scripts" / "run").read_text()
+    line = text[text.index(".venv/bin/gunicorn"):].split("&")[0]
+    assert '--control-socket "var/gunicorn-$PORT.ctl"' in line and "--max-requests 1000" in line
+    assert "--max-requests-jitter" in line

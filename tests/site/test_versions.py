@@ -72,10 +72,18 @@ def test_a_save_is_a_new_version_and_the_first_is_unchanged(facade_photo, as_ali
     again = as_alice.get(_url(proc, "versions/1/")).json()
     assert again["data"] == first and again["digest"] == v1["digest"]  # version 1 is as it was
     assert as_alice.get(_url(proc, "versions/2/")).json()["data"] == Tree.from_dict(edited).to_dict()
-    # a title or visibility change alone records no version; a save of the same tree again does (every save)
+    # a title or visibility change alone records no version, and neither does the same tree saved again
     assert as_alice.patch(_url(proc), {"title": "Rivoli 12", "visibility": "unlisted"}, format="json").json()[
         "version"] == 2
-    assert as_alice.patch(_url(proc), {"data": edited}, format="json").json()["version"] == 3
+    for _ in range(20):
+        assert as_alice.patch(_url(proc), {"data": edited}, format="json").json()["version"] == 2
+    for values in ({}, {"width": proc.data["width"]}):  # parameters set to what they are: the same tree
+        r = as_alice.post(_url(proc, "parameters"), {"values": values, "save": True}, format="json")
+        assert r.status_code == 200 and r.json()["version"] == 2, r.content[:300]
+    assert [v["version"] for v in _history(as_alice, proc)] == [2, 1]
+    r = as_alice.post(_url(proc, "parameters"), {"values": {"width": proc.data["width"] + 10}, "save": True},
+                      format="json")
+    assert r.json()["version"] == 3
 
 
 def test_figures_are_measured_again_on_every_save_and_never_left_stale(facade_photo, as_alice, alice):

@@ -143,9 +143,9 @@ class Procedure(models.Model):
         return reverse("procedure", args=[self.code])
 
     def save(self, *args, change: Change | None = None, **kwargs) -> None:
-        """Save, and record the tree as a new version: always with ``change`` (what made it), else when the tree
-        differs from the latest version's (a procedure created, an edit in the admin), so that a save of the title
-        or visibility alone records none."""
+        """Save, and record the tree as a new version (`_record_version`): when it differs from the latest
+        version's, or when ``change`` is more than an edit (a revert, a re-run); so a save of the title or visibility
+        alone, or of the same tree again, records none."""
         fields = kwargs.get("update_fields")
         writes_tree = "data" in fields if fields is not None else "data" not in self.get_deferred_fields()
         if writes_tree:
@@ -158,11 +158,14 @@ class Procedure(models.Model):
                 self._record_version(change)
 
     def _record_version(self, change: Change | None) -> None:
+        """The versioning rule: a tree is a new version unless it is the latest one's and nothing but an edit made
+        it (a save of an unchanged tree, parameters set to what they were): then the latest stays current."""
         latest = self.versions.order_by("-version").values("version", "digest").first()
-        if change is None:
-            if latest is not None and latest["digest"] == self.digest:
+        unchanged = latest is not None and latest["digest"] == self.digest
+        if change is None or change.kind == ProcedureVersion.Kind.EDIT:
+            if unchanged:
                 return
-            change = Change(ProcedureVersion.Kind.EDIT if latest else ProcedureVersion.Kind.CREATED)
+            change = change or Change(ProcedureVersion.Kind.EDIT if latest else ProcedureVersion.Kind.CREATED)
         ProcedureVersion.objects.create(
             procedure=self, version=(latest["version"] if latest else 0) + 1, data=self.data, digest=self.digest,
             accuracy=self.accuracy, metrics=self.metrics, kind=change.kind, note=change.note[:200],

@@ -4,6 +4,7 @@ name the offending field or grammar node."""
 from __future__ import annotations
 
 from django.contrib.auth.models import AnonymousUser
+from django.http import QueryDict
 from rest_framework import serializers
 
 from facaid import interchange
@@ -46,13 +47,29 @@ def title_field() -> TextField:
     return TextField(max_length=200, required=False, allow_blank=True)
 
 
-class FiniteFloatField(serializers.FloatField):
-    """A finite number: DRF's FloatField lets an integer too large for a float raise OverflowError (a 500) and
-    takes infinity."""
+def _json_body(field: serializers.Field) -> bool:
+    """Whether ``field`` reads a JSON body (a form or multipart body sends every number as text)."""
+    return not isinstance(getattr(field.root, "initial_data", None), QueryDict)
 
-    default_error_messages = {"invalid": "A finite number is required."}
+
+def _not_a_number(field: serializers.Field, data) -> None:
+    """Refuse a boolean (which Python counts as 0 or 1) and, in a JSON body, a number written as a string."""
+    if isinstance(data, bool):
+        field.fail("boolean")
+    if isinstance(data, str) and _json_body(field):
+        field.fail("string")
+
+
+class NumberField(serializers.FloatField):
+    """A finite JSON number: not a boolean, not a string (DRF's FloatField takes ``true`` as 1 and ``"5"`` as 5),
+    not infinity, and no 500 for an integer too large for a float (DRF's raises OverflowError)."""
+
+    default_error_messages = {"invalid": "A finite number is required.",
+                              "boolean": "A number is required, not a boolean.",
+                              "string": "A number is required, not a string: write it without quotes."}
 
     def to_internal_value(self, data):
+        _not_a_number(self, data)
         try:
             value = super().to_internal_value(data)
         except OverflowError:
@@ -62,13 +79,18 @@ class FiniteFloatField(serializers.FloatField):
         return value
 
 
-class MetresField(FiniteFloatField):
-    """A length: a finite number, not a boolean (which DRF's FloatField would take as 0 or 1)."""
+class WholeNumberField(serializers.IntegerField):
+    """A whole JSON number: not a boolean, not a string (DRF's IntegerField takes ``"5"`` as 5)."""
+
+    default_error_messages = {"boolean": "A whole number is required, not a boolean.",
+                              "string": "A whole number is required, not a string: write it without quotes."}
 
     def to_internal_value(self, data):
-        if isinstance(data, bool):
-            self.fail("invalid")
+        _not_a_number(self, data)
         return super().to_internal_value(data)
+
+
+MetresField = NumberField  # a length in metres
 
 
 def real_size_field(side: str) -> MetresField:
@@ -130,7 +152,7 @@ class PhotoUploadSerializer(serializers.Serializer):
 
 class RectifySerializer(serializers.Serializer):
     corners = serializers.ListField(
-        child=serializers.ListField(child=FiniteFloatField(), min_length=2, max_length=2),
+        child=serializers.ListField(child=NumberField(), min_length=2, max_length=2),
         min_length=4, max_length=4, help_text="[[x, y] x 4]: top-left, top-right, bottom-right, bottom-left")
 
 
@@ -249,8 +271,8 @@ class JobSerializer(serializers.ModelSerializer):
         return str(job.result.code) if job.result_id else None
 
 
-def k_field() -> serializers.IntegerField:
-    return serializers.IntegerField(min_value=1, max_value=MAX_K, default=DEFAULT_K,
+def k_field() -> WholeNumberField:
+    return WholeNumberField(min_value=1, max_value=MAX_K, default=DEFAULT_K,
                                     help_text="candidates decoded and compared")
 
 
@@ -260,9 +282,9 @@ MAX_PREFIX_NODES = MAX_NODES  # a prefix keeps at most the whole tree
 class JobCreateSerializer(serializers.Serializer):
     segmentation = serializers.UUIDField()
     k = k_field()
-    seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
+    seed = WholeNumberField(min_value=0, max_value=2**31 - 1, default=0)
     prefix_procedure = serializers.UUIDField(required=False, allow_null=True, default=None)
-    prefix_nodes = serializers.IntegerField(min_value=0, max_value=MAX_PREFIX_NODES, default=0)
+    prefix_nodes = WholeNumberField(min_value=0, max_value=MAX_PREFIX_NODES, default=0)
     structure = serializers.ChoiceField(
         STRUCTURES, default="editable",
         help_text="which procedure of a real facade becomes current: editable (floors of tiles with exceptions, "
@@ -273,20 +295,20 @@ class JobCreateSerializer(serializers.Serializer):
 class RerunSerializer(serializers.Serializer):
     """A re-run keeps the procedure's first ``nodes`` nodes (breadth first); the same integers as a job's."""
 
-    nodes = serializers.IntegerField(min_value=1, max_value=MAX_PREFIX_NODES, default=1)
+    nodes = WholeNumberField(min_value=1, max_value=MAX_PREFIX_NODES, default=1)
     k = k_field()
 
 
 class VariationsSerializer(serializers.Serializer):
-    n = serializers.IntegerField(min_value=1, max_value=32, default=8)
-    seed = serializers.IntegerField(min_value=0, max_value=2**31 - 1, default=0)
+    n = WholeNumberField(min_value=1, max_value=32, default=8)
+    seed = WholeNumberField(min_value=0, max_value=2**31 - 1, default=0)
     ranges = serializers.DictField(
-        child=serializers.ListField(child=serializers.FloatField(), min_length=2, max_length=2), required=False,
+        child=serializers.ListField(child=NumberField(), min_length=2, max_length=2), required=False,
         help_text="named parameter -> [low, high], e.g. {\"floors\": [4, 7]}: each variant draws them instead")
 
 
 class ParametersSerializer(serializers.Serializer):
-    values = serializers.DictField(child=serializers.FloatField(), allow_empty=True,
+    values = serializers.DictField(child=NumberField(), allow_empty=True,
                                    help_text="named parameters to set, e.g. {\"floors\": 6}")
     save = serializers.BooleanField(default=False, help_text="save the result as the procedure's next version "
                                                              "(owner only); else it is only returned")
@@ -303,6 +325,6 @@ class ConvertSerializer(serializers.Serializer):
                                      help_text="its format (default: found from the content)")
     image = TextField(max_length=1000, required=False,
                       help_text="of a COCO or CVAT file of several images, the one to read: its file name or id")
-    width = serializers.IntegerField(min_value=1, max_value=MAX_SIDE, required=False,
+    width = WholeNumberField(min_value=1, max_value=MAX_SIDE, required=False,
                                      help_text="with height: of several images, read the only one of this size")
-    height = serializers.IntegerField(min_value=1, max_value=MAX_SIDE, required=False)
+    height = WholeNumberField(min_value=1, max_value=MAX_SIDE, required=False)

@@ -43,8 +43,8 @@ def remeasure(proc: Procedure) -> None:
 
 def save_tree(proc: Procedure, data: dict, change: Change | None = None) -> None:
     """Give the procedure ``data`` (a validated procedure JSON), re-measured, and save it with its other fields as
-    a new version (an edit unless ``change`` says otherwise), also when the tree is the one it holds: every save
-    is a version, and its figures are fresh."""
+    a new version (an edit unless ``change`` says otherwise); an edit that leaves the tree as it is makes none
+    (`models.Procedure._record_version`), and the current version stays."""
     proc.data = data
     remeasure(proc)
     proc.save(change=change or Change(ProcedureVersion.Kind.EDIT))
