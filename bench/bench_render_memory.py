@@ -46,6 +46,9 @@ CASES = {  # name: what the request is
     "segmentation-list-100": "GET a photo's 100 segmentation versions of 20,000 rectangles each (a page)",
     "remeasure-40MP": "PATCH the data of a procedure made from a 40 MP segmentation (2,000 windows), re-measured",
     "compare.png-73947-leaves": "GET the difference picture of two versions of the 73,947-leaf procedure",
+    "complete-40MP-rgba-png": "POST complete on a 40 MP RGBA PNG photo, 2,000 rectangles of 2,000 sizes, anonymous",
+    "overlay.png-40MP-rgba-png": "GET overlay.png over a 40 MP RGBA PNG photo",
+    "facade-photo.glb-40MP-rgba-png": "GET facade-photo.glb (the relief with the photo on its fronts), 40 MP RGBA PNG",
 }
 
 CHILD = r"""
@@ -190,6 +193,27 @@ elif case == "compare.png-73947-leaves":
         proc.save()  # a second version
     warm = lambda: anon.get(f"/api/v1/procedures/{little.code}/versions/compare.png?a=1&b=2")
     run = lambda: anon.get(f"/api/v1/procedures/{big.code}/versions/compare.png?a=1&b=2")
+elif case == "complete-40MP-rgba-png":
+    p, _, _ = photo("PNG", mode="RGBA")
+    sp, _, _ = photo("PNG", 100, 80, mode="RGBA")
+    import numpy as np
+    rng = np.random.default_rng(0)
+    rects = []
+    for i in range(2000):
+        w, h = np.exp(rng.uniform(np.log(8), np.log(300), size=2))
+        x, y = rng.uniform(0, 8000 - w), rng.uniform(0, 5000 - h)
+        rects.append({"label": ["window", "door", "balcony", "sill", "blind"][i % 5], "x0": int(x), "y0": int(y),
+                      "x1": int(x + w), "y1": int(y + h)})
+    body = {"width": 8000, "height": 5000, "rects": rects}
+    small_body = {"width": 100, "height": 80, "rects": [{"label": "window", "x0": 10, "y0": 10, "x1": 30, "y1": 40}]}
+    warm = lambda: anon.post(f"/api/v1/photos/{sp.code}/complete", small_body, format="json")
+    run = lambda: anon.post(f"/api/v1/photos/{p.code}/complete", body, format="json")
+elif case in ("overlay.png-40MP-rgba-png", "facade-photo.glb-40MP-rgba-png"):
+    name = case.split("-40MP")[0]
+    p, proc, _ = photo("PNG", mode="RGBA")
+    sp, sproc, _ = photo("PNG", 100, 80, mode="RGBA")
+    warm = lambda: anon.get(f"/api/v1/procedures/{sproc.code}/download/{name}")
+    run = lambda: anon.get(f"/api/v1/procedures/{proc.code}/download/{name}")
 else:
     raise SystemExit(f"unknown case {case}")
 

@@ -10,6 +10,8 @@ allows it (a public procedure). The trees:
 - ``deep``: the same shape cut to the limit: 256 x 12 copies of a 29-split chain (95,000 node instances).
 - ``wide``: 157 x 157 tiles of a window with wall on both sides (73,947 leaves, 98,755 instances), its rows
   floors, its tiles bays, its windows windows: every named parameter applies.
+- ``photo``: completion (no tree): 2,000 rectangles of 2,000 sizes drawn on a public 16 MP photo (issue 56 measured
+  135 s for 1,690 types).
 
 Each figure is the median of ``--repeat`` requests, in seconds of wall time on an idle machine (one request at
 a time, so wall time is the CPU the request thread holds). Target: a crafted tree refused in < 0.1 s on every
@@ -42,6 +44,7 @@ CASES = {
     "labels.png": "GET the download labels.png",
     "facade.glb": "GET the download facade.glb",
     "procedure.cga": "GET the download procedure.cga",
+    "complete-16MP": "POST complete, 2,000 rectangles of 2,000 sizes on a public 16 MP photo, anonymous",
 }
 
 BODY = ("render", "store", "set-floors", "set-window-width", "set-all")  # the requests that carry a tree in their body
@@ -86,13 +89,32 @@ def wide(n):
                 "children": [row]})
 
 
-tree = {"crafted": chain(256, 256, 29), "deep": chain(256, 12, 29), "wide": wide(157)}[tree_name]
+tree = {"crafted": chain(256, 256, 29), "deep": chain(256, 12, 29), "wide": wide(157), "photo": wide(2)}[tree_name]
 proc = Procedure.objects.create(owner=user, data=wide(2), visibility="public")
 if tree_name != "crafted":
     proc.data = tree
     proc.save()  # the heavy tree as its version 2 (version 1 is small)
 code = proc.code
 floors_range = {"floors": [2, 4]}
+if case == "complete-16MP":
+    import io
+    import numpy as np
+    from django.core.files.images import ImageFile
+    from PIL import Image
+    from webapp.facades.models import Photo
+    rng = np.random.default_rng(0)
+    buf = io.BytesIO()
+    Image.fromarray(rng.integers(0, 256, size=(4000, 4000, 3), dtype=np.uint8)).save(buf, "JPEG", quality=85)
+    photo = Photo(owner=user, title="noise", visibility="public")
+    photo.image.save("photo.jpg", ImageFile(io.BytesIO(buf.getvalue()), name="photo"), save=False)
+    photo.save()
+    rects = []
+    for i in range(2000):
+        w, h = np.exp(rng.uniform(np.log(8), np.log(300), size=2))
+        x, y = rng.uniform(0, 4000 - w), rng.uniform(0, 4000 - h)
+        rects.append({"label": ["window", "door", "balcony", "sill", "blind"][i % 5], "x0": int(x), "y0": int(y),
+                      "x1": int(x + w), "y1": int(y + h)})
+    drawn = {"width": 4000, "height": 4000, "rects": rects}
 requests = {
     "render": lambda: anon.post("/api/v1/render", tree, format="json"),
     "store": lambda: owner.post("/api/v1/procedures/", {"data": tree}, format="json"),
@@ -112,6 +134,7 @@ requests = {
     "labels.png": lambda: anon.get(f"/api/v1/procedures/{code}/download/labels.png"),
     "facade.glb": lambda: anon.get(f"/api/v1/procedures/{code}/download/facade.glb"),
     "procedure.cga": lambda: anon.get(f"/api/v1/procedures/{code}/download/procedure.cga"),
+    "complete-16MP": lambda: anon.post(f"/api/v1/photos/{photo.code}/complete", drawn, format="json"),
 }
 anon.post("/api/v1/render", wide(2), format="json")  # warm: imports, URL resolution
 times, status = [], None
@@ -144,13 +167,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--case", nargs="*", choices=sorted(CASES), help="only these requests")
-    ap.add_argument("--tree", nargs="*", choices=["crafted", "deep", "wide"], default=["crafted", "deep", "wide"])
+    ap.add_argument("--tree", nargs="*", choices=["crafted", "deep", "wide", "photo"],
+                    default=["crafted", "deep", "wide", "photo"])
     args = ap.parse_args()
     print(f"{'tree':8s} {'request':18s} {'status':>6s} {'seconds (median)':>17s}  runs")
     for tree in args.tree:
         for case in args.case or CASES:
             if tree == "crafted" and case not in BODY:
                 continue  # a tree the site refuses is never stored: only requests that carry one can send it
+            if (tree == "photo") != (case == "complete-16MP"):
+                continue
             r = run_case(tree, case, args.repeat)
             print(f"{tree:8s} {case:18s} {r['status']:6d} {statistics.median(r['times']):17.3f}  "
                   f"{', '.join(f'{t:.3f}' for t in r['times'])}   {CASES[case]}", flush=True)

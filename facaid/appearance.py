@@ -18,6 +18,35 @@ PATCH = 12  # side of the patches compared: a window's panes and frame at any si
 FLAT = 0.5  # grey levels: a patch whose spread is below this (a flat colour, a render) has no appearance
 
 
+class Levels:
+    """A photo's grey levels with what the searches and checks of one call share: the picture PIL resizes patches
+    from (a copy of the levels, made once: it was made per search, most of a call's time with many types). The
+    levels may be of a smaller ``scale`` (x, y) than the segmentation whose boxes are asked about (`levels`)."""
+
+    def __init__(self, grey_levels: np.ndarray, scale: tuple[float, float] = (1.0, 1.0)):
+        self.array = grey_levels
+        self.shape = grey_levels.shape
+        self.scale = np.array([*scale, *scale], dtype=float)  # x, y, x, y: boxes in pixels of the segmentation
+        self._image: Image.Image | None = None
+
+    @property
+    def image(self) -> Image.Image:
+        if self._image is None:
+            self._image = Image.fromarray(self.array, "F")
+        return self._image
+
+    def scaled(self, f: float) -> np.ndarray:
+        """The levels scaled by ``f`` (≤ 1; OpenCV's area average), made anew: a copy per scale kept for the call
+        would hold up to 16 MB for each type searched."""
+        import cv2
+
+        return self.array if f >= 1 else cv2.resize(self.array, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+
+
+def _levels(grey_levels: np.ndarray | Levels) -> Levels:
+    return grey_levels if isinstance(grey_levels, Levels) else Levels(grey_levels)
+
+
 def grey(photo: Any, width: int, height: int) -> np.ndarray:
     """The photo (a PIL image, a path, or an (H, W) / (H, W, C) array) as float32 grey levels of the segmentation's
     size, resized when it has another (the rectified photo a segmentation was drawn on has its size)."""
@@ -36,10 +65,32 @@ def grey(photo: Any, width: int, height: int) -> np.ndarray:
     return np.asarray(image, dtype=np.float32)
 
 
-def patches(grey_levels: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+WORK_PIXELS = 8_000_000  # a larger photo is read at a smaller scale (`levels`): its levels and their copy ≤ 64 MB
+
+
+def levels(photo: Any, width: int, height: int, max_pixels: int = WORK_PIXELS) -> Levels:
+    """The grey levels of a photo (a PIL image, a path or a file) for a segmentation of ``width`` x ``height``, at
+    most ``max_pixels`` of them: a larger one is read at a smaller scale, and the answers about boxes are still in
+    the segmentation's pixels. A path or file is opened here and let go once it is grey (a JPEG decoded at a
+    reduced scale already), so the call holds one full-size decoded copy at most for a moment."""
+    s = min(1.0, float(np.sqrt(max_pixels / max(1, width * height))))
+    tw, th = max(1, round(width * s)), max(1, round(height * s))
+    if isinstance(photo, Image.Image):
+        image = photo.convert("L")
+    else:
+        with Image.open(photo) as opened:
+            opened.draft("L", (tw, th))
+            image = opened.convert("L")
+    if image.size != (tw, th):
+        image = image.resize((tw, th), Image.Resampling.BILINEAR)
+    return Levels(np.asarray(image, dtype=np.float32), (tw / width, th / height))
+
+
+def patches(grey_levels: np.ndarray | Levels, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(normalized patches (n, PATCH * PATCH), flat (n,) bool) of the boxes ((n, 4) x0, y0, x1, y1 in pixels)."""
-    h, w = grey_levels.shape
-    image = Image.fromarray(grey_levels, "F")
+    levels = _levels(grey_levels)
+    h, w = levels.shape
+    image = levels.image
     out = np.zeros((len(boxes), PATCH * PATCH), dtype=np.float32)
     flat = np.ones(len(boxes), dtype=bool)
     for i, (x0, y0, x1, y1) in enumerate(np.asarray(boxes, dtype=float).tolist()):
@@ -56,9 +107,15 @@ def patches(grey_levels: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.
     return out, flat
 
 
-def similarity(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray) -> np.ndarray:
+def similarity(grey_levels: np.ndarray | Levels, boxes: np.ndarray, examples: np.ndarray) -> np.ndarray:
     """Each box's best NCC against the example boxes ((m, 4)), in [-1, 1]; NaN where the box or every example
-    is flat, or there is no example."""
+    is flat, or there is no example. Boxes in the segmentation's pixels, whatever the levels' scale."""
+    levels = _levels(grey_levels)
+    return _similarity(levels, np.asarray(boxes, dtype=float).reshape(-1, 4) * levels.scale,
+                       np.asarray(examples, dtype=float).reshape(-1, 4) * levels.scale)
+
+
+def _similarity(grey_levels: Levels, boxes: np.ndarray, examples: np.ndarray) -> np.ndarray:
     sims = np.full(len(boxes), np.nan)
     theirs = _examples(grey_levels, examples)
     if not len(boxes) or not len(theirs):
@@ -69,7 +126,7 @@ def similarity(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray)
     return sims
 
 
-def _examples(grey_levels: np.ndarray, examples: np.ndarray) -> np.ndarray:
+def _examples(grey_levels: np.ndarray | Levels, examples: np.ndarray) -> np.ndarray:
     """The normalized patches of the examples that are not flat."""
     if not len(examples):
         return np.zeros((0, PATCH * PATCH), dtype=np.float32)
@@ -80,7 +137,21 @@ def _examples(grey_levels: np.ndarray, examples: np.ndarray) -> np.ndarray:
 SHIFTS = (-0.2, -0.1, 0.0, 0.1, 0.2)  # shares of a box's width (height) that `refine` moves it by
 
 
-def refine(grey_levels: np.ndarray, boxes: np.ndarray, examples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def refine(grey_levels: np.ndarray | Levels, boxes: np.ndarray, examples: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """(boxes moved to where they look most like the examples, their NCC): see `_refine`; boxes in the
+    segmentation's pixels, whatever the levels' scale."""
+    levels = _levels(grey_levels)
+    boxes = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    if (levels.scale == 1).all():
+        return _refine(levels, boxes, np.asarray(examples, dtype=float).reshape(-1, 4))
+    moved, sims = _refine(levels, boxes * levels.scale,
+                          np.asarray(examples, dtype=float).reshape(-1, 4) * levels.scale)
+    shift = np.round(moved[:, :2] / levels.scale[:2] - boxes[:, :2])  # each box moved, its size kept
+    return np.where(~np.isnan(sims)[:, None], boxes + np.concatenate([shift, shift], axis=1), boxes), sims
+
+
+def _refine(grey_levels: Levels, boxes: np.ndarray, examples: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(boxes moved to where they look most like the examples, their NCC): each box is tried at `SHIFTS` of its
     size along x and y (25 places) and kept where its best NCC against the examples is highest; NaN and the box
     unmoved where the photo says nothing."""
@@ -114,8 +185,24 @@ SHARPEN = 4  # the places found are put right on a copy this many times finer th
 CONTEXT = 0.25  # share of its size around each example that is matched with it (a window in its wall)
 
 
-def search(grey_levels: np.ndarray, examples: np.ndarray, size: tuple[float, float], threshold: float,
+def search(grey_levels: np.ndarray | Levels, examples: np.ndarray, size: tuple[float, float], threshold: float,
            limit: int = 200) -> tuple[np.ndarray, np.ndarray]:
+    """(boxes of ``size``, their NCC) where the photo looks like the examples: see `_search`; boxes and size in the
+    segmentation's pixels, whatever the levels' scale."""
+    levels = _levels(grey_levels)
+    if (levels.scale == 1).all():
+        return _search(levels, np.asarray(examples, dtype=float).reshape(-1, 4), size, threshold, limit)
+    sx, sy = levels.scale[:2]
+    boxes, sims = _search(levels, np.asarray(examples, dtype=float).reshape(-1, 4) * levels.scale,
+                          (size[0] * sx, size[1] * sy), threshold, limit)
+    if len(boxes):  # the found places at the size asked for, around their middles
+        mx, my = (boxes[:, 0] + boxes[:, 2]) / (2 * sx), (boxes[:, 1] + boxes[:, 3]) / (2 * sy)
+        boxes = np.stack([mx - size[0] / 2, my - size[1] / 2, mx + size[0] / 2, my + size[1] / 2], axis=1)
+    return boxes, sims
+
+
+def _search(levels: Levels, examples: np.ndarray, size: tuple[float, float], threshold: float,
+            limit: int = 200) -> tuple[np.ndarray, np.ndarray]:
     """(boxes (n, 4) of ``size`` = (width, height), their NCC) where the photo looks like the examples ((m, 4)
     boxes) at ``threshold`` or more, anywhere in it. Each example with `CONTEXT` of its size around it (what is
     beside a window tells it from a pane of a shop's glass), scaled to ``size``, is slid over the photo (OpenCV's
@@ -129,16 +216,16 @@ def search(grey_levels: np.ndarray, examples: np.ndarray, size: tuple[float, flo
     w, h = float(size[0]), float(size[1])
     if not len(examples) or w < 2 or h < 2:
         return none
-    f = min(1.0, SEARCH_SIDE / min(w, h), float(np.sqrt(SEARCH_PIXELS / grey_levels.size)))
+    f = min(1.0, SEARCH_SIDE / min(w, h), float(np.sqrt(SEARCH_PIXELS / levels.array.size)))
     if min(w, h) * f < SEARCH_SMALLEST:
         return none
-    small = cv2.resize(grey_levels, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if f < 1 else grey_levels
+    small = levels.scaled(f)
     mx, my = CONTEXT * w, CONTEXT * h
     tw, th = max(3, round((w + 2 * mx) * f)), max(3, round((h + 2 * my) * f))
     if tw >= small.shape[1] or th >= small.shape[0]:
         return none
-    image = Image.fromarray(grey_levels, "F")
-    gh, gw = grey_levels.shape
+    image = levels.image
+    gh, gw = levels.shape
     f2 = min(1.0, SHARPEN * f)  # the scale the places found are then put right at
     tw2, th2 = max(3, round((w + 2 * mx) * f2)), max(3, round((h + 2 * my) * f2))
     response, fine = None, []
@@ -170,18 +257,18 @@ def search(grey_levels: np.ndarray, examples: np.ndarray, size: tuple[float, flo
     order = np.argsort(-sims, kind="stable")[:limit]
     x, y = xs[order] / f, ys[order] / f  # the top-left corners of the places with their context, in pixels
     if f2 > f:
-        x, y = _sharpen(grey_levels, fine, f2, x, y, slack=1 / f)
+        x, y = _sharpen(levels, fine, f2, x, y, slack=1 / f)
     x, y = x + mx, y + my
     return np.stack([x, y, x + w, y + h], axis=1), sims[order].astype(float)
 
 
-def _sharpen(grey_levels: np.ndarray, templates: list[np.ndarray], f: float, x: np.ndarray, y: np.ndarray,
+def _sharpen(levels: Levels, templates: list[np.ndarray], f: float, x: np.ndarray, y: np.ndarray,
              slack: float) -> tuple[np.ndarray, np.ndarray]:
     """The places (top-left corners ``x``, ``y`` in pixels) moved, each within ``slack`` pixels, to where the
     ``templates`` (at scale ``f``) match best on a copy of the photo at that scale."""
     import cv2
 
-    copy = cv2.resize(grey_levels, None, fx=f, fy=f, interpolation=cv2.INTER_AREA) if f < 1 else grey_levels
+    copy = levels.scaled(f)
     ch, cw = copy.shape
     th, tw = templates[0].shape
     r = int(np.ceil(slack * f)) + 1

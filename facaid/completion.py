@@ -53,6 +53,7 @@ MAX_DRAWN = 2_000  # more drawn rectangles than this are refused (a CMP facade h
 MAX_PROPOSALS = 2_000  # proposals gathered at most in one call
 MAX_FILL = 16  # two drawn lines at most this many pitches apart are filled between
 MAX_TYPES = 200  # with more types than this (no facade has them), companions are not looked for
+MAX_SEARCH_TYPES = 64  # the photo is searched for at most this many types, those drawn most often (CMP: 58 at most)
 SIZE_TOLERANCE = 0.2  # elements of one class whose width and height agree within this share are one type
 SAME_PLACE = 0.5  # IoU at which two proposals are the same element
 OVERLAP = 0.2  # a proposal whose area lies this much over drawn elements of its class is not made
@@ -320,16 +321,19 @@ def _companions(types: list[_Type], props: _Proposals) -> None:
                 props.add(s.label, anchor + offset, round(0.3 + 0.5 * share, 3), f"with {LABELS[a.label]}")
 
 
-def _search(levels: np.ndarray, types: list[_Type], props: _Proposals) -> None:
+def _search(levels: appearance.Levels, types: list[_Type], props: _Proposals) -> None:
     """Where the photo looks like a type's drawn elements (`facaid.appearance.search`, NCC at least
-    `SEARCH_MATCH`), anywhere in the facade: each such place is proposed at the type's size (``looks like``)."""
-    for t in types:
+    `SEARCH_MATCH`), anywhere in the facade: each such place is proposed at the type's size (``looks like``). The
+    `MAX_SEARCH_TYPES` types drawn most often are searched for (in their order), so that a call costs at most that
+    many searches however many types are drawn."""
+    most = sorted(range(len(types)), key=lambda i: -len(types[i].boxes))[:MAX_SEARCH_TYPES]
+    for t in (types[i] for i in sorted(most)):
         boxes, _ = appearance.search(levels, t.boxes, (t.width, t.height), SEARCH_MATCH)
         for box in boxes:
             props.add(t.label, box, PHOTO_CONFIRMED, f"looks like {LABELS[t.label]}")
 
 
-def _photo_check(levels: np.ndarray, props: _Proposals) -> dict[int, tuple[float, float, np.ndarray]]:
+def _photo_check(levels: appearance.Levels, props: _Proposals) -> dict[int, tuple[float, float, np.ndarray]]:
     """{item: (score, similarity, box)} for the proposals the photo has a say on: each is moved to where it looks
     most like the drawn elements of its class (`facaid.appearance.refine`); one that looks like them scores at least
     `PHOTO_CONFIRMED`, one that does not half its structural score; a flat place or class keeps its score."""
@@ -378,7 +382,12 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
     _companions(types, props)
     looks = {}
     if photo is not None:
-        levels = appearance.grey(photo, seg.width, seg.height)
+        if isinstance(photo, appearance.Levels):
+            levels = photo
+        elif isinstance(photo, np.ndarray):
+            levels = appearance.Levels(appearance.grey(photo, seg.width, seg.height))
+        else:
+            levels = appearance.levels(photo, seg.width, seg.height)
         _search(levels, types, props)
         looks = _photo_check(levels, props)
     out = []

@@ -167,9 +167,28 @@ def _mesh(gltf: gl.GLTF2, data: _Data, relief: Relief, shape: _Shape, box: np.nd
     return len(gltf.meshes) - 1
 
 
+def shrunk_rgb(photo: Image.Image, factor: int, rows: int = 256) -> Image.Image:
+    """``photo`` in RGB, ``factor`` times smaller (each block of factor x factor pixels averaged), made strip by
+    strip: PIL's own `reduce` of an image with alpha premultiplies a full-size copy first, and a conversion first
+    makes a full-size RGB copy."""
+    w, h = photo.size
+    out = Image.new("RGB", (-(-w // factor), -(-h // factor)))
+    step = factor * rows
+    for y in range(0, h, step):
+        strip = photo.crop((0, y, w, min(h, y + step))).convert("RGB")
+        out.paste(strip.reduce(factor) if factor > 1 else strip, (0, y // factor))
+    return out
+
+
 def _add_photo(gltf: gl.GLTF2, data: _Data, photo: Image.Image) -> None:
-    """The photo as a JPEG texture and the material ``photo`` that shows it."""
-    image = photo.convert("RGB")
+    """The photo as a JPEG texture and the material ``photo`` that shows it. A large photo is shrunk before it is
+    converted (a JPEG decoded at a reduced scale; others reduced by a whole factor, which averages each channel on
+    its own: no full-size premultiplied or converted copy), so the call holds one decoded copy at most."""
+    photo.draft("RGB", (MAX_TEXTURE, MAX_TEXTURE))
+    if photo.width * photo.height > MAX_TEXTURE**2:  # no converted (or premultiplied) full-size copy
+        image = shrunk_rgb(photo, -(-max(photo.size) // MAX_TEXTURE))
+    else:
+        image = photo.convert("RGB")
     image.thumbnail((MAX_TEXTURE, MAX_TEXTURE))
     out = io.BytesIO()
     image.save(out, "JPEG", quality=90)

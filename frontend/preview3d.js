@@ -5,6 +5,7 @@
 // its label and tree path (the node's glTF `extras`), a click keeps it. Frames are drawn on demand, never in a loop.
 // `window.facaidPreview3d` says how far it got, for the page's tests.
 import {elementOf, elementsUnder, elementText, fitView, keyLight} from "./preview3d-view.js";
+import {patientFetch} from "./server.js";
 
 const panel = document.getElementById("preview3d");
 const view = panel.querySelector(".preview3d-view");
@@ -156,7 +157,7 @@ function dispose(root) {
 async function load(variant) {
   if (models.has(variant)) return models.get(variant);
   const url = panel.dataset[variant === "photo" ? "photoGlb" : "glb"];
-  const r = await fetch(url, {credentials: "same-origin", cache: "no-cache"});
+  const r = await patientFetch(url, {credentials: "same-origin", cache: "no-cache"});
   if (!r.ok) {
     const body = await r.json().catch(() => ({}));
     throw new Error(Object.values(body).flat().join(" ") || `the server answered ${r.status}`);

@@ -2,6 +2,8 @@
 // compared side by side (both pictures, the pixels whose label differs, both accuracies against the procedure's
 // segmentation), and, for the owner, revert: a new version equal to an old one, after which the page reloads.
 
+import {patientFetch, patientImage} from "./server.js";
+
 const KINDS = {created: "created", edit: "edited", revert: "reverted", rerun: "re-run"};
 
 export function accuracyText(accuracy) {
@@ -65,17 +67,17 @@ export function mountHistory({code, owner, csrf}) {
 
   async function compare(a, b) {
     status.textContent = `comparing version ${a} with version ${b}…`;
-    const r = await fetch(`${api}compare?a=${a}&b=${b}`, {credentials: "same-origin"});
+    const r = await patientFetch(`${api}compare?a=${a}&b=${b}`, {credentials: "same-origin"});
     const body = await r.json().catch(() => ({}));
     if (!r.ok) { status.textContent = `could not compare: ${JSON.stringify(body)}`; return; }
     const width = Math.max(body.a.width, body.b.width);
     for (const [side, v] of [["a", body.a], ["b", body.b]]) {
       const img = document.getElementById(`compare-${side}`);
-      img.src = v.picture; img.style.width = `${(100 * v.width) / width}%`;
+      patientImage(img, v.picture); img.style.width = `${(100 * v.width) / width}%`;
       document.getElementById(`compare-${side}-caption`).textContent =
         `${side.toUpperCase()}: version ${v.version} · pixel accuracy ${accuracyText(v.accuracy)}`;
     }
-    document.getElementById("compare-diff").src = body.overlay;
+    patientImage(document.getElementById("compare-diff"), body.overlay);
     document.getElementById("compare-diff").style.width = "100%";
     document.getElementById("compare-diff-caption").textContent =
       `in magenta, ${(100 * body.differing).toFixed(2)} % of the pixels: their label differs`;

@@ -5,6 +5,7 @@
 // outlines what it stands for in the picture.
 import {accuracyText, mountHistory} from "./procedure-history.js";
 import {leafAt, leavesUnder, parametersOf, pictureToProcedure} from "./selection.js";
+import {patientFetch} from "./server.js";
 
 const script = document.currentScript || document.querySelector("script[data-code]");
 const code = script.dataset.code;
@@ -298,12 +299,15 @@ class Throttled extends Error {
 async function render(data) {
   const r = await fetch("/api/v1/render", {method: "POST", credentials: "same-origin",
     headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
-  if (r.status === 429) throw new Throttled(Math.max(1, Number(r.headers.get("Retry-After")) || 1));
+  if (r.status === 429 || r.status === 503) {  // throttled, or every heavy slot of the process busy
+    throw new Throttled(Math.max(1, Number(r.headers.get("Retry-After")) || 1));
+  }
   if (!r.ok) { const e = await r.json().catch(() => ({})); throw new Error(JSON.stringify(e)); }
   return URL.createObjectURL(await r.blob());
 }
 
-// rendering is rate-limited per account (the server's "heavy" rate): wait as told and try once more
+// rendering is rate-limited per account (the server's "heavy" rate) and capped per process (a 503 when busy): wait
+// as told and try once more
 async function renderPatiently(data) {
   try {
     return await render(data);
@@ -336,7 +340,7 @@ function scheduleRender() {
 }
 
 async function send(url, method, data) {
-  const r = await fetch(url, {method, credentials: "same-origin",
+  const r = await patientFetch(url, {method, credentials: "same-origin",
     headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
   return [r, await r.json().catch(() => ({}))];
 }

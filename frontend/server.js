@@ -1,8 +1,31 @@
+/** `fetch` that waits out a busy server: a 429 (throttled) or a 503 (every heavy slot of the process taken) is
+ * tried again after its Retry-After (1 to 10 s), `tries` times in all; the last answer is returned as it is. */
+export async function patientFetch(url, options = {}, tries = 4) {
+  for (let i = 1; ; i++) {
+    const r = await fetch(url, options);
+    if ((r.status !== 429 && r.status !== 503) || i >= tries) return r;
+    const seconds = Math.min(10, Math.max(1, Number(r.headers.get("Retry-After")) || 1));
+    await new Promise((done) => setTimeout(done, seconds * 1000));
+  }
+}
+
+/** Show `url` in `img`; a picture the server could not send yet (busy: a 503 or 429 has no picture) is asked for
+ * again after 1.5 s, `tries` times in all (a query parameter that the server ignores makes each a new load). */
+export function patientImage(img, url, tries = 4) {
+  let tried = 1;
+  img.onerror = () => {
+    if (tried >= tries) return;
+    tried += 1;
+    setTimeout(() => { img.src = `${url}${url.includes("?") ? "&" : "?"}try=${tried}`; }, 1500);
+  };
+  img.src = url;
+}
+
 // The editor's calls to the site's API: JSON in and out, errors as messages that name the field.
 export function makeApi(csrf) {
   return async function api(path, options = {}) {
     const json = options.body && !(options.body instanceof FormData);
-    const r = await fetch(path, {credentials: "same-origin", ...options,
+    const r = await patientFetch(path, {credentials: "same-origin", ...options,
       headers: {"X-CSRFToken": csrf, ...(json ? {"Content-Type": "application/json"} : {}), ...(options.headers || {})}});
     const body = r.headers.get("Content-Type")?.includes("json") ? await r.json() : null;
     if (!r.ok) throw new Error(body ? Object.entries(body).map(([k, v]) => `${k}: ${v}`).join("; ") : r.statusText);

@@ -8,12 +8,14 @@ trees it reads and makes may lay out at most ``FACAID_REQUEST_WORK`` node instan
 from __future__ import annotations
 
 import logging
+import threading
 
 from django.conf import settings
 from django.db import OperationalError
 
 from facaid.grammar.budget import WorkLimitError, work_budget
 from webapp.errors import error_response
+from webapp.facades.throttling import HeavySlots, is_heavy
 
 log = logging.getLogger(__name__)
 
@@ -79,3 +81,37 @@ class WorkBudgetMiddleware:
         if not isinstance(exception, WorkLimitError):
             return None
         return error_response(request, 400, str(exception))
+
+
+class HeavySlotsMiddleware:
+    """At most ``settings.FACAID_HEAVY_SLOTS`` requests to heavy API views (`webapp.facades.throttling.is_heavy`)
+    at once in this process; another is a 503 with ``Retry-After`` at once, so that a burst of them (anonymous ones
+    too) leaves the other threads to the gallery, job status and pages."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+        self.slots = HeavySlots(settings.FACAID_HEAVY_SLOTS)
+        self.lock = threading.Lock()
+
+    def __call__(self, request):
+        try:
+            return self.get_response(request)
+        finally:
+            slots = getattr(request, "_heavy_slots", None)
+            if slots is not None:
+                request._heavy_slots = None
+                slots.give_back()
+
+    def process_view(self, request, view_func, view_args, view_kwargs):
+        if not is_heavy(request, view_func, view_kwargs):
+            return None
+        with self.lock:  # the setting changed (a test): new slots; requests give back the ones they took
+            if self.slots.slots != settings.FACAID_HEAVY_SLOTS:
+                self.slots = HeavySlots(settings.FACAID_HEAVY_SLOTS)
+            slots = self.slots
+        if not slots.take():
+            return error_response(request, 503, f"the site is busy with {slots.slots} heavy requests (rendering, "
+                                                "variations, downloads) in this process; try again in a moment",
+                                  **{"Retry-After": "2"})
+        request._heavy_slots = slots
+        return None

@@ -56,6 +56,9 @@ FACAID_PROXY_COUNT = env_int("FACAID_PROXY_COUNT", 0)
 # reconstruction in 5 ranges) and seconds of the request thread's CPU, checked as each tree is made
 FACAID_REQUEST_WORK = env_int("FACAID_REQUEST_WORK", 2_000_000)
 FACAID_REQUEST_SECONDS = env_float("FACAID_REQUEST_SECONDS", 2.0)
+# heavy API requests (rendering, variations, rectifying, downloads: webapp/facades/throttling.py) one process serves
+# at once; gunicorn's 4 threads a worker (scripts/run) keep 2 for the gallery, job status and pages
+FACAID_HEAVY_SLOTS = env_int("FACAID_HEAVY_SLOTS", 2, minimum=1)
 
 INSTALLED_APPS = [
     "django.contrib.admin",
@@ -86,6 +89,7 @@ MIDDLEWARE = [
     "axes.middleware.AxesMiddleware",  # turns a login lockout into the 429 page
     "webapp.middleware.BusyDatabaseMiddleware",
     "webapp.middleware.WorkBudgetMiddleware",  # the trees one request may read and make (docs/site.md#security)
+    "webapp.middleware.HeavySlotsMiddleware",  # heavy API requests at once per process, the rest a 503
 ]
 
 ROOT_URLCONF = "webapp.urls"

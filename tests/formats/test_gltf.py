@@ -143,3 +143,19 @@ def test_a_procedure_of_too_many_rectangles_is_refused_with_its_count():
     huge = window_grid(200, 60)
     with pytest.raises(MeshTooLarge, match=f"draws 24000 rectangles; a mesh is made of at most {MAX_MESH_RECTS}"):
         procedure_gltf(huge, 0.01)
+
+
+@pytest.mark.parametrize("mode", ["RGBA", "RGB", "LA", "P"])
+def test_a_large_photo_is_shrunk_strip_by_strip_as_a_whole_reduce_would(mode):
+    """`shrunk_rgb` averages the same blocks as converting to RGB and reducing the whole (no full-size copy)."""
+    from PIL import Image
+
+    from facaid.gltf import shrunk_rgb
+
+    rng = np.random.default_rng(3)
+    pixels = rng.integers(0, 256, size=(601, 803, 4), dtype=np.uint8)
+    photo = Image.fromarray(pixels, "RGBA").convert(mode)
+    for factor in (1, 2, 3):
+        mine = np.asarray(shrunk_rgb(photo, factor, rows=40), dtype=int)
+        whole = np.asarray(photo.convert("RGB").reduce(factor), dtype=int)
+        assert mine.shape == whole.shape and np.abs(mine - whole).max() <= 1

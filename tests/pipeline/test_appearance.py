@@ -82,3 +82,42 @@ def test_with_a_photo_completion_proposes_windows_no_structure_implies():
                for p in proposals)
     for p in proposals:
         assert any(abs(p["x0"] - b[0]) <= 1 and abs(p["y0"] - b[1]) <= 1 for b in SCATTERED[1:])
+
+
+def test_levels_of_a_photo_larger_than_the_working_size_answer_in_the_segmentations_pixels():
+    """A large photo is read at a smaller scale (`appearance.levels`): the same windows are found and confirmed,
+    in the segmentation's pixels."""
+    from facaid.appearance import Levels, levels
+
+    boxes = _grid()
+    photo = _photo(boxes)
+    full = levels(photo, 600, 500)
+    assert isinstance(full, Levels) and (full.scale == 1).all() and full.shape == (500, 600)
+    half = levels(photo, 600, 500, max_pixels=75_000)
+    assert half.shape == (250, 300) and np.allclose(half.scale, 0.5)
+    examples = np.array(boxes[:2], dtype=float)
+    assert similarity(half, np.array([boxes[7]], float), examples)[0] > 0.9
+    moved, best = refine(half, np.array([[boxes[7][0] + 12, boxes[7][1], boxes[7][2] + 12, boxes[7][3]]], float),
+                         examples)
+    assert np.abs(moved[0] - boxes[7]).max() <= 2 and best[0] > 0.9
+    found, _ = search(half, examples, (60, 60), 0.9)
+    assert len(found) >= 25 and all(any(np.abs(f - np.array(b)).max() <= 3 for b in boxes) for f in found)
+
+
+def test_completion_searches_the_photo_for_a_bounded_number_of_types(monkeypatch):
+    """However many types are drawn, the photo is searched for the `MAX_SEARCH_TYPES` drawn most often (issue 56:
+    1,690 types on a 16 MP photo took 135 s)."""
+    from facaid import appearance, completion
+
+    calls = []
+    real = appearance.search
+    monkeypatch.setattr(appearance, "search", lambda *a, **k: calls.append(a[2]) or real(*a, **k))  # a spy
+    rng = np.random.default_rng(1)
+    rects = [Rect(FACADE, 0, 0, 600, 500)]
+    for i in range(300):  # every one its own size: 300 types
+        w, h = 4 + i % 20 * 3, 4 + i // 20 * 3
+        x, y = int(rng.integers(0, 600 - w)), int(rng.integers(0, 500 - h))
+        rects.append(Rect(WINDOW, x, y, x + w, y + h))
+    rects += [Rect(WINDOW, *b) for b in _grid()[:6]]  # and one type drawn six times
+    complete(Segmentation(600, 500, tuple(rects)), _photo(_grid()))
+    assert 0 < len(calls) <= completion.MAX_SEARCH_TYPES and (60.0, 60.0) in calls

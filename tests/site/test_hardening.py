@@ -214,6 +214,53 @@ def test_a_request_that_makes_too_many_trees_is_a_400_naming_its_budget(as_charl
     assert r.status_code == 400 and "s of computing" in r.json()["detail"], r.content[:300]
 
 
+def test_heavy_requests_past_the_process_slots_are_a_503_and_light_pages_answer(live_server, alice, settings):
+    """With one heavy slot, a render in flight makes the next heavy request a 503 with Retry-After at once, and the
+    gallery answers meanwhile (a burst of heavy requests leaves threads to the light pages)."""
+    import threading
+    import time
+    import urllib.error
+    import urllib.request
+
+    settings.FACAID_HEAVY_SLOTS = 1
+    settings.FACAID_API_HEAVY_RATE = None
+    Procedure.objects.create(owner=alice, title="shown", data=wall(100, 100), visibility="public")
+    tile = {"rule": "split", "axis": "x", "sizes": [["flt", 1], ["flt", 2], ["flt", 1]],
+            "children": [{"rule": "leaf", "label": "facade"}, {"rule": "leaf", "label": "window"},
+                         {"rule": "leaf", "label": "facade"}]}
+    row = {"rule": "repeat", "axis": "x", "count": 150, "sizes": [["flt", 1]], "children": [tile]}
+    big = {**wall(4000, 4000), "root": {"rule": "repeat", "axis": "y", "count": 150, "sizes": [["flt", 1]],
+                                        "children": [row]}}
+
+    def post(tree) -> tuple[int, str | None]:
+        request = urllib.request.Request(f"{live_server.url}/api/v1/render", json.dumps(tree).encode(),
+                                         {"Content-Type": "application/json"})
+        try:
+            with urllib.request.urlopen(request, timeout=60) as r:
+                return r.status, None
+        except urllib.error.HTTPError as exc:
+            return exc.code, exc.headers.get("Retry-After")
+
+    heavy: list = []
+
+    def patient():  # as the page does: wait as told when busy, until it is rendered
+        while len(heavy) < 50 and (not heavy or heavy[-1][0] != 200):
+            heavy.append(post(big))
+            time.sleep(0.05)
+
+    thread = threading.Thread(target=patient)
+    thread.start()
+    others, gallery = [], []
+    while thread.is_alive() and len(others) < 500:
+        others.append(post(wall(50, 50)))
+        with urllib.request.urlopen(f"{live_server.url}/api/v1/gallery/", timeout=60) as r:
+            gallery.append(r.status)
+    thread.join()
+    assert heavy[-1] == (200, None) and set(heavy[:-1]) <= {(503, "2")}
+    assert (503, "2") in heavy + others and set(gallery) == {200}
+    assert post(wall(50, 50)) == (200, None)  # every slot is given back
+
+
 # --- uploads --------------------------------------------------------------------------------------------------------
 
 def test_a_photo_from_a_phone_in_mpo_is_taken_as_its_first_frame(as_alice):

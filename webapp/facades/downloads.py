@@ -130,14 +130,12 @@ def _mesh_zip(proc: Procedure, tree: Tree, scale: float | None, source: str) -> 
 
 def _gltf(binary: bool, photo: bool = False) -> Callable[[Procedure, Tree, float | None, str], bytes]:
     def write(proc: Procedure, tree: Tree, scale: float | None, source: str) -> bytes:
-        image = None
-        if photo:
-            drawn = proc.photo.image if drawn_on_original(proc) else proc.photo.working_image()
-            with drawn.open("rb") as f:
-                image = Image.open(f)
-                image.load()
-        return procedure_gltf(tree, scale, binary=binary, photo=image, scale_from=source,
-                              name=proc.title or stem(proc))
+        if not photo:
+            return procedure_gltf(tree, scale, binary=binary, scale_from=source, name=proc.title or stem(proc))
+        drawn = proc.photo.image if drawn_on_original(proc) else proc.photo.working_image()
+        with drawn.open("rb") as f:  # read as the texture needs it (`facaid.gltf._add_photo`), not at full size first
+            return procedure_gltf(tree, scale, binary=binary, photo=Image.open(f), scale_from=source,
+                                  name=proc.title or stem(proc))
     return write
 
 

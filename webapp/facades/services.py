@@ -15,7 +15,7 @@ from django.utils import timezone
 from PIL import Image
 from rest_framework.exceptions import APIException, ValidationError
 
-from facaid import interchange
+from facaid import appearance, interchange
 from facaid.completion import RejectedError, complete
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
 from facaid.rectify import propose_corners_file
@@ -156,13 +156,12 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
         raise ValidationError({"min_score": f"give a number in [0, 1], got {min_score!r}"})
     if not isinstance(use_photo, bool):
         raise ValidationError({"use_photo": f"give true or false, got {use_photo!r}"})
-    picture = None
+    levels = None
     if use_photo:
-        with _readable(photo.working_image()) as f:
-            picture = Image.open(f)
-            picture.load()
+        with _readable(photo.working_image()) as f:  # grey levels at a bounded scale, the file let go
+            levels = appearance.levels(f, seg.width, seg.height)
     try:
-        return complete(seg, picture, rejected=rejected, min_score=float(min_score))
+        return complete(seg, levels, rejected=rejected, min_score=float(min_score))
     except RejectedError as exc:
         raise ValidationError({"rejected": str(exc)}) from None
     except ValueError as exc:  # too many rectangles

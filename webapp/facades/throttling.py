@@ -1,7 +1,11 @@
 """The API's throttle for requests that cost real CPU: rendering a procedure (a preview, or its pictures as a save
 commits), variations, rectifying a photo, building a download. A rate of its own (FACAID_API_HEAVY_RATE) on top of
 the general ones, per account for users and per address for everyone else; reads of what is already kept
-(a procedure's JSON, its `labels.png` file) do not count."""
+(a procedure's JSON, its `labels.png` file) do not count. And a cap on how many such requests one process serves
+at once (`HeavySlots`), so that a burst of them leaves threads for the light pages."""
+
+import threading
+from types import SimpleNamespace
 
 from rest_framework.permissions import SAFE_METHODS
 from rest_framework.settings import api_settings
@@ -35,3 +39,27 @@ def allow_heavy(request) -> tuple[bool, float | None]:
     if throttle.allow_request(request, None):
         return True, None
     return False, throttle.wait()
+
+
+def is_heavy(request, view_func, view_kwargs) -> bool:
+    """Whether a request goes to a view with the heavy throttle, and is not one of its light ones."""
+    cls = getattr(view_func, "cls", None)  # an API view (rest_framework's api_view)
+    classes = getattr(cls, "throttle_classes", ())
+    return any(issubclass(t, HeavyRateThrottle) for t in classes) and \
+        not _light(request, SimpleNamespace(kwargs=view_kwargs))
+
+
+class HeavySlots:
+    """At most ``slots`` heavy requests at once in this process (each gunicorn worker has its own): one past them is
+    answered at once (`webapp.middleware.HeavySlotsMiddleware`, a 503 with Retry-After) instead of taking a thread
+    that a light page needs."""
+
+    def __init__(self, slots: int):
+        self.slots = slots
+        self._free = threading.BoundedSemaphore(slots)
+
+    def take(self) -> bool:
+        return self._free.acquire(blocking=False)
+
+    def give_back(self) -> None:
+        self._free.release()
