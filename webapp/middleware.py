@@ -15,6 +15,7 @@ from django.db import OperationalError
 
 from facaid.grammar.budget import WorkLimitError, work_budget
 from webapp.errors import error_response
+from webapp.facades.models import VersionQuotaError
 from webapp.facades.throttling import HeavySlots, is_heavy
 
 log = logging.getLogger(__name__)
@@ -78,7 +79,7 @@ class WorkBudgetMiddleware:
             return self.get_response(request)
 
     def process_exception(self, request, exception):
-        if not isinstance(exception, WorkLimitError):
+        if not isinstance(exception, WorkLimitError | VersionQuotaError):  # (the quota: a save past it, models.py)
             return None
         return error_response(request, 400, str(exception))
 

@@ -380,3 +380,50 @@ def test_the_exact_procedure_first_when_asked(as_alice, monkeypatch):
     [v2, v1] = _history(as_alice, proc)
     assert (v1["metrics"]["structure"], v2["metrics"]["structure"]) == ("editable", "exact")
     assert job.params["structure"] == "exact"
+
+
+@pytest.mark.django_db(transaction=True)
+def test_migration_0007_stores_every_version_compressed_and_keeps_its_tree(alice):
+    from django.db import connection
+    from django.db.migrations.executor import MigrationExecutor
+
+    from webapp.facades.fields import pack
+
+    before = [("facades", "0006_procedure_versions")]
+    executor = MigrationExecutor(connection)
+    executor.migrate(before)
+    old = executor.loader.project_state(before).apps
+    trees = [generate(i).procedure.to_dict() for i in (4, 5)]
+    proc = old.get_model("facades", "Procedure").objects.create(owner_id=alice.id, data=trees[1], digest="x")
+    rows = old.get_model("facades", "ProcedureVersion").objects
+    for n, tree in enumerate(trees, start=1):
+        rows.create(procedure_id=proc.id, version=n, data=tree, digest=f"d{n}", kind="edit")
+    executor = MigrationExecutor(connection)
+    executor.loader.build_graph()
+    executor.migrate([("facades", "0007_compressed_versions")])
+    versions = ProcedureVersion.objects.filter(procedure_id=proc.id).order_by("version")
+    assert [v.data for v in versions] == trees  # (PostgreSQL's jsonb kept them in its own key order)
+    assert all(v.size == len(pack(v.data)) for v in versions)
+    with connection.cursor() as cursor:
+        cursor.execute("SELECT data FROM facades_procedureversion WHERE procedure_id = %s", [proc.id])
+        stored = [bytes(row[0]) for row in cursor.fetchall()]
+    assert all(len(b) * 4 < len(json.dumps(t)) for b, t in zip(stored, trees, strict=True))  # compressed
+
+
+def test_versions_past_the_accounts_quota_are_refused_by_name_and_nothing_is_lost(facade_photo, as_alice, alice,
+                                                                                   settings):
+    _, seg = facade_photo
+    proc = _faithful(alice, seg)
+    settings.FACAID_VERSIONS_QUOTA_MB = (ProcedureVersion.objects.get(procedure=proc).size * 3.5) / 2**20
+    kept = []
+    for seed in range(10, 20):
+        tree = _same_size_variant(generate(seed).procedure.to_dict()) if seed % 2 else None
+        tree = tree or {**Tree.from_dict(proc.data).to_dict(), "meta": {"note": f"save {seed}"}}
+        r = as_alice.patch(_url(proc), {"data": tree}, format="json")
+        if r.status_code != 200:
+            break
+        kept.append(r.json()["version"])
+    assert r.status_code == 400 and "your saved versions take" in r.json()["detail"], r.content[:300]
+    assert "nothing was saved" in r.json()["detail"]
+    assert [v["version"] for v in _history(as_alice, proc)] == [*reversed(kept), 1]  # all kept, none added
+    assert as_alice.get(_url(proc)).json()["version"] == (kept or [1])[-1]

@@ -1,5 +1,6 @@
 """Photos, their segmentations (versioned), reconstruction jobs and procedures (versioned: every save of a tree
-is a new `ProcedureVersion`, and none is ever changed or deleted but with its procedure). Every object is addressed
+is a new `ProcedureVersion`, stored compressed within its owner's quota, and none is ever changed or deleted but
+with its procedure). Every object is addressed
 by a UUID ``code``; photos and procedures carry a visibility (private, unlisted, public)."""
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ from django.conf import settings
 from django.db import models, transaction
 from django.urls import reverse
 from django.utils import timezone
+
+from webapp.facades.fields import CompressedJSONField, pack
 
 
 class Visibility(models.TextChoices):
@@ -110,6 +113,28 @@ class Draft(models.Model):
         return f"{self.photo} draft"
 
 
+class VersionQuotaError(Exception):
+    """A save past its owner's quota of stored versions; the message says how much is used and what to do."""
+
+
+def versions_stored(owner_id) -> int:
+    """Bytes the owner's versions take (compressed), all procedures."""
+    return ProcedureVersion.objects.filter(procedure__owner_id=owner_id).aggregate(
+        total=models.Sum("size"))["total"] or 0
+
+
+def check_quota(owner_id, size: int) -> None:
+    """Refuse a version of ``size`` bytes that would take its owner past ``FACAID_VERSIONS_QUOTA_MB``; nothing
+    stored is touched."""
+    quota = settings.FACAID_VERSIONS_QUOTA_MB * 2**20
+    used = versions_stored(owner_id)
+    if used + size > quota:
+        raise VersionQuotaError(
+            f"your saved versions take {used / 2**20:.1f} MB of your {quota / 2**20:g} MB, and this one needs "
+            f"{size / 2**10:.0f} KB more: delete procedures you no longer need (their versions go with them); "
+            "nothing was saved")
+
+
 def tree_digest(data: dict) -> str:
     """16 hex digits naming a procedure JSON (its keys sorted); migration 0003 writes the same out."""
     text = json.dumps(data, sort_keys=True, separators=(",", ":"), allow_nan=False)
@@ -166,8 +191,11 @@ class Procedure(models.Model):
             if unchanged:
                 return
             change = change or Change(ProcedureVersion.Kind.EDIT if latest else ProcedureVersion.Kind.CREATED)
+        size = len(pack(self.data))
+        check_quota(self.owner_id, size)
         ProcedureVersion.objects.create(
-            procedure=self, version=(latest["version"] if latest else 0) + 1, data=self.data, digest=self.digest,
+            procedure=self, version=(latest["version"] if latest else 0) + 1, data=self.data, size=size,
+            digest=self.digest,
             accuracy=self.accuracy, metrics=self.metrics, kind=change.kind, note=change.note[:200],
             based_on=change.based_on, warning=change.warning[:300])
 
@@ -208,7 +236,8 @@ class ProcedureVersion(models.Model):
 
     procedure = models.ForeignKey(Procedure, on_delete=models.CASCADE, related_name="versions")
     version = models.PositiveIntegerField()
-    data = models.JSONField()
+    data = CompressedJSONField()  # the tree, zlib-compressed JSON (migration 0007)
+    size = models.PositiveIntegerField(default=0)  # bytes stored: what the owner's quota adds up
     digest = models.CharField(max_length=16)  # tree_digest(data): the ETag of its picture
     accuracy = models.FloatField(null=True, blank=True)
     metrics = models.JSONField(default=dict, blank=True)

@@ -237,6 +237,8 @@ class ProcedureVersionSummarySerializer(serializers.ModelSerializer):
 
 
 class ProcedureVersionSerializer(ProcedureVersionSummarySerializer):
+    data = serializers.JSONField(read_only=True, help_text="the version's tree (a procedure JSON)")
+
     class Meta(ProcedureVersionSummarySerializer.Meta):
         fields = [*ProcedureVersionSummarySerializer.Meta.fields, "data"]
         read_only_fields = fields
