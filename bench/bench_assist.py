@@ -3,6 +3,7 @@
     .venv/bin/python bench/bench_assist.py [--stride 1] [--limit N] [--min-score S] [--json F]
     .venv/bin/python bench/bench_assist.py --generated 12      # + photo-like renders of generated facades
     .venv/bin/python bench/bench_assist.py --timing 6          # one call's time, with and without the photo
+    .venv/bin/python bench/bench_assist.py --photos var/cmp_photos --stride 9   # + CMP's own photos (git-ignored)
 
 A simulated annotator (`facaid.evaluation.assist.simulate`) draws each facade's true elements in reading order,
 asks `facaid.completion.complete` for proposals after every third, accepts at no cost each proposal that matches
@@ -13,7 +14,10 @@ median time of a completion call. CMP is evaluation data: nothing here trains. C
 ``--generated N`` runs the same annotator on N held-out generated facades (seeds 5000 on) drawn on photo-like
 renders of themselves (`facaid.photolike.render_photo`), their wall one rectangle as a person draws it
 (`facaid.evaluation.assist.as_drawn`), not the flattened pieces around each element, without and with the photo
-(searched, and checking the proposals).
+(searched, and checking the proposals). ``--photos DIR`` gives the CMP annotations their own photos
+(``DIR/cmp_bNNNN.jpg``, read out of a public copy of the CMP base set into a git-ignored cache, issue 57: never in the
+repo); only the facades whose photo is there are run, each without and with its photo. The hit rate is accepted ÷
+proposed (accepted + rejected).
 """
 
 from __future__ import annotations
@@ -23,11 +27,17 @@ import functools
 import json
 import statistics
 import time
+from pathlib import Path
 
 from facaid.completion import DEFAULT_MIN_SCORE, complete
 from facaid.evaluation.assist import as_drawn, simulate, summary
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.paths import DEFAULT_CMP
+
+
+def hits(s: dict) -> float:
+    """Accepted ÷ proposed: a proposer that floods the person with wrong boxes is seen here."""
+    return s["accepted"] / max(1, s["accepted"] + s["rejected"])
 
 
 def main() -> None:
@@ -38,6 +48,7 @@ def main() -> None:
     ap.add_argument("--min-score", type=float, default=DEFAULT_MIN_SCORE)
     ap.add_argument("--json", default=None)
     ap.add_argument("--generated", type=int, default=0, help="N generated facades with photo-like renders instead")
+    ap.add_argument("--photos", default=None, help="a folder of CMP's photos, cmp_bNNNN.jpg (a git-ignored cache)")
     ap.add_argument("--timing", type=int, default=0,
                     help="time one call on 150 drawn elements of N generated facades rendered at 2x (1-2 MP photos)")
     args = ap.parse_args()
@@ -55,21 +66,43 @@ def main() -> None:
         calls.append(time.perf_counter() - t0)
         return out
 
+    photo_calls: list[float] = []
+
+    def timed_photo(seg, photo, **kw):
+        t0 = time.perf_counter()
+        out = complete(seg, photo, min_score=args.min_score, **kw)
+        photo_calls.append(time.perf_counter() - t0)
+        return out
+
+    photos = Path(args.photos) if args.photos else None
     result = {"min_score": args.min_score}
     for name, recs in halves.items():
         recs = recs[:: args.stride][: args.limit]
+        if photos is not None:
+            recs = [(rid, seg) for rid, seg in recs if (photos / f"{rid}.jpg").exists()]
         if not recs:
             continue
         assisted = [simulate(seg, timed) for _, seg in recs]
         alone = [simulate(seg, functools.partial(lambda s, rejected: [])) for _, seg in recs]
         result[name] = {"assisted": summary(assisted), "unassisted": summary(alone)}
+        if photos is not None:
+            result[name]["photo"] = summary([
+                simulate(seg, functools.partial(timed_photo, photo=str(photos / f"{rid}.jpg"))) for rid, seg in recs])
         a, u = result[name]["assisted"], result[name]["unassisted"]
         print(f"{name}: {a['facades']} facades, median effort {a['effort_median']:.3f} with completion "
-              f"({a['accepted']} proposals accepted, {a['rejected']} rejected, {a['drawn']} drawn of "
-              f"{a['elements']}), {u['effort_median']:.3f} without")
-    if calls:
-        result["call_seconds_median"] = statistics.median(calls)
-        print(f"completion call: median {1000 * statistics.median(calls):.1f} ms ({len(calls)} calls)")
+              f"({a['accepted']} proposals accepted, {a['rejected']} rejected, hit rate {hits(a):.2f}, {a['drawn']} "
+              f"drawn of {a['elements']}), {u['effort_median']:.3f} without")
+        if photos is not None:
+            p = result[name]["photo"]
+            print(f"{name}, with its photo: median effort {p['effort_median']:.3f} ({p['accepted']} accepted, "
+                  f"{p['rejected']} rejected, hit rate {hits(p):.2f}, {p['drawn']} drawn)")
+    for key, took in (("call_seconds", calls), ("photo_call_seconds", photo_calls)):
+        if took:
+            result[f"{key}_median"] = statistics.median(took)
+            result[f"{key}_p90"] = sorted(took)[int(0.9 * (len(took) - 1))]
+            print(f"completion call{' with the photo' if 'photo' in key else ''}: median "
+                  f"{1000 * statistics.median(took):.1f} ms, p90 {1000 * result[f'{key}_p90']:.1f} ms "
+                  f"({len(took)} calls)")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)

@@ -79,7 +79,8 @@ def levels(photo: Any, width: int, height: int, max_pixels: int = WORK_PIXELS) -
         image = photo.convert("L")
     else:
         with Image.open(photo) as opened:
-            opened.draft("L", (tw, th))
+            if s < 1:  # a large JPEG decodes at a reduced scale (at scale 1 the decode is the full one, as before)
+                opened.draft("L", (tw, th))
             image = opened.convert("L")
     if image.size != (tw, th):
         image = image.resize((tw, th), Image.Resampling.BILINEAR)

@@ -5,7 +5,7 @@
 // outlines what it stands for in the picture.
 import {accuracyText, mountHistory} from "./procedure-history.js";
 import {leafAt, leavesUnder, parametersOf, pictureToProcedure} from "./selection.js";
-import {patientFetch} from "./server.js";
+import {busy, patientFetch} from "./server.js";
 
 const script = document.currentScript || document.querySelector("script[data-code]");
 const code = script.dataset.code;
@@ -299,7 +299,7 @@ class Throttled extends Error {
 async function render(data) {
   const r = await fetch("/api/v1/render", {method: "POST", credentials: "same-origin",
     headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
-  if (r.status === 429 || r.status === 503) {  // throttled, or every heavy slot of the process busy
+  if (busy(r)) {  // throttled, or every heavy slot of the process taken
     throw new Throttled(Math.max(1, Number(r.headers.get("Retry-After")) || 1));
   }
   if (!r.ok) { const e = await r.json().catch(() => ({})); throw new Error(JSON.stringify(e)); }

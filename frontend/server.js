@@ -1,9 +1,15 @@
-/** `fetch` that waits out a busy server: a 429 (throttled) or a 503 (every heavy slot of the process taken) is
- * tried again after its Retry-After (1 to 10 s), `tries` times in all; the last answer is returned as it is. */
+/** Whether an answer says the request did not run and may be sent again: throttled (429), or every heavy slot of
+ * the process taken (a 503 marked `X-Facaid-Busy`; another 503, a busy database, may come after a write). */
+export function busy(r) {
+  return r.status === 429 || (r.status === 503 && r.headers.get("X-Facaid-Busy") !== null);
+}
+
+/** `fetch` that waits out a busy server (`busy`): tried again after its Retry-After (1 to 10 s), `tries` times in
+ * all; the last answer is returned as it is. */
 export async function patientFetch(url, options = {}, tries = 4) {
   for (let i = 1; ; i++) {
     const r = await fetch(url, options);
-    if ((r.status !== 429 && r.status !== 503) || i >= tries) return r;
+    if (!busy(r) || i >= tries) return r;
     const seconds = Math.min(10, Math.max(1, Number(r.headers.get("Retry-After")) || 1));
     await new Promise((done) => setTimeout(done, seconds * 1000));
   }
@@ -13,10 +19,11 @@ export async function patientFetch(url, options = {}, tries = 4) {
  * again after 1.5 s, `tries` times in all (a query parameter that the server ignores makes each a new load). */
 export function patientImage(img, url, tries = 4) {
   let tried = 1;
+  clearTimeout(img.retryTimer);  // a retry left from the picture this element showed before must not come back
   img.onerror = () => {
     if (tried >= tries) return;
     tried += 1;
-    setTimeout(() => { img.src = `${url}${url.includes("?") ? "&" : "?"}try=${tried}`; }, 1500);
+    img.retryTimer = setTimeout(() => { img.src = `${url}${url.includes("?") ? "&" : "?"}try=${tried}`; }, 1500);
   };
   img.src = url;
 }

@@ -87,7 +87,8 @@ class WorkBudgetMiddleware:
 class HeavySlotsMiddleware:
     """At most ``settings.FACAID_HEAVY_SLOTS`` requests to heavy API views (`webapp.facades.throttling.is_heavy`)
     at once in this process; another is a 503 with ``Retry-After`` at once, so that a burst of them (anonymous ones
-    too) leaves the other threads to the gallery, job status and pages."""
+    too) leaves the other threads to the gallery, job status and pages. It is answered before the view runs, which
+    ``X-Facaid-Busy: slots`` tells clients: such a request is safe to send again, whatever its method."""
 
     def __init__(self, get_response):
         self.get_response = get_response
@@ -113,6 +114,6 @@ class HeavySlotsMiddleware:
         if not slots.take():
             return error_response(request, 503, f"the site is busy with {slots.slots} heavy requests (rendering, "
                                                 "variations, downloads) in this process; try again in a moment",
-                                  **{"Retry-After": "2"})
+                                  **{"Retry-After": "2", "X-Facaid-Busy": "slots"})
         request._heavy_slots = slots
         return None

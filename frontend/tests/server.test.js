@@ -9,7 +9,8 @@ function answers(...statuses) {  // a stand-in for the network: the statuses in 
   globalThis.fetch = async (url) => {
     asked.push(url);
     const status = statuses[Math.min(asked.length, statuses.length) - 1];
-    return {status, ok: status < 400, headers: {get: (name) => (name === "Retry-After" ? "1" : null)}};
+    const headers = {"Retry-After": "1", ...(status === 503 ? {"X-Facaid-Busy": "slots"} : {})};
+    return {status, ok: status < 400, headers: {get: (name) => headers[name] ?? null}};
   };
   return asked;
 }
@@ -31,4 +32,14 @@ test("it gives up after its tries and returns the last answer as it is", async (
   const other = answers(400);
   assert.equal((await patientFetch("/x")).status, 400);
   assert.equal(other.length, 1);  // other errors are not tried again
+});
+
+test("a 503 without the busy mark (a busy database, after a write perhaps) is not sent again", async () => {
+  const asked = [];
+  globalThis.fetch = async (url) => {
+    asked.push(url);
+    return {status: 503, ok: false, headers: {get: (name) => (name === "Retry-After" ? "5" : null)}};
+  };
+  assert.equal((await patientFetch("/api/v1/procedures/x/", {method: "PATCH"})).status, 503);
+  assert.equal(asked.length, 1);
 });

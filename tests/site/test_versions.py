@@ -427,3 +427,10 @@ def test_versions_past_the_accounts_quota_are_refused_by_name_and_nothing_is_los
     assert "nothing was saved" in r.json()["detail"]
     assert [v["version"] for v in _history(as_alice, proc)] == [*reversed(kept), 1]  # all kept, none added
     assert as_alice.get(_url(proc)).json()["version"] == (kept or [1])[-1]
+
+
+def test_a_compressed_tree_reads_back_from_the_database_from_a_dump_and_as_given():
+    from webapp.facades.fields import CompressedJSONField, pack
+
+    field, tree = CompressedJSONField(), generate(3).procedure.to_dict()
+    assert field.to_python(pack(tree)) == tree == field.to_python(json.dumps(tree)) == field.to_python(tree)

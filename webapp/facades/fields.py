@@ -33,6 +33,8 @@ class CompressedJSONField(models.BinaryField):
     def to_python(self, value):
         if isinstance(value, bytes | memoryview):
             return unpack(value)
+        if isinstance(value, str):  # loaddata: the JSON text `value_to_string` wrote
+            return json.loads(value)
         return value
 
     def get_db_prep_value(self, value, connection, prepared=False):

@@ -1,0 +1,100 @@
+"""How well the proposed corners find the facade in a photo (issue 57's corners target).
+
+    .venv/bin/python bench/bench_corners.py --photos var/cmp_photos [--limit N] [--warp SEED] [--json F]
+
+For each CMP dev-half photo in ``--photos`` (``cmp_bNNNN.jpg``, the git-ignored cache of the public copy of CMP's
+base set; CMP's photos are rectified facades), `facaid.rectify.propose_corners_file` proposes the facade's four
+corners; the figure is the IoU of that quadrilateral with the annotation's facade box (the bounding box of its
+wall rectangles). ``--warp SEED`` first warps each photo by a random perspective of its own (the corners moved
+inwards by up to a fifth of the side, seeded), so the known corners are the warped facade box's, and scores the
+proposal against them. Target: IoU ≥ 0.85 on ≥ 80 % of the dev-half photos. Also prints when the proposal says the
+photo is already fronto-parallel.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import statistics
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw
+
+from facaid.evaluation.real import DEV_FACADES, load_records
+from facaid.labels import FACADE
+from facaid.paths import DEFAULT_CMP
+from facaid.rectify import homography, propose_corners_file
+
+
+def facade_box(seg) -> tuple[int, int, int, int] | None:
+    walls = [r for r in seg.rects if r.label == FACADE]
+    if not walls:
+        return None
+    return (min(r.x0 for r in walls), min(r.y0 for r in walls), max(r.x1 for r in walls), max(r.y1 for r in walls))
+
+
+def quad_iou(a, b, size: tuple[int, int], scale: float = 0.25) -> float:
+    """IoU of two quadrilaterals ([[x, y] x 4]) drawn on a grid of ``size`` x ``scale``."""
+    w, h = max(1, round(size[0] * scale)), max(1, round(size[1] * scale))
+    masks = []
+    for quad in (a, b):
+        img = Image.new("1", (w, h))
+        ImageDraw.Draw(img).polygon([(x * scale, y * scale) for x, y in quad], fill=1)
+        masks.append(np.asarray(img, dtype=bool))
+    union = (masks[0] | masks[1]).sum()
+    return float((masks[0] & masks[1]).sum() / union) if union else 0.0
+
+
+def warped(photo: Image.Image, box, rng: np.random.Generator) -> tuple[Image.Image, list[list[float]]]:
+    """The photo seen in a random perspective, and where its facade box's corners went."""
+    w, h = photo.size
+    src = np.array([[0, 0], [w, 0], [w, h], [0, h]], dtype=float)
+    dst = src + rng.uniform(0, 0.2, size=(4, 2)) * np.array([[w, h], [-w, h], [-w, -h], [w, -h]])
+    m = homography(src, dst)  # photo -> warped
+    inverse = np.linalg.inv(m)
+    out = photo.transform((w, h), Image.Transform.PERSPECTIVE, (inverse / inverse[2, 2]).ravel()[:8].tolist(),
+                          Image.Resampling.BILINEAR)
+    x0, y0, x1, y1 = box
+    corners = np.array([[x0, y0, 1], [x1, y0, 1], [x1, y1, 1], [x0, y1, 1]], dtype=float) @ m.T
+    return out, (corners[:, :2] / corners[:, 2:]).tolist()
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--photos", required=True)
+    ap.add_argument("--data", default=str(DEFAULT_CMP))
+    ap.add_argument("--limit", type=int, default=DEV_FACADES)
+    ap.add_argument("--warp", type=int, default=None, help="warp each photo by a seeded random perspective first")
+    ap.add_argument("--json", default=None)
+    args = ap.parse_args()
+    rows = []
+    for k, (rid, seg) in enumerate(load_records(args.data, DEV_FACADES)[: args.limit]):
+        path = Path(args.photos) / f"{rid}.jpg"
+        box = facade_box(seg)
+        if not path.exists() or box is None:
+            continue
+        photo = Image.open(path).convert("RGB")
+        if photo.size != (seg.width, seg.height):
+            photo = photo.resize((seg.width, seg.height))
+        truth = [[box[0], box[1]], [box[2], box[1]], [box[2], box[3]], [box[0], box[3]]]
+        if args.warp is not None:
+            photo, truth = warped(photo, box, np.random.default_rng([args.warp, k]))
+        buf = io.BytesIO()
+        photo.save(buf, "JPEG", quality=92)
+        buf.seek(0)
+        found = propose_corners_file(buf)
+        rows.append({"id": rid, "iou": quad_iou(found["corners"], truth, photo.size),
+                     "confidence": found["confidence"], "notes": found["notes"]})
+    ious = [r["iou"] for r in rows]
+    good = sum(i >= 0.85 for i in ious)
+    print(f"{len(rows)} photos{' (warped)' if args.warp is not None else ''}: IoU with the facade box median "
+          f"{statistics.median(ious):.3f}, ≥ 0.85 on {good} ({100 * good / len(rows):.0f} %; target 80 %)")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(rows, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()
