@@ -99,7 +99,7 @@ def rectify_file(fp, corners, max_pixels: int | None = None) -> Image.Image:
 WORK_SIDE = 640  # the photo is searched at this size (its longer side): LSD takes ~50 ms there on one core
 MIN_WORK_SIDE = 24  # smaller than this, there are no lines to find
 MIN_LENGTH = 0.02  # of the longer side: shorter segments are texture, not the facade's lines
-STRONG = 0.3  # a boundary line has at least this share of the strongest line's support in its family
+STRONG = 0.15  # a boundary line has at least this share of the strongest line's support in its family
 MIN_SPAN = 0.1  # the boundaries of a family lie at least this far apart (of the frame's extent), or they are noise
 EXTENT_WIDEN = 0.03
 MERGE_PX = 3.0  # segments whose lines lie within this many work pixels are one line
@@ -220,6 +220,52 @@ def _region(frame: np.ndarray, family: Family, segs: np.ndarray, size: tuple[int
         (mid[:, 1] <= v1 + dv)
 
 
+UPRIGHT_DEG = 1.0  # a quadrilateral whose sides all lie this close to the photo's axes: a fronto-parallel photo
+BUSY = 0.3  # a band beside it with this share of the lines per area inside is more of the facade
+COLOUR = 12  # ... and so is one whose median colour is this close (grey levels, every channel) to the box's
+
+
+def _upright(pts: np.ndarray) -> bool:
+    """Whether the four sides of the quadrilateral (TL, TR, BR, BL) lie within `UPRIGHT_DEG` of the photo's axes."""
+    d = np.roll(pts, -1, axis=0) - pts
+    angles = np.degrees(np.arctan2(d[:, 1], d[:, 0])) % 90
+    return bool(np.all(np.minimum(angles, 90 - angles) <= UPRIGHT_DEG))
+
+
+def _widened(pts: np.ndarray, segs: np.ndarray, picture: np.ndarray) -> np.ndarray:
+    """A fronto-parallel facade's box (work pixels) moved out to the photo's edge on each side where the band between
+    them is more of the facade: its colour that of the box (`COLOUR`: the wall goes on beyond the outermost
+    windows) or as many lines per area (`BUSY`). The outermost strong lines of a rectified photo are often a
+    window column's or a shop sign's, inside the facade (issue 57: the proposal cut a bay or a floor off most
+    rectified photos)."""
+    h, w = picture.shape[:2]
+    x0, y0 = pts[:, 0].min(), pts[:, 1].min()
+    x1, y1 = pts[:, 0].max(), pts[:, 1].max()
+    mid = (segs[:, :2] + segs[:, 2:4]) / 2
+
+    def density(a, b, c, d) -> float:
+        area = max(c - a, 1.0) * max(d - b, 1.0)
+        inside = (mid[:, 0] >= a) & (mid[:, 0] < c) & (mid[:, 1] >= b) & (mid[:, 1] < d)
+        return float(segs[inside, 4].sum() / area)
+
+    def colour(a, b, c, d) -> np.ndarray:
+        region = picture[int(b) : max(int(b) + 1, int(d)), int(a) : max(int(a) + 1, int(c))]
+        if not region.size:
+            return np.full(picture.shape[2], np.inf)
+        return np.median(region.reshape(-1, picture.shape[2]), axis=0)
+
+    box, wall = density(x0, y0, x1, y1), colour(x0, y0, x1, y1)
+    out = np.array([x0, y0, x1, y1], dtype=float)
+    for i, band in enumerate(((0, y0, x0, y1), (x0, 0, x1, y0), (x1, y0, w, y1), (x0, y1, x1, h))):
+        if min(band[2] - band[0], band[3] - band[1]) < 1:
+            continue
+        same = float(np.abs(colour(*band) - wall).max()) <= COLOUR
+        busy = box > 0 and density(*band) >= BUSY * box
+        if same or busy:
+            out[i] = (0, 0, w, h)[i]
+    return np.array([[out[0], out[1]], [out[2], out[1]], [out[2], out[3]], [out[0], out[3]]])
+
+
 def _fallback(w: int, h: int, note: str) -> dict:
     return {"corners": [[0.0, 0.0], [float(w), 0.0], [float(w), float(h)], [0.0, float(h)]], "confidence": 0.0,
             "notes": [note, "the photo's own corners are proposed: drag them onto the facade's"],
@@ -295,6 +341,12 @@ def propose_corners(image: Image.Image) -> dict:
     height = np.linalg.norm(frame_pts[3] - frame_pts[0]) + np.linalg.norm(frame_pts[2] - frame_pts[1])
     cover = [min(1.0, s / max(width / 2, 1e-12)) for _, s in rows] if rows else [0.0, 0.0]
     cover += [min(1.0, s / max(height / 2, 1e-12)) for _, s in cols] if cols else [0.0, 0.0]
+
+    if _upright(pts):
+        notes.append("the photo looks fronto-parallel already (the facade's lines are upright): rectifying it "
+                     "changes little beyond the crop")
+        scale = np.array([w / gw, h / gh])
+        pts = _widened(pts / scale, segs, np.stack(channels, axis=-1)) * scale
 
     outside = (pts < -0.5) | (pts > np.array([w, h]) + 0.5)
     if outside.any():
