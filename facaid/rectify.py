@@ -259,7 +259,7 @@ def _widened(pts: np.ndarray, segs: np.ndarray, picture: np.ndarray) -> np.ndarr
     for i, band in enumerate(((0, y0, x0, y1), (x0, 0, x1, y0), (x1, y0, w, y1), (x0, y1, x1, h))):
         if min(band[2] - band[0], band[3] - band[1]) < 1:
             continue
-        same = float(np.abs(colour(*band) - wall).max()) <= COLOUR
+        same = bool(np.isfinite(wall).all()) and float(np.abs(colour(*band) - wall).max()) <= COLOUR
         busy = box > 0 and density(*band) >= BUSY * box
         if same or busy:
             out[i] = (0, 0, w, h)[i]

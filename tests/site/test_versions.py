@@ -427,6 +427,9 @@ def test_versions_past_the_accounts_quota_are_refused_by_name_and_nothing_is_los
     assert "nothing was saved" in r.json()["detail"]
     assert [v["version"] for v in _history(as_alice, proc)] == [*reversed(kept), 1]  # all kept, none added
     assert as_alice.get(_url(proc)).json()["version"] == (kept or [1])[-1]
+    jobs = Job.objects.count()  # a job would fail on its result: it is refused when asked for
+    r = as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"]}, format="json")
+    assert r.status_code == 400 and "your saved versions take" in r.json()["detail"] and Job.objects.count() == jobs
 
 
 def test_a_compressed_tree_reads_back_from_the_database_from_a_dump_and_as_given():

@@ -21,7 +21,7 @@ from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
 from facaid.rectify import propose_corners_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
-from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility, check_quota
 from webapp.facades.serializers import parse_segmentation
 from webapp.facades.uploads import UploadError, normalize_photo
 
@@ -168,6 +168,9 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
         raise ValidationError({"segmentation": str(exc)}) from None
 
 
+QUOTA_ROOM = 64 * 1024  # bytes of versions a job's result needs at most, about (two versions of a large tree)
+
+
 class TooManyJobs(APIException):
     status_code = 429
     default_code = "too_many_jobs"
@@ -192,6 +195,7 @@ def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Pr
         if active >= settings.FACAID_MAX_ACTIVE_JOBS:
             raise TooManyJobs(f"You have {active} reconstructions waiting or running (at most "
                               f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
+        check_quota(user.pk, QUOTA_ROOM)  # a full quota refuses the job now, not its result after the work
         return jobs.submit(owner=user, segmentation=segmentation, params=params)
 
 
