@@ -208,7 +208,17 @@ def cmd_complete(args: argparse.Namespace) -> None:
         raise CliError(f"photo not found at {args.photo}")
     if not 0 <= args.min_score <= 1:
         raise CliError(f"--min-score must be in [0, 1], got {args.min_score}")
-    proposals = complete(seg, args.photo, min_score=args.min_score)
+    photo = None
+    if args.photo:
+        from PIL import Image
+
+        from facaid.appearance import levels
+
+        try:  # read once, as grey levels of a bounded size (the site's API reads it the same way)
+            photo = levels(args.photo, seg.width, seg.height)
+        except (OSError, Image.DecompressionBombError) as exc:
+            raise CliError(f"cannot read photo {args.photo}: {exc}") from None
+    proposals = complete(seg, photo, min_score=args.min_score)
     counts: dict[str, int] = {}
     for p in proposals:
         counts[p["label"]] = counts.get(p["label"], 0) + 1
@@ -577,7 +587,8 @@ def build_parser() -> argparse.ArgumentParser:
                         description="Read the rows, columns and companions of the elements drawn so far and propose "
                                     "the missing ones, each with a score, none repeating a drawn one.")
     cp.add_argument("input", help="segmentation JSON drawn so far")
-    cp.add_argument("--photo", help="the rectified photo (accepted; the photo check is not implemented yet)")
+    cp.add_argument("--photo", help="the rectified photo the segmentation is drawn on: it proposes what looks like "
+                                    "the drawn elements and confirms or rejects each proposal")
     cp.add_argument("--min-score", type=float, default=DEFAULT_MIN_SCORE,
                     help=f"leave out proposals scored lower (default {DEFAULT_MIN_SCORE})")
     cp.add_argument("--clip", action="store_true", help="clip rectangles reaching outside the image")

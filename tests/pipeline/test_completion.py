@@ -142,6 +142,30 @@ def test_cli_complete(tmp_path, capsys):
     assert "--min-score must be in [0, 1]" in capsys.readouterr().err
     assert main(["complete", str(path), "--photo", str(tmp_path / "none.png")]) == 2
     assert "photo not found" in capsys.readouterr().err
+    (tmp_path / "notes.png").write_text("not a picture")
+    assert main(["complete", str(path), "--photo", str(tmp_path / "notes.png")]) == 2
+    assert "cannot read photo" in capsys.readouterr().err
+    # the photo confirms the missing window where it has one, and rejects it where it shows wall
+    for shown, says in ((windows, "1 proposal for 30 drawn rectangles: 1 window"),
+                        ([w for i, w in enumerate(windows) if i != 8], "0 proposals for 30 drawn rectangles")):
+        _painted([(r.x0, r.y0, r.x1, r.y1) for r in shown]).save(tmp_path / "photo.png")
+        assert main(["complete", str(path), "--photo", str(tmp_path / "photo.png"), "--json", str(out)]) == 0
+        assert says in capsys.readouterr().out
+    assert json.loads(out.read_text())["proposals"] == []
+
+
+def _painted(boxes: list[tuple[int, int, int, int]]):
+    """A photo-like picture (600 x 500) of a noisy wall with dark windows at ``boxes``, a light cross in each."""
+    import numpy as np
+    from PIL import Image
+
+    rng = np.random.default_rng(0)
+    pixels = 170 + rng.normal(0, 6, (500, 600))
+    for x0, y0, x1, y1 in boxes:
+        pixels[y0:y1, x0:x1] = 50 + rng.normal(0, 6, (y1 - y0, x1 - x0))
+        pixels[y0:y1, (x0 + x1) // 2 - 2 : (x0 + x1) // 2 + 2] = 200
+        pixels[(y0 + y1) // 2 - 2 : (y0 + y1) // 2 + 2, x0:x1] = 200
+    return Image.fromarray(np.clip(pixels, 0, 255).astype(np.uint8), "L")
 
 
 def test_as_drawn_makes_the_wall_one_rectangle_and_keeps_the_label_map():
