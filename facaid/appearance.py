@@ -47,9 +47,19 @@ def _levels(grey_levels: np.ndarray | Levels) -> Levels:
     return grey_levels if isinstance(grey_levels, Levels) else Levels(grey_levels)
 
 
-def grey(photo: Any, width: int, height: int) -> np.ndarray:
-    """The photo (a PIL image, a path, or an (H, W) / (H, W, C) array) as float32 grey levels of the segmentation's
-    size, resized when it has another (the rectified photo a segmentation was drawn on has its size)."""
+WORK_PIXELS = 8_000_000  # a larger photo is read at a smaller scale (`levels`): its levels and their copy ≤ 64 MB
+
+
+def levels(photo: Any, width: int, height: int, max_pixels: int = WORK_PIXELS) -> Levels:
+    """The grey levels of a photo (a PIL image, a path, a file, an (H, W) / (H, W, C) array, or `Levels` already,
+    returned as they are) for a segmentation of ``width`` x ``height``, at most ``max_pixels`` of them: a larger one
+    is read at a smaller scale, and the answers about boxes are still in the segmentation's pixels. A path or file
+    is opened here and let go once it is grey (a JPEG decoded at a reduced scale already), so the call holds one
+    full-size decoded copy at most for a moment."""
+    if isinstance(photo, Levels):
+        return photo
+    s = min(1.0, float(np.sqrt(max_pixels / max(1, width * height))))
+    tw, th = max(1, round(width * s)), max(1, round(height * s))
     if isinstance(photo, np.ndarray):
         array = photo.astype(np.float32)
         if array.ndim == 3:
@@ -57,25 +67,7 @@ def grey(photo: Any, width: int, height: int) -> np.ndarray:
         if array.ndim != 2:
             raise ValueError(f"photo must be an (H, W) or (H, W, C) array, got shape {list(photo.shape)}")
         image = Image.fromarray(array, "F")
-    else:
-        image = photo if isinstance(photo, Image.Image) else Image.open(photo)
-        image = image.convert("L")
-    if image.size != (width, height):
-        image = image.resize((width, height), Image.Resampling.BILINEAR)
-    return np.asarray(image, dtype=np.float32)
-
-
-WORK_PIXELS = 8_000_000  # a larger photo is read at a smaller scale (`levels`): its levels and their copy ≤ 64 MB
-
-
-def levels(photo: Any, width: int, height: int, max_pixels: int = WORK_PIXELS) -> Levels:
-    """The grey levels of a photo (a PIL image, a path or a file) for a segmentation of ``width`` x ``height``, at
-    most ``max_pixels`` of them: a larger one is read at a smaller scale, and the answers about boxes are still in
-    the segmentation's pixels. A path or file is opened here and let go once it is grey (a JPEG decoded at a
-    reduced scale already), so the call holds one full-size decoded copy at most for a moment."""
-    s = min(1.0, float(np.sqrt(max_pixels / max(1, width * height))))
-    tw, th = max(1, round(width * s)), max(1, round(height * s))
-    if isinstance(photo, Image.Image):
+    elif isinstance(photo, Image.Image):
         image = photo.convert("L")
     else:
         with Image.open(photo) as opened:

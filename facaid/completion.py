@@ -386,12 +386,7 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
     _companions(types, props)
     looks = {}
     if photo is not None:
-        if isinstance(photo, appearance.Levels):
-            levels = photo
-        elif isinstance(photo, np.ndarray):
-            levels = appearance.Levels(appearance.grey(photo, seg.width, seg.height))
-        else:
-            levels = appearance.levels(photo, seg.width, seg.height)
+        levels = appearance.levels(photo, seg.width, seg.height)
         _search(levels, types, props)
         looks = _photo_check(levels, props)
     out = []

@@ -191,10 +191,10 @@ class Procedure(models.Model):
             if unchanged:
                 return
             change = change or Change(ProcedureVersion.Kind.EDIT if latest else ProcedureVersion.Kind.CREATED)
-        size = len(pack(self.data))
-        check_quota(self.owner_id, size)
+        packed = pack(self.data)  # stored as it is: the field compresses only what is not compressed yet
+        check_quota(self.owner_id, len(packed))
         ProcedureVersion.objects.create(
-            procedure=self, version=(latest["version"] if latest else 0) + 1, data=self.data, size=size,
+            procedure=self, version=(latest["version"] if latest else 0) + 1, data=packed, size=len(packed),
             digest=self.digest,
             accuracy=self.accuracy, metrics=self.metrics, kind=change.kind, note=change.note[:200],
             based_on=change.based_on, warning=change.warning[:300])

@@ -109,19 +109,18 @@ def refresh(procedure_id: int) -> None:
 
 
 def _refresh(rows) -> None:
-    if True:
-        row = rows.values_list("code", "digest", "data").first()
-        if row is None:
-            return
-        code, tag, data = row
-        for kind in SIDES:
-            name = _name(code, tag, kind)
-            if not default_storage.exists(name):
-                _write(name, render(data, kind))
-        keep = {tag, rows.values_list("digest", flat=True).first() or tag}
-        for name in _files(code):
-            if _tag(name) not in keep and not name.endswith(".partial"):
-                default_storage.delete(name)
+    row = rows.values_list("code", "digest", "data").first()
+    if row is None:
+        return
+    code, tag, data = row
+    for kind in SIDES:
+        name = _name(code, tag, kind)
+        if not default_storage.exists(name):
+            _write(name, render(data, kind))
+    keep = {tag, rows.values_list("digest", flat=True).first() or tag}
+    for name in _files(code):
+        if _tag(name) not in keep and not name.endswith(".partial"):
+            default_storage.delete(name)
 
 
 def remove(code) -> None:

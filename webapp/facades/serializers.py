@@ -90,14 +90,11 @@ class WholeNumberField(serializers.IntegerField):
         return super().to_internal_value(data)
 
 
-MetresField = NumberField  # a length in metres
-
-
-def real_size_field(side: str) -> MetresField:
+def real_size_field(side: str) -> NumberField:
     lo, hi = REAL_SIZE_M
-    return MetresField(min_value=lo, max_value=hi, required=False, allow_null=True,
-                            help_text=f"the facade's real {side} in metres ({lo:g} to {hi:g}; null: none), "
-                                      "the scale of its CGA rules and mesh; setting one clears the other")
+    return NumberField(min_value=lo, max_value=hi, required=False, allow_null=True,
+                       help_text=f"the facade's real {side} in metres ({lo:g} to {hi:g}; null: none), "
+                                 "the scale of its CGA rules and mesh; setting one clears the other")
 
 
 class PhotoSerializer(serializers.ModelSerializer):
@@ -275,7 +272,7 @@ class JobSerializer(serializers.ModelSerializer):
 
 def k_field() -> WholeNumberField:
     return WholeNumberField(min_value=1, max_value=MAX_K, default=DEFAULT_K,
-                                    help_text="candidates decoded and compared")
+                            help_text="candidates decoded and compared")
 
 
 MAX_PREFIX_NODES = MAX_NODES  # a prefix keeps at most the whole tree
@@ -328,5 +325,5 @@ class ConvertSerializer(serializers.Serializer):
     image = TextField(max_length=1000, required=False,
                       help_text="of a COCO or CVAT file of several images, the one to read: its file name or id")
     width = WholeNumberField(min_value=1, max_value=MAX_SIDE, required=False,
-                                     help_text="with height: of several images, read the only one of this size")
+                             help_text="with height: of several images, read the only one of this size")
     height = WholeNumberField(min_value=1, max_value=MAX_SIDE, required=False)

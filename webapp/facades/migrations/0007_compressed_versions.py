@@ -18,8 +18,8 @@ def pack_versions(apps, schema_editor):
         if not batch:
             return
         for v in batch:
-            packed = webapp.facades.fields.pack(v.data)
-            v.packed, v.size = v.data, len(packed)
+            v.packed = webapp.facades.fields.pack(v.data)  # stored as it is, not compressed twice
+            v.size = len(v.packed)
         ProcedureVersion.objects.bulk_update(batch, ["packed", "size"])
         last = batch[-1].id
 
