@@ -9,7 +9,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE, STRUCTURES
+from facaid.defaults import DEFAULT_K, DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE, STRUCTURES
 from facaid.generator import STYLE_NAMES
 from facaid.paths import DEFAULT_CHECKPOINT, DEFAULT_CMP
 
@@ -206,8 +206,13 @@ def cmd_complete(args: argparse.Namespace) -> None:
     seg = Segmentation.from_dict(_read_json(args.input), clip=args.clip)
     if args.photo and not Path(args.photo).is_file():
         raise CliError(f"photo not found at {args.photo}")
-    if not 0 <= args.min_score <= 1:
-        raise CliError(f"--min-score must be in [0, 1], got {args.min_score}")
+    if args.unit is not None and not args.photo:
+        raise CliError("--unit finds the unit's copies in the photo: give --photo too")
+    min_score = args.min_score
+    if min_score is None:
+        min_score = DEFAULT_MIN_SCORE if args.unit is None else DEFAULT_MIN_COPY
+    if not 0 <= min_score <= 1:
+        raise CliError(f"--min-score must be in [0, 1], got {min_score}")
     photo = None
     if args.photo:
         from PIL import Image
@@ -218,7 +223,16 @@ def cmd_complete(args: argparse.Namespace) -> None:
             photo = levels(args.photo, seg.width, seg.height)
         except (OSError, Image.DecompressionBombError) as exc:
             raise CliError(f"cannot read photo {args.photo}: {exc}") from None
-    proposals = complete(seg, photo, min_score=args.min_score)
+    if args.unit is not None:
+        from facaid.copies import UnitError, find_copies
+
+        try:
+            unit = [int(i) for i in args.unit.split(",")]
+            proposals = find_copies(seg, photo, unit, min_score=min_score)
+        except (ValueError, UnitError) as exc:
+            raise CliError(f"--unit: {exc}") from None
+    else:
+        proposals = complete(seg, photo, min_score=min_score)
     counts: dict[str, int] = {}
     for p in proposals:
         counts[p["label"]] = counts.get(p["label"], 0) + 1
@@ -420,6 +434,10 @@ def cmd_convert(args: argparse.Namespace) -> None:
         if not (isinstance(obj, dict) and ("procedure" in obj or obj.get("format") is not None)):
             raise
         seg, source, name, warnings = load_segmentation_or_procedure(obj), "procedure", None, ()
+        if fmt != "segmentation":  # an annotation tool's file: one box per element, the wall under them
+            from facaid.annotation import as_annotated
+
+            seg = as_annotated(seg)
     for line in warnings:
         print(f"warning: {line}", file=sys.stderr)
     out = Path(args.out)
@@ -589,8 +607,11 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("input", help="segmentation JSON drawn so far")
     cp.add_argument("--photo", help="the rectified photo the segmentation is drawn on: it proposes what looks like "
                                     "the drawn elements and confirms or rejects each proposal")
-    cp.add_argument("--min-score", type=float, default=DEFAULT_MIN_SCORE,
-                    help=f"leave out proposals scored lower (default {DEFAULT_MIN_SCORE})")
+    cp.add_argument("--unit", help="comma-separated indices of the rectangles of one unit (a window and what is drawn "
+                                   "around it): propose its copies in the photo instead")
+    cp.add_argument("--min-score", type=float, default=None,
+                    help=f"leave out proposals scored lower (default {DEFAULT_MIN_SCORE}; {DEFAULT_MIN_COPY} with "
+                         "--unit)")
     cp.add_argument("--clip", action="store_true", help="clip rectangles reaching outside the image")
     cp.add_argument("--json", help="write the proposals to this JSON file ({\"proposals\": [...]})")
     cp.set_defaults(func=cmd_complete)

@@ -51,7 +51,12 @@ def _segmentation(fmt: str):
         from facaid.interchange import write as write_annotations
 
         picture = path.name[: -len(export_for(path)[0])] + ".png"  # the label map `--out NAME.png` writes beside it
-        return _text(path, write_annotations(to_segmentation(proc), fmt, image=picture))
+        seg = to_segmentation(proc)
+        if fmt != "segmentation":  # an annotation tool's file: one box per element, the wall under them
+            from facaid.annotation import as_annotated
+
+            seg = as_annotated(seg)
+        return _text(path, write_annotations(seg, fmt, image=picture))
     return write
 
 
@@ -108,10 +113,10 @@ def _cityjson(proc, path, scale, photo):
 EXPORTS: dict[str, Export] = {  # the longest extension that a file name ends in wins
     ".json": Export("the procedure JSON", _json, scaled=False),
     ".segmentation.json": Export("the labelled rectangles it draws", _segmentation("segmentation"), scaled=False),
-    ".coco.json": Export("those rectangles as COCO object detection annotations", _segmentation("coco"),
+    ".coco.json": Export("its elements as COCO object detection annotations, one box each", _segmentation("coco"),
                          scaled=False),
-    ".labelme.json": Export("those rectangles as a LabelMe file", _segmentation("labelme"), scaled=False),
-    ".cvat.xml": Export("those rectangles as CVAT for images XML", _segmentation("cvat"), scaled=False),
+    ".labelme.json": Export("the same boxes as a LabelMe file", _segmentation("labelme"), scaled=False),
+    ".cvat.xml": Export("the same boxes as CVAT for images XML", _segmentation("cvat"), scaled=False),
     ".png": Export("the label map as a picture", _png, scaled=False),
     ".overlay.png": Export("the label map over --photo, half opaque", _overlay, scaled=False, photo=True,
                            needs_photo=True),

@@ -2,7 +2,7 @@
 // the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
 import {acceptCommand, proposalAt, rejectedOf, repeatByPitch, repeatSelection, similarProposals, splitCommand}
   from "./assist.js";
-import {DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
+import {AddRects, DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
 import {identical} from "./geometry.js";
 import {buildHelp} from "./help.js";
 import {BOX_FIELDS, boxFields, setBoxCommand} from "./inspect.js";
@@ -10,6 +10,7 @@ import {ACTIONS, keyAction} from "./keys.js";
 import {buildObjectList} from "./object-list.js";
 import {freeView, layersNote, objectGroups, pickable, pickableSelection, toggleLayer} from "./objects.js";
 import {buildPalette, markActive} from "./panel.js";
+import {chipAt, chipMembers, chips, copyOf, toggleRejected, unitIndices} from "./proposals.js";
 import {openRectifyMode} from "./rectify-mode.js";
 import {drawScene, grayPixels} from "./render.js";
 import {download, makeApi} from "./server.js";
@@ -233,16 +234,25 @@ canvas.addEventListener("wheel", (e) => {
   draw();
 }, {passive: false});
 
-// proposals: a click rejects (or takes back) one before any tool sees the press; Shift+click accepts it alone
+// proposals: a click rejects (or takes back) one, with the rest of its copy, before any tool sees the press;
+// Shift+click accepts it alone; a row's or column's chip does the same for all of the row or column
+const chipUnder = (e) => chipAt(chips(ui.proposals, (x, y) => [x * view.scale + view.ox, y * view.scale + view.oy]),
+  e.offsetX, e.offsetY);
 canvas.addEventListener("click", (e) => {
-  const p = ui.drag ? null : proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY));
-  if (!p) return;
-  if (e.shiftKey) {
-    ui.proposals = ui.proposals.filter((q) => q !== p);
-    run(acceptCommand([{...p, accepted: true}], `accept one ${p.label}`));
+  if (ui.drag) return;
+  const chip = chipUnder(e);
+  const p = chip ? null : proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY));
+  const members = chip ? chipMembers(ui.proposals, chip) : p ? copyOf(ui.proposals, p) : [];
+  if (!members.length) return;
+  if (e.shiftKey) {  // a row or column adds what is not rejected in it; one proposal is added as it is
+    const taken = chip ? members.filter((q) => q.accepted !== false) : members;
+    ui.proposals = ui.proposals.filter((q) => !taken.includes(q));
+    const what = chip ? `a ${chip.kind} of ${taken.length}` : `one ${p.label}`;
+    if (taken.length) run(acceptCommand(taken.map((q) => ({...q, accepted: true})), `accept ${what}`));
     changed();
   } else {
-    p.accepted = p.accepted === false;
+    const rejected = toggleRejected(members);
+    if (chip) status(`${rejected ? "Rejected" : "Took back"} a ${chip.kind} of ${members.length} proposals.`);
     draw();
   }
 }, true);
@@ -342,23 +352,42 @@ function similar() {
   draw();
 }
 
+// find copies (facaid.copies on the server): where the selected unit, a window with what is drawn around it,
+// repeats in the photo
+async function findCopies() {
+  if (!ui.selection.size) return status("Find copies looks for copies of the selected unit: select a window and " +
+    "what belongs to it (sill, blind, hood) first.", "error");
+  const drawn = seg.toJSON(), unit = unitIndices(seg, ui.selection);
+  await propose({...drawn, unit}, drawn, "find copies", (n, copies) => n
+    ? `${copies} copies of the unit (${n} proposals), scored by how alike they look: click one to reject its copy, ` +
+      "a row's or column's chip to reject all of it (Shift: add it alone), Enter or \"Accept\" to add the rest."
+    : "No copies of the unit found in the photo.");
+}
+
 // completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
 async function completeNow() {
-  if (ui.completing) return;  // one request at a time
-  ui.rejected.push(...rejectedOf(ui.proposals));
-  ui.proposals = [];
-  ui.completing = true;
   const drawn = seg.toJSON();
+  await propose({...drawn, rejected: ui.rejected}, drawn, "complete", (n) => n ? `${n} proposals: click one to ` +
+    'reject it, Shift+click to add it alone, Enter or "Accept" to add the rest.'
+    : "Nothing to propose yet: draw a few elements of a row and a column.");
+}
+
+// one request for proposals at a time; those shown stay until the answer replaces them (the rejected ones are
+// remembered and passed back), unless the drawing changed meanwhile
+async function propose(body, drawn, from, message) {
+  if (ui.completing) return;
+  const known = new Set(ui.rejected.map((r) => JSON.stringify(r)));
+  ui.rejected.push(...rejectedOf(ui.proposals).filter((r) => !known.has(JSON.stringify(r))));
+  body.rejected = ui.rejected;
+  ui.completing = true;
   try {
-    const {proposals} = await api(`/api/v1/photos/${photoCode}/complete`, {method: "POST",
-      body: JSON.stringify({...drawn, rejected: ui.rejected})});
+    const {proposals} = await api(`/api/v1/photos/${photoCode}/complete`, {method: "POST", body: JSON.stringify(body)});
     if (JSON.stringify(seg.toJSON()) !== JSON.stringify(drawn)) {
-      return status("The drawing changed meanwhile: press C again.");
+      return status(`The drawing changed meanwhile: ${from === "complete" ? "press C" : "ask"} again.`);
     }
     ui.proposals = proposals;
-    ui.proposalsFrom = "complete";
-    status(proposals.length ? `${proposals.length} proposals: click one to reject it, Shift+click to add it alone, ` +
-      'Enter or "Accept" to add the rest.' : "Nothing to propose yet: draw a few elements of a row and a column.");
+    ui.proposalsFrom = from;
+    status(message(proposals.length, new Set(proposals.map((p) => p.copy)).size));
   } catch (err) {
     status(`No proposals: ${err.message}`, "error");
   } finally {
@@ -378,12 +407,29 @@ function acceptProposals() {
 // --- files, saving, submitting, rectifying (frontend/session.js) ------------------------------------------------
 async function importJSON(file) {
   try {
-    const {rects, warnings} = await readSegmentationFile(file, seg.width, seg.height, api);
-    run(new ReplaceAll(rects));
-    status(`Imported ${rects.length} rectangles.${warnings.map((w) => ` Note: ${w}.`).join("")}`, "success");
+    const original = info.rectified && info.corners ? {width: info.width, height: info.height, corners: info.corners}
+      : null;  // an annotation of the photo as taken is carried through its rectification
+    const {rects, warnings} = await readSegmentationFile(file, seg.width, seg.height, api, original);
+    const choice = seg.size ? await askImport(seg.size, rects.length) : "replace";
+    if (choice === "cancel") return status("Not imported: nothing changed.");
+    run(choice === "merge" ? new AddRects(rects, "import") : new ReplaceAll(rects));
+    status(`Imported ${rects.length} rectangles${choice === "merge" ? `, added to the ${seg.size - rects.length} ` +
+      "drawn" : ""}.${warnings.map((w) => ` Note: ${w}.`).join("")}`, "success");
   } catch (err) {
     status(`Not imported: ${err.message}`, "error");
   }
+}
+
+// "replace", "merge" or "cancel": what to do with the rectangles drawn when a file brings others
+function askImport(drawn, coming) {
+  const dialog = $("#import-choice");
+  $("#import-question").textContent = `${drawn} rectangles are drawn and the file has ${coming}: replace the drawn ` +
+    "ones with the file's, or add the file's to them?";
+  return new Promise((resolve) => {
+    dialog.addEventListener("close", () => resolve(dialog.returnValue || "cancel"), {once: true});
+    dialog.returnValue = "";
+    dialog.showModal();
+  });
 }
 
 async function saveNow() {
@@ -422,6 +468,7 @@ async function submitNow() {
 async function openRectify() {
   rectifying = await openRectifyMode(canvas, $("#rectify-preview"), info);
   $("#rectify-panel").hidden = false;
+  $("#rectify-panel").scrollIntoView({block: "nearest"});  // its step in view in the side panel
   const side = info.real_height_m != null ? "height" : "width";
   $("#real-side").value = side;
   $("#real-metres").value = info[`real_${side}_m`] ?? "";
@@ -470,13 +517,18 @@ on("#split", "click", () => carryOut(splitCommand(seg, [...ui.selection], {n: Nu
 on("#similar", "click", similar);
 on("#accept", "click", acceptProposals);
 on("#complete", "click", completeNow);
+on("#copies", "click", findCopies);
 on("#fit", "click", fit);
 on("#sel-apply", "click", applyBox);
 on("#help-open", "click", () => showHelp(true));
 on("#help-close", "click", () => showHelp(false));
 on("#help", "click", (e) => { if (e.target.id === "help") showHelp(false); });  // a click beside the dialog
 on("#export", "click", () => download(seg.toJSON(), `segmentation-${photoCode.slice(0, 8)}.json`));
-on("#import", "change", (e) => e.target.files[0] && importJSON(e.target.files[0]));
+on("#import", "change", (e) => {  // emptied after: the same file chosen again is read again
+  const file = e.target.files[0];
+  e.target.value = "";
+  if (file) importJSON(file);
+});
 on("#save", "click", saveNow);
 on("#submit", "click", submitNow);
 on("#fill", "input", draw);

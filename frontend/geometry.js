@@ -166,3 +166,27 @@ export function isConvexQuad(corners) {
   }
   return true;
 }
+
+/** Rectangles of the original photo carried into its rectified image: the quadrilateral `corners` (TL, TR, BR,
+ * BL in the original) is the rectified image of `width` x `height`; each box's four corners go through that
+ * homography and the box becomes the axis-aligned one around them, cut to the image. A box that keeps less than
+ * half of itself inside (outside the facade) is left out. {rects, left: how many were left out}. */
+export function throughRectification(rects, corners, width, height) {
+  const h = homography(corners, [[0, 0], [width, 0], [width, height], [0, height]]);
+  const out = [];
+  let left = 0;
+  for (const r of rects) {
+    const pts = [[r.x0, r.y0], [r.x1, r.y0], [r.x1, r.y1], [r.x0, r.y1]].map(([x, y]) => applyHomography(h, x, y));
+    const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
+    const box = {x0: Math.min(...xs), y0: Math.min(...ys), x1: Math.max(...xs), y1: Math.max(...ys)};
+    const cut = {x0: Math.max(0, Math.round(box.x0)), y0: Math.max(0, Math.round(box.y0)),
+      x1: Math.min(width, Math.round(box.x1)), y1: Math.min(height, Math.round(box.y1))};
+    const whole = (box.x1 - box.x0) * (box.y1 - box.y0), kept = (cut.x1 - cut.x0) * (cut.y1 - cut.y0);
+    if (!xs.concat(ys).every(Number.isFinite) || cut.x1 - cut.x0 < 1 || cut.y1 - cut.y0 < 1 || kept < whole / 2) {
+      left++;
+    } else {
+      out.push({label: r.label, ...cut});
+    }
+  }
+  return {rects: out, left};
+}

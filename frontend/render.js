@@ -5,6 +5,7 @@ import {handlePoints, normalize} from "./geometry.js";
 import {cssColor} from "./labels.js";
 import {toGray} from "./match.js";
 import {shown} from "./objects.js";
+import {chips} from "./proposals.js";
 
 /** The photo's gray levels at its own size, for `match.findSimilar`. */
 export function grayPixels(photo, width, height) {
@@ -56,6 +57,17 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
     }
   }
   for (const p of ui.proposals) stroke(p, p.accepted === false ? "#888" : "#ffeb3b", 2, [6, 4]);
+  drawScores(ctx, ui.proposals, sx, sy, view.scale);
+  for (const c of chips(ui.proposals, (x, y) => [sx(x), sy(y)])) {  // one click: a whole row or column
+    const off = c.members.every((p) => p.accepted === false);
+    ctx.fillStyle = off ? "#888" : "#ffeb3b";
+    ctx.fillRect(c.x, c.y, c.w, c.h);
+    ctx.fillStyle = "#222";
+    ctx.font = "bold 13px sans-serif";
+    ctx.textAlign = "center";
+    ctx.fillText(off ? "↺" : "×", c.x + c.w / 2, c.y + c.h - 5);
+    ctx.textAlign = "start";
+  }
   if (drag?.kind === "marquee") stroke(normalize(drag.box), "#9cf", 1, [3, 3]);
   ctx.strokeStyle = "#ff4fd8";
   ctx.lineWidth = 1;
@@ -70,5 +82,18 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
     ctx.globalAlpha = ui.overlayAlpha;
     ctx.drawImage(ui.overlay, view.ox, view.oy, seg.width * view.scale, seg.height * view.scale);
     ctx.globalAlpha = 1;
+  }
+}
+
+/** Each proposal's score (two decimals) in its top-left corner, where it is wide enough on the screen to hold it. */
+function drawScores(ctx, proposals, sx, sy, scale) {
+  ctx.font = "11px sans-serif";
+  for (const p of proposals) {
+    if (p.score === undefined || (p.x1 - p.x0) * scale < 30 || (p.y1 - p.y0) * scale < 16) continue;
+    const text = p.score.toFixed(2);
+    ctx.fillStyle = "rgba(0, 0, 0, 0.6)";
+    ctx.fillRect(sx(p.x0) + 2, sy(p.y0) + 2, ctx.measureText(text).width + 4, 13);
+    ctx.fillStyle = p.accepted === false ? "#aaa" : "#ffeb3b";
+    ctx.fillText(text, sx(p.x0) + 4, sy(p.y0) + 12);
   }
 }

@@ -1,6 +1,7 @@
 // The editor's conversation with the site: the photo and its segmentation loaded (or a draft restored), versions
 // saved, a job submitted and followed, a segmentation file read, the rectification applied.
 import {ReplaceAll} from "./commands.js";
+import {throughRectification} from "./geometry.js";
 import {History} from "./history.js";
 import {followJob} from "./server.js";
 import {Segmentation} from "./state.js";
@@ -119,7 +120,7 @@ export async function submit(api, photoCode, seg, history, {saved, k = 4, onSave
 /** {rects, warnings}: the rectangles of a segmentation file for an image of the given size, and what was read other
  * than as it stands. Our JSON is read here; COCO, LabelMe and CVAT files by the site (`POST /api/v1/convert`: of a
  * file of several images, the only one of the photo's size); throws a message otherwise. */
-export async function readSegmentationFile(file, width, height, api) {
+export async function readSegmentationFile(file, width, height, api, original = null) {
   const text = await file.text();
   let data = null, warnings = [];
   try {
@@ -132,10 +133,17 @@ export async function readSegmentationFile(file, width, height, api) {
       body: JSON.stringify({text, width, height})}));
   }
   const parsed = Segmentation.fromJSON(data);
-  if (parsed.width !== width || parsed.height !== height) {
-    throw new Error(`the file is ${parsed.width}x${parsed.height}; the photo is ${width}x${height}`);
+  if (parsed.width === width && parsed.height === height) return {rects: parsed.toJSON().rects, warnings};
+  if (original && parsed.width === original.width && parsed.height === original.height) {
+    // an annotation of the photo as taken: carried through the rectification the editor knows
+    const {rects, left} = throughRectification(parsed.toJSON().rects, original.corners, width, height);
+    const outside = left ? `; ${left} outside the facade left out` : "";
+    return {rects, warnings: [...warnings, `the file annotates the photo as taken (${original.width}x` +
+      `${original.height}): its ${rects.length + left} boxes were carried through the rectification into the ` +
+      `${width}x${height} facade${outside}`]};
   }
-  return {rects: parsed.toJSON().rects, warnings};
+  const taken = original ? ` (as taken, before rectifying, ${original.width}x${original.height})` : "";
+  throw new Error(`the file is ${parsed.width}x${parsed.height}; the photo is ${width}x${height}${taken}`);
 }
 
 export async function rectify(api, photoCode, corners) {

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from facaid.annotation import as_drawn  # noqa: F401  (the benches and tests read it here)
 from facaid.completion import complete
 from facaid.labels import LABEL_ID
 from facaid.metrics import pixel_accuracy
@@ -78,27 +79,6 @@ def _review(proposals: list[dict], todo: list[Rect], drawing: list[Rect], reject
             drawing.append(box)
         else:
             rejected.append({k: p[k] for k in ("label", "x0", "y0", "x1", "y1")})
-
-
-def as_drawn(seg: Segmentation) -> Segmentation:
-    """The segmentation as a person draws it: the wall as one rectangle per block of the building (what is not
-    background, in the fewest rectangles a row-by-row merge finds) under its elements, where a flattened
-    segmentation (a generated facade's) has it in pieces around each element. Its label map is the same."""
-    built = rasterize(seg) != LABEL_ID["background"]
-    walls: list[Rect] = []
-    open_runs: dict[tuple[int, int], int] = {}  # (x0, x1) of a run of building pixels -> the row its block began
-    for y in range(seg.height + 1):
-        runs = set()
-        if y < seg.height:
-            row = np.concatenate([[False], built[y], [False]])
-            edges = np.flatnonzero(row[1:] != row[:-1])
-            runs = {(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)}
-        for run in [r for r in open_runs if r not in runs]:
-            walls.append(Rect(LABEL_ID["facade"], run[0], open_runs.pop(run), run[1], y))
-        for run in runs - open_runs.keys():
-            open_runs[run] = y
-    elements = tuple(r for r in seg.rects if r.label != LABEL_ID["facade"])
-    return Segmentation(seg.width, seg.height, (*walls, *elements))
 
 
 def summary(sessions: list[Session]) -> dict:

@@ -1,7 +1,8 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {clampToImage, handleAt, identical, moveWithin, normalize, repeatRect, resize, snap} from "../geometry.js";
+import {clampToImage, handleAt, identical, moveWithin, normalize, repeatRect, resize, snap, throughRectification}
+  from "../geometry.js";
 
 test("normalize and clamp", () => {
   assert.deepEqual(normalize({x0: 5, y0: 9, x1: 1, y1: 2}), {x0: 1, y0: 2, x1: 5, y1: 9});
@@ -64,4 +65,23 @@ test("identical: rectangles drawn twice, by box and class", () => {
   assert.deepEqual(identical([wall, {...wall}, {...wall, label: "window"}, {...wall, x1: 9}]),
     [{label: "facade", count: 2}]);
   assert.deepEqual(identical([wall]), []);
+});
+
+test("boxes of the photo as taken are carried through its rectification; those outside the facade are left out", () => {
+  // the facade seen from the left: its right edge shorter in the photo; rectified to 300 x 200
+  const corners = [[100, 50], [400, 100], [400, 300], [100, 350]];
+  const rects = [{label: "window", x0: 100, y0: 50, x1: 130, y1: 80},  // at the facade's top-left corner
+    {label: "door", x0: 370, y0: 250, x1: 400, y1: 300},  // at its bottom-right corner
+    {label: "window", x0: 0, y0: 0, x1: 60, y1: 40}];  // beside it, off the facade
+  const {rects: out, left} = throughRectification(rects, corners, 300, 200);
+  assert.equal(left, 1);
+  assert.deepEqual(out[0].label, "window");
+  assert.equal(out[0].x0, 0);
+  assert.equal(out[0].y0, 0);
+  assert.ok(out[0].x1 > 20 && out[0].x1 < 40 && out[0].y1 > 10 && out[0].y1 < 30, JSON.stringify(out[0]));
+  assert.equal(out[1].x1, 300);
+  assert.equal(out[1].y1, 200);
+  // an identity rectification keeps every box as it is
+  const same = throughRectification(rects.slice(0, 2), [[0, 0], [500, 0], [500, 400], [0, 400]], 500, 400);
+  assert.deepEqual(same.rects.map(({x0, y0, x1, y1}) => [x0, y0, x1, y1]), [[100, 50, 130, 80], [370, 250, 400, 300]]);
 });

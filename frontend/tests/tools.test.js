@@ -8,6 +8,7 @@ import {AddRects} from "../commands.js";
 import {History} from "../history.js";
 import {keyAction} from "../keys.js";
 import {Segmentation} from "../state.js";
+import {HANDLE_PX} from "../tools/context.js";
 import {press} from "../tools/select.js";
 import {PinchGesture, fitView} from "../tools/view.js";
 
@@ -90,6 +91,19 @@ test("resize: a press on a handle of the one selected rectangle resizes it, its 
   assert.deepEqual(gesture.preview.get(2), {id: 2, label: "window", x0: 20, y0: 20, x1: 60, y1: 50});
   history.execute(gesture.up(ctx).command);
   assert.equal(seg.get(2).x1, 60);
+});
+
+test("draw: beside the selected rectangle a drag draws, however near its handle at any zoom; on it, it resizes", () => {
+  const {seg} = scene();
+  for (const scale of [0.25, 0.6, 1, 4]) {
+    const ctx = context(seg, {selection: new Set([2]), scale});  // window 2 spans x 20-40, y 20-50
+    const beside = HANDLE_PX / scale / 2;  // within the handle's reach, outside the rectangle
+    assert.equal(press("draw", at(40 + beside, 20 + beside / 2), ctx, {}).gesture.kind, "draw", `scale ${scale}`);
+    assert.equal(press("draw", at(40, 20), ctx, {}).gesture.kind, "resize");  // on its corner
+    if (scale >= 0.6) assert.equal(press("draw", at(40 - beside, 35), ctx, {}).gesture.handle, "e");  // inside it
+    // the select tool keeps the handle's reach on both sides
+    assert.equal(press("select", at(40 + beside, 35), ctx, {}).gesture.kind, "resize");
+  }
 });
 
 test("marquee: a press on nothing clears the selection (Shift keeps it) and selects what the box touches, no facade", () => {

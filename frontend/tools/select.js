@@ -1,6 +1,6 @@
 // What a press starts, by tool and by what lies under the pointer: the gesture and the selection it leaves.
 //   - Space or the middle button: pan;
-//   - on a handle of the one selected rectangle: resize it;
+//   - on a handle of the one selected rectangle: resize it (with the draw tool, only a press on the rectangle);
 //   - the draw tool: draw;
 //   - the select tool, on a rectangle: select it (Shift toggles it) and move the selection; a press inside the
 //     selection grabs it even where another class paints on top;
@@ -20,9 +20,13 @@ export function press(tool, pointer, ctx, view, {pan = false} = {}) {
   const selection = new Set(ctx.selection);
   if (pan) return {gesture: new PanGesture(pointer, view), selection};
   if (selection.size === 1) {
-    const id = [...selection][0];
-    const handle = handleAt(ctx.seg.get(id), pointer.x, pointer.y, HANDLE_PX / ctx.scale);
-    if (handle) return {gesture: new ResizeGesture(id, handle), selection};
+    const id = [...selection][0], r = ctx.seg.get(id);
+    const handle = handleAt(r, pointer.x, pointer.y, HANDLE_PX / ctx.scale);
+    // with the draw tool only a press on the rectangle itself resizes it: beside it (a window 8 px from the one just
+    // drawn), a drag draws, at any zoom
+    if (handle && (tool !== "draw" || onRect(r, pointer.x, pointer.y))) {
+      return {gesture: new ResizeGesture(id, handle), selection};
+    }
   }
   if (tool === "draw") return {gesture: new DrawGesture(pointer), selection};
   const inside = [...selection].map((id) => ctx.seg.get(id)).find((r) => contains(r, pointer.x, pointer.y));
@@ -41,3 +45,5 @@ export function press(tool, pointer, ctx, view, {pan = false} = {}) {
   }
   return {gesture: new MoveGesture(pointer, selection), selection};
 }
+
+const onRect = (r, x, y) => x >= r.x0 && x <= r.x1 && y >= r.y0 && y <= r.y1;  // its edges included

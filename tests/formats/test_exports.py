@@ -11,6 +11,7 @@ import trimesh
 from format_helpers import window_grid
 from PIL import Image
 
+from facaid.annotation import as_annotated
 from facaid.cli import main
 from facaid.exports import EXPORTS, export_for
 from facaid.generator import generate
@@ -18,6 +19,7 @@ from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.interchange import read as read_annotations
 from facaid.labels import LABEL_ID
+from facaid.segmentation import rasterize
 
 
 @pytest.fixture(scope="module")
@@ -61,8 +63,11 @@ def read_back(path, proc):
 def test_every_extension_writes_its_format(tmp_path, source, proc, capsys):
     rects = len(to_segmentation(proc).rects)
     windows = sum(r.label in (LABEL_ID["window"], LABEL_ID["shop"]) for r in to_segmentation(proc).rects)
+    boxes = len(as_annotated(to_segmentation(proc)).rects)  # one box per element, the wall under them
+    assert boxes < rects
     expected = {".json": rects, ".png": (444, 797), ".svg": rects, ".obj": True, ".glb": rects, ".gltf": rects,
-                ".ifc": windows, ".city.json": windows, ".overlay.png": (444, 797)}
+                ".ifc": windows, ".city.json": windows, ".overlay.png": (444, 797), ".coco.json": boxes,
+                ".labelme.json": boxes, ".cvat.xml": boxes}
     photo = tmp_path / "photo.png"
     Image.new("RGB", (proc.width, proc.height), (120, 80, 40)).save(photo)
     for ext in EXPORTS:
@@ -80,6 +85,8 @@ def test_every_extension_writes_its_format(tmp_path, source, proc, capsys):
             assert read_back(out, proc) == expected.get(ext, rects), ext
     coco = json.loads((tmp_path / "house.coco.json").read_text())
     assert coco["images"][0]["file_name"] == "house.png"  # the label map written by --out house.png
+    back = read_annotations((tmp_path / "house.coco.json").read_bytes(), size=(round(proc.width), round(proc.height)))
+    assert (rasterize(back) == rasterize(to_segmentation(proc))).all()  # the same label map in fewer boxes
 
 
 def test_the_longest_extension_wins():

@@ -12,6 +12,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from facaid import interchange
+from facaid.annotation import as_annotated
 from facaid.cli import main
 from facaid.generator import generate
 from facaid.grammar import to_segmentation
@@ -416,7 +417,11 @@ def test_cli_converts_a_procedure_and_names_the_image(tmp_path):
     assert main(["convert", str(tmp_path / "p.json"), "--out", str(tmp_path / "p.labelme.json"),
                  "--image", "rue-5.jpg"]) == 0
     loaded = load((tmp_path / "p.labelme.json").read_bytes())
-    assert (loaded.segmentation, loaded.image) == (to_segmentation(sample.procedure), "rue-5.jpg")
+    # an annotation tool's file holds its elements one box each (`facaid.annotation`); our JSON the exact pieces
+    assert (loaded.segmentation, loaded.image) == (as_annotated(to_segmentation(sample.procedure)), "rue-5.jpg")
+    assert main(["convert", str(tmp_path / "p.json"), "--out", str(tmp_path / "p.seg.json"), "--to",
+                 "segmentation"]) == 0
+    assert load((tmp_path / "p.seg.json").read_bytes()).segmentation == to_segmentation(sample.procedure)
 
 
 @pytest.mark.parametrize("args, message", [

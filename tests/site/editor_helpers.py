@@ -85,3 +85,14 @@ def drag(page, start, end, steps=6) -> None:
     page.mouse.down()
     page.mouse.move(*screen(page, *end), steps=steps)
     page.mouse.up()
+
+
+def import_file(page, path, choice: str = "replace") -> None:
+    """Import ``path`` through the editor's Import button; where rectangles are drawn already the editor asks what
+    to do with them, and ``choice`` answers ("replace", "merge" or "cancel")."""
+    page.evaluate("document.querySelector('#status').textContent = ''")  # the answer to this import, not the last
+    page.set_input_files("#import", str(path))
+    page.wait_for_function("document.querySelector('#import-choice').open || "
+                           "/^(Imported|Not imported)/.test(document.querySelector('#status').textContent)")
+    if page.evaluate("document.querySelector('#import-choice').open"):
+        page.click(f"#import-choice button[value={choice}]")

@@ -264,6 +264,34 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
     assert as_bob.post(url, _drawn_grid(w, h), format="json").status_code == 404  # Alice's private photo
 
 
+def test_completion_with_a_unit_proposes_its_copies_in_the_photo(as_alice):
+    """``unit`` in the body: the copies of a window with its sill, found in the photo (`facaid.copies`), each with its
+    score and the copy it belongs to; a bad unit is a 400 naming it."""
+    from photo_helpers import CLOSED, GRID, lattice_photo, sill_of
+
+    out = io.BytesIO()
+    lattice_photo().save(out, "PNG")
+    photo = upload(as_alice, out.getvalue(), title="A lattice of windows").json()
+    url = f"/api/v1/photos/{photo['code']}/complete"
+    rects = [{"label": "facade", "x0": 0, "y0": 0, "x1": 700, "y1": 520}]
+    rects += [{"label": label, **dict(zip(("x0", "y0", "x1", "y1"), box, strict=True))}
+              for label, box in (("window", GRID[7]), ("sill", sill_of(GRID[7])))]
+    body = {"width": 700, "height": 520, "rects": rects, "unit": [1, 2]}
+    r = as_alice.post(url, body, format="json")
+    assert r.status_code == 200, r.content
+    proposals = r.json()["proposals"]
+    copies = len(GRID) - 1 - len(CLOSED)
+    assert len(proposals) == 2 * copies and {p["copy"] for p in proposals} == set(range(copies))
+    assert all(p["reason"] == "copy of the unit" and 0.6 <= p["score"] <= 1 for p in proposals)
+    assert len(as_alice.post(url, {**body, "min_score": 1.0}, format="json").json()["proposals"]) == 0
+    for bad, message in (([], "non-empty"), ([0], "not the wall"), ([1, 5], "from 0 to 2"), ("1", "list"),
+                         ([1.5], "list")):
+        r = as_alice.post(url, {**body, "unit": bad}, format="json")
+        assert r.status_code == 400 and "unit" in r.json() and message in json.dumps(r.json()), (bad, r.content)
+    r = as_alice.post(url, {**body, "use_photo": False}, format="json")
+    assert r.status_code == 400 and "use_photo true" in json.dumps(r.json())
+
+
 def test_the_draft_is_kept_for_the_owner_replaced_and_dropped_by_a_save(facade_photo, as_alice, as_bob):
     photo, seg = facade_photo
     url = f"/api/v1/photos/{photo['code']}/draft"

@@ -133,6 +133,15 @@ def test_facaid_export_writes_every_site_download(procedure, as_alice, tmp_path,
             assert json.loads(out.read_text()) == json.loads(site.content)
         else:
             assert read(out.read_bytes(), size=size) == read(site.content, size=size), name
+    # the annotation formats hold one box per element, the wall under them; the same label map as the exact pieces
+    from facaid.labels import LABEL_ID
+    from facaid.segmentation import rasterize
+
+    boxes = read(as_alice.get(base + "segmentation.coco.json").content, size=size)
+    exact = read(as_alice.get(base + "segmentation.json").content, size=size)
+    assert len(boxes.rects) < len(exact.rects) and (rasterize(boxes) == rasterize(exact)).all()
+    assert sum(r.label == LABEL_ID["facade"] for r in boxes.rects) < sum(r.label == LABEL_ID["facade"]
+                                                                       for r in exact.rects)
     capsys.readouterr()
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from facaid import interchange
+from facaid.annotation import as_annotated
 from facaid.generator import generate
 from facaid.grammar import to_segmentation
 from facaid.segmentation import Segmentation
@@ -169,7 +170,7 @@ def test_a_procedures_rectangles_download_in_each_format(as_alice, alice):
         r = as_alice.get(f"/api/v1/procedures/{proc.code}/download/{name}")
         assert r.status_code == 200, name
         loaded = interchange.load(r.content)
-        assert loaded.segmentation == to_segmentation(sample.procedure)
+        assert loaded.segmentation == as_annotated(to_segmentation(sample.procedure))  # one box per element
         assert loaded.image == f"facaid-{str(proc.code)[:8]}-labels.png"
 
 

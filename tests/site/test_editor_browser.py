@@ -7,7 +7,7 @@ import json
 import shutil
 
 import pytest
-from editor_helpers import E, open_page
+from editor_helpers import E, import_file, open_page
 
 from webapp.facades.models import Segmentation
 
@@ -100,7 +100,7 @@ def test_editor_imports_a_coco_file_of_several_images(live_server, facade_photo,
     page, _ = open_page(live_server, browser, photo["code"], f"{E}?.seg?.size > 0")
     errors = page.errors
     n0 = page.evaluate(f"{E}.seg.size")
-    page.set_input_files("#import", str(path))
+    import_file(page, path)
     page.wait_for_function("document.querySelector('#status').textContent.startsWith('Imported')")
     assert page.text_content("#status") == "Imported 2 rectangles."
     assert page.evaluate(f"{E}.seg.toJSON()") == drawn.to_dict()
@@ -108,3 +108,46 @@ def test_editor_imports_a_coco_file_of_several_images(live_server, facade_photo,
     assert page.evaluate(f"{E}.seg.size") == n0
     assert page.get_attribute("a[href$='segmentation?format=coco']", "download") is not None
     assert errors == []
+
+
+def test_an_annotation_of_the_photo_as_taken_is_carried_through_the_rectification_and_merged_when_asked(
+        live_server, as_alice, browser, tmp_path):
+    """Issue 58: an annotation of the original photo (COCO here) is not refused for its size: the editor carries its
+    boxes through the rectification and says so; over drawn rectangles it asks to replace, add or cancel."""
+    from editor_helpers import windows_photo
+    from site_helpers import upload
+
+    from facaid import interchange
+    from facaid.segmentation import Rect
+    from facaid.segmentation import Segmentation as Drawn
+
+    photo = upload(as_alice, windows_photo(), title="Six windows").json()
+    corners = [[40, 30], [440, 30], [440, 330], [40, 330]]  # a facade box: the rectified image is 400 x 300
+    r = as_alice.post(f"/api/v1/photos/{photo['code']}/rectify", {"corners": corners}, format="json")
+    assert r.status_code == 200, r.content
+    taken = Drawn(480, 360, (Rect(2, 60, 60, 120, 150), Rect(2, 200, 60, 260, 150), Rect(2, 0, 0, 30, 20)))
+    path = tmp_path / "as-taken.coco.json"
+    path.write_bytes(interchange.write(taken, "coco", image="rue-12.jpg"))
+    page, _ = open_page(live_server, browser, photo["code"], f"{E}?.seg?.width === 400")
+    import_file(page, path)
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Imported')")
+    message = page.text_content("#status")
+    assert message.startswith("Imported 2 rectangles.") and "carried through the rectification" in message
+    assert "1 outside the facade left out" in message
+    boxes = sorted((r["x0"], r["y0"], r["x1"], r["y1"]) for r in page.evaluate(f"[...{E}.seg.rects.values()]"))
+    assert boxes == [(20, 30, 80, 120), (160, 30, 220, 120)]
+    # again, over what is drawn now: it asks; cancel changes nothing, add keeps both
+    import_file(page, path, "cancel")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Not imported')")
+    assert page.evaluate(f"{E}.seg.size") == 2
+    import_file(page, path, "merge")
+    page.wait_for_function(f"{E}.seg.size === 4")
+    assert "added to the 2 drawn" in page.text_content("#status")
+    page.keyboard.press("Control+z")  # one step
+    assert page.evaluate(f"{E}.seg.size") == 2
+    # a file of neither size is refused naming both
+    path.write_text(json.dumps({"width": 300, "height": 200, "rects": []}))
+    import_file(page, path)
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Not imported')")
+    assert "the photo is 400x300 (as taken, before rectifying, 480x360)" in page.text_content("#status")
+    assert page.errors == []

@@ -9,7 +9,7 @@ import shutil
 
 import numpy as np
 import pytest
-from editor_helpers import WIN_H, WIN_W, WINDOWS, E, rects, screen, view
+from editor_helpers import WIN_H, WIN_W, WINDOWS, E, import_file, rects, screen, view
 
 from facaid.defaults import DEFAULT_K
 
@@ -126,7 +126,7 @@ def test_completion_proposes_the_missing_window_accepted_undone_and_rejected(edi
         {"label": "window", "x0": x, "y0": y, "x1": x + WIN_W, "y1": y + WIN_H} for x, y in WINDOWS[:5]]
     path = tmp_path / "drawn.json"
     path.write_text(json.dumps({"width": 480, "height": 360, "rects": drawn}))
-    page.set_input_files("#import", str(path))
+    import_file(page, path)
     page.wait_for_function(f"{E}.seg.size === 6")
     page.keyboard.press("c")
     page.wait_for_function(f"{E}.ui.proposals.length === 1")
@@ -213,7 +213,7 @@ def test_two_identical_rectangles_are_flagged_until_one_is_deleted(editor, tmp_p
     wall = {"label": "facade", "x0": 0, "y0": 0, "x1": 480, "y1": 360}
     path = tmp_path / "twice.json"
     path.write_text(json.dumps({"width": 480, "height": 360, "rects": [wall, wall]}))
-    page.set_input_files("#import", str(path))
+    import_file(page, path)
     page.wait_for_function(f"{E}.seg.size === 2")
     assert "2 identical facade rectangles (delete the copies)" in page.text_content("#count")
     assert page.eval_on_selector("#count", "e => e.classList.contains('warning')")
@@ -223,3 +223,38 @@ def test_two_identical_rectangles_are_flagged_until_one_is_deleted(editor, tmp_p
     assert page.evaluate(f"{E}.seg.size") == 1
     assert "identical" not in page.text_content("#count")
     assert not page.eval_on_selector("#count", "e => e.classList.contains('warning')")
+
+
+def test_a_drag_beside_the_window_just_drawn_draws_a_second_one_at_fit_zoom_and_below(editor):
+    """Issue 58: windows in pairs 8 px apart. The second drag starts 9 image px right of the first window's corner,
+    within its handle's reach when zoomed out: with the draw tool it draws a second window, it does not resize the
+    first into a sliver."""
+    page = editor
+    x, y = screen(page, 240, 180)
+    page.mouse.move(x, y)
+    for _ in range(8):  # zoomed out: the image smaller than its pixels
+        if view(page)["s"] < 0.5:  # 6 screen px of a handle's reach are 12 image px: past the 9 px beside it
+            break
+        page.mouse.wheel(0, 300)
+        page.wait_for_timeout(50)
+    assert view(page)["s"] < 0.5
+    page.keyboard.press("r")  # the draw tool
+    page.keyboard.down("Alt")  # no snapping: the boxes as dragged
+    for start, end in (((60, 20), (86, 86)), ((95, 21), (121, 88))):
+        page.mouse.move(*screen(page, *start))
+        page.mouse.down()
+        page.mouse.move(*screen(page, *end), steps=6)
+        page.mouse.up()
+    page.keyboard.up("Alt")
+    drawn = [(r["x0"], r["y0"], r["x1"], r["y1"]) for r in rects(page)][2:]
+    assert len(drawn) == 2, drawn
+    for got, want in zip(drawn, [(60, 20, 86, 86), (95, 21, 121, 88)], strict=True):
+        assert max(abs(a - b) for a, b in zip(got, want, strict=True)) <= 2, (got, want)
+    # on the window itself, near its corner, the same tool resizes it
+    page.keyboard.down("Alt")
+    page.mouse.move(*screen(page, 120, 87))
+    page.mouse.down()
+    page.mouse.move(*screen(page, 130, 95), steps=4)
+    page.mouse.up()
+    page.keyboard.up("Alt")
+    assert len(rects(page)) == 4 and abs(rects(page)[3]["x1"] - 130) <= 2

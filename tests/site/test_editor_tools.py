@@ -8,7 +8,7 @@ import os
 import shutil
 
 import pytest
-from editor_helpers import WINDOWS, E, drag, open_page, rects, screen, selected
+from editor_helpers import WINDOWS, E, drag, import_file, open_page, rects, screen, selected
 from site_helpers import login
 
 from webapp.facades.models import Segmentation
@@ -343,7 +343,7 @@ def test_repeat_to_the_edge_from_two_examples_and_split_into_columns_each_one_un
         {"label": "facade", "x0": 20, "y0": 0, "x1": 460, "y1": 360},
         {"label": "window", "x0": 200, "y0": 60, "x1": 260, "y1": 150},
         {"label": "window", "x0": 340, "y0": 60, "x1": 400, "y1": 150}]}))
-    page.set_input_files("#import", str(path))
+    import_file(page, path)
     page.wait_for_function(f"{E}.seg.size === 3")
     steps = page.evaluate(f"{E}.history.done.length")
     select_window(page, 200, 60)

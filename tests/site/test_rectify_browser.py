@@ -66,3 +66,25 @@ def test_propose_corners_moves_the_handles_onto_the_facade(live_server, as_alice
     page.wait_for_function(f"{E}.rectifying")
     assert page.input_value("#real-side") == "height" and page.input_value("#real-metres") == "14.5"
     assert errors == []
+
+
+def test_at_1280x800_the_rectification_step_keeps_its_size_field_and_apply_in_view(live_server, as_alice, browser,
+                                                                                      tmp_path):
+    """Issue 58: the real-size field and Apply sat below the fold at 1280 x 800; they stay in view, on top."""
+    from site_helpers import screenshot
+
+    data, _ = photo_like()
+    photo = upload(as_alice, data, title="Street").json()
+    page, _ = open_page(live_server, browser, photo["code"], f"{E}?.seg !== null && {E}?.seg !== undefined",
+                        viewport=(1280, 800))
+    page.click("#rectify")
+    page.wait_for_function(f"{E}.rectifying")
+    for selector in ("#real-metres", "#rectify-apply", "#rectify-cancel", "#rectify-preview"):
+        box = page.locator(selector).bounding_box()
+        assert box and box["y"] >= 0 and box["y"] + box["height"] <= 800 and box["x"] + box["width"] <= 1280, selector
+        if selector != "#rectify-preview":  # the topmost there: not covered by anything
+            on_top = page.evaluate(f"document.elementFromPoint({box['x'] + box['width'] / 2}, "
+                                   f"{box['y'] + box['height'] / 2})?.closest('{selector}') !== null")
+            assert on_top, selector
+    screenshot(page, "rectify-1280x800.png", tmp_path)
+    assert page.errors == []

@@ -13,6 +13,7 @@ from PIL import Image
 from rest_framework.exceptions import ValidationError
 
 from facaid import interchange
+from facaid.annotation import as_annotated
 from facaid.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
 from facaid.cityjson import cityjson_text, procedure_cityjson
 from facaid.gltf import procedure_gltf
@@ -159,8 +160,10 @@ def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
 
 
 def _annotations(fmt: str) -> Callable[[Procedure, Tree, Params], bytes]:
-    """The rectangles it draws as another tool's annotations, of the label map downloaded beside them."""
-    return lambda proc, tree, params: interchange.write(to_segmentation(tree), fmt, image=f"{stem(proc)}-labels.png")
+    """The elements it draws as another tool's annotations, one box each (`facaid.annotation.as_annotated`), of the
+    label map downloaded beside them."""
+    return lambda proc, tree, params: interchange.write(as_annotated(to_segmentation(tree)), fmt,
+                                                        image=f"{stem(proc)}-labels.png")
 
 
 DOWNLOADS: dict[str, Download] = {
@@ -169,11 +172,12 @@ DOWNLOADS: dict[str, Download] = {
                                "gives them", "application/json", _procedure_json),
     "segmentation.json": Download("the labelled rectangles it draws", "application/json",
                                   lambda proc, tree, params: to_segmentation(tree).to_json()),
-    "segmentation.coco.json": Download("those rectangles as COCO object detection annotations", "application/json",
+    "segmentation.coco.json": Download("its elements as COCO object detection annotations, one box each (pieces of "
+                                       "one element merged, the wall under them)", "application/json",
                                        _annotations("coco")),
-    "segmentation.labelme.json": Download("those rectangles as a LabelMe file", "application/json",
+    "segmentation.labelme.json": Download("the same boxes as a LabelMe file", "application/json",
                                           _annotations("labelme")),
-    "segmentation.cvat.xml": Download("those rectangles as CVAT for images XML", "application/xml",
+    "segmentation.cvat.xml": Download("the same boxes as CVAT for images XML", "application/xml",
                                       _annotations("cvat")),
     "labels.png": Download("the label map as a picture", "image/png", None),
     "labels.svg": Download("the label map as vector rectangles, one group per class", "image/svg+xml",

@@ -17,7 +17,8 @@ from rest_framework.exceptions import APIException, ValidationError
 
 from facaid import appearance, interchange
 from facaid.completion import RejectedError, complete
-from facaid.defaults import DEFAULT_K, DEFAULT_MIN_SCORE
+from facaid.copies import UnitError, find_copies
+from facaid.defaults import DEFAULT_K, DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE
 from facaid.rectify import propose_corners_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
@@ -145,10 +146,13 @@ def segmentation_file(photo: Photo, format: str, version: str | None = None) -> 
 def complete_segmentation(photo: Photo, data) -> list[dict]:
     """Proposals for what is not drawn yet (`facaid.complete`) in a segmentation of the photo: the body is the
     segmentation JSON, optionally with ``rejected`` (rectangles not to propose again), ``min_score`` and
-    ``use_photo`` (default true: the photo the segmentation is drawn on confirms or rejects each proposal)."""
+    ``use_photo`` (default true: the photo the segmentation is drawn on confirms or rejects each proposal). With
+    ``unit`` (indices of its rectangles: a window and what is drawn around it), the copies of that unit the photo
+    shows instead (`facaid.copies.find_copies`)."""
     seg = _segmentation_of(photo, data, "segmentation").segmentation
     rejected = data.get("rejected") or []
-    min_score = data.get("min_score", DEFAULT_MIN_SCORE)
+    unit = data.get("unit")
+    min_score = data.get("min_score", DEFAULT_MIN_SCORE if unit is None else DEFAULT_MIN_COPY)
     use_photo = data.get("use_photo", True)
     if not isinstance(rejected, list):
         raise ValidationError({"rejected": "give a list of rectangles"})
@@ -156,14 +160,20 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
         raise ValidationError({"min_score": f"give a number in [0, 1], got {min_score!r}"})
     if not isinstance(use_photo, bool):
         raise ValidationError({"use_photo": f"give true or false, got {use_photo!r}"})
+    if unit is not None and not use_photo:
+        raise ValidationError({"unit": "the copies of a unit are found in the photo: leave use_photo true"})
     levels = None
     if use_photo:
         with _readable(photo.working_image()) as f:  # grey levels at a bounded scale, the file let go
             levels = appearance.levels(f, seg.width, seg.height)
     try:
+        if unit is not None:
+            return find_copies(seg, levels, unit, rejected=rejected, min_score=float(min_score))
         return complete(seg, levels, rejected=rejected, min_score=float(min_score))
     except RejectedError as exc:
         raise ValidationError({"rejected": str(exc)}) from None
+    except UnitError as exc:
+        raise ValidationError({"unit": str(exc)}) from None
     except ValueError as exc:  # too many rectangles
         raise ValidationError({"segmentation": str(exc)}) from None
 
