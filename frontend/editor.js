@@ -44,6 +44,7 @@ async function load() {
   buildPalette($("#palette"), pickLabel);
   pickLabel(ui.label);
   changed();
+  if (location.hash === "#rectify") await openRectify();  // the photo page's "Rectify it in the editor"
 }
 
 function changed() {

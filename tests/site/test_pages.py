@@ -155,3 +155,23 @@ def test_jobs_are_named_by_their_photo(alice, bob):
     for page in (visitor.get("/").content.decode(), visitor.get(f"/jobs/{other.code}").content.decode()):
         assert "a photo not shared with you" in page
         assert "Rivoli" not in page and str(named.code) not in page
+
+
+def test_cards_say_pixel_accuracy_and_the_photo_page_links_to_the_rectification(alice, bob):
+    """Issue 58: "0.997 acc." said nothing to a newcomer; the photo page pointed at a control it does not have."""
+    from facaid.generator import generate
+
+    data, _ = facade_png()
+    photo = Photo.objects.create(owner=alice, title="Mine", visibility="public",
+                                 image=SimpleUploadedFile("f.png", data))
+    Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="public", accuracy=0.99712)
+    home = Client().get("/").content.decode()
+    assert "pixel accuracy 99.7 %" in home and " acc." not in home
+    assert 'title="The share of the photo\'s pixels' in home
+    owner = Client()
+    owner.force_login(alice)
+    page = owner.get(f"/photos/{photo.code}").content.decode()
+    assert f'href="/photos/{photo.code}/edit#rectify">Rectify it in the editor</a>' in page
+    visitor = Client()
+    visitor.force_login(bob)
+    assert "Rectify it in the editor" not in visitor.get(f"/photos/{photo.code}").content.decode()

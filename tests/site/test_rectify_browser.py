@@ -87,4 +87,8 @@ def test_at_1280x800_the_rectification_step_keeps_its_size_field_and_apply_in_vi
                                    f"{box['y'] + box['height'] / 2})?.closest('{selector}') !== null")
             assert on_top, selector
     screenshot(page, "rectify-1280x800.png", tmp_path)
+    # the photo page's link opens the editor on this step
+    page.goto(f"{live_server.url}/photos/{photo['code']}")
+    page.click("text=Rectify it in the editor")
+    page.wait_for_function(f"{E}?.rectifying && !document.querySelector('#rectify-panel').hidden")
     assert page.errors == []

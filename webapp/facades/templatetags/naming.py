@@ -16,3 +16,11 @@ def photo_name(context, photo) -> str:
     if not access.photo_visible_to(context["user"], photo):
         return "a photo not shared with you"
     return photo.title or f"untitled photo {str(photo.code)[:8]}"
+
+
+@register.filter
+def percent(share) -> str:
+    """A share in [0, 1] as a percentage with one decimal ("99.7 %"), or "" when there is none."""
+    if share is None:
+        return ""
+    return f"{100 * float(share):.1f} %"
