@@ -79,3 +79,9 @@ def as_annotated(seg: Segmentation) -> Segmentation:
     walls = [r for r in drawn.rects if r.label == LABEL_ID["facade"]]
     elements = merge_pieces([r for r in drawn.rects if r.label != LABEL_ID["facade"]])
     return Segmentation(seg.width, seg.height, (*walls, *elements))
+
+
+def written_as(seg: Segmentation, fmt: str) -> Segmentation:
+    """A procedure's rectangles as a file of ``fmt`` holds them: an annotation tool's (COCO, LabelMe, CVAT) one box
+    per element (`as_annotated`), our own contract (``"segmentation"``) the exact pieces."""
+    return seg if fmt == "segmentation" else as_annotated(seg)

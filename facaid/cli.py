@@ -433,11 +433,9 @@ def cmd_convert(args: argparse.Namespace) -> None:
         obj = _json_object(data)
         if not (isinstance(obj, dict) and ("procedure" in obj or obj.get("format") is not None)):
             raise
-        seg, source, name, warnings = load_segmentation_or_procedure(obj), "procedure", None, ()
-        if fmt != "segmentation":  # an annotation tool's file: one box per element, the wall under them
-            from facaid.annotation import as_annotated
+        from facaid.annotation import written_as
 
-            seg = as_annotated(seg)
+        seg, source, name, warnings = written_as(load_segmentation_or_procedure(obj), fmt), "procedure", None, ()
     for line in warnings:
         print(f"warning: {line}", file=sys.stderr)
     out = Path(args.out)

@@ -18,7 +18,7 @@ import numpy as np
 from facaid import appearance, repeats
 from facaid.completion import proposals_for
 from facaid.defaults import DEFAULT_MIN_COPY
-from facaid.labels import LABELS
+from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.segmentation import Segmentation
 
 
@@ -45,11 +45,12 @@ def find_copies(segmentation: Segmentation | dict, photo: Any, unit: list[int], 
         raise UnitError(f"unit must list distinct rectangle indices from 0 to {n - 1}, got {unit}")
     rows = seg.to_array()
     mine = rows[unit]
-    if (np.isin(mine[:, 0], [LABELS.index("facade"), LABELS.index("background")])).any():
+    if np.isin(mine[:, 0], (FACADE, BACKGROUND)).any():
         raise UnitError("a unit is elements (a window and what is drawn around it), not the wall or background")
     levels = appearance.levels(photo, seg.width, seg.height)
     out: list[dict] = []
-    for score, parts in sorted(repeats.unit_copies(levels, props.drawn, mine), key=lambda f: -f[0]):
+    others = np.delete(rows, unit, axis=0)  # the unit votes once, the other drawn elements beside it
+    for score, parts in sorted(repeats.unit_copies(levels, others, mine), key=lambda f: -f[0]):
         if score < min_score:
             break
         copy = len({p["copy"] for p in out})

@@ -47,16 +47,12 @@ def _png(proc, path, scale, photo):
 
 def _segmentation(fmt: str):
     def write(proc, path, scale, photo):
+        from facaid.annotation import written_as
         from facaid.grammar.execute import to_segmentation
         from facaid.interchange import write as write_annotations
 
         picture = path.name[: -len(export_for(path)[0])] + ".png"  # the label map `--out NAME.png` writes beside it
-        seg = to_segmentation(proc)
-        if fmt != "segmentation":  # an annotation tool's file: one box per element, the wall under them
-            from facaid.annotation import as_annotated
-
-            seg = as_annotated(seg)
-        return _text(path, write_annotations(seg, fmt, image=picture))
+        return _text(path, write_annotations(written_as(to_segmentation(proc), fmt), fmt, image=picture))
     return write
 
 

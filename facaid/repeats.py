@@ -212,11 +212,11 @@ Copy = tuple[float, list[tuple[int, np.ndarray]]]  # (NCC, [(label, box)]): one 
 
 
 def unit_copies(levels: Levels, drawn: np.ndarray, unit: np.ndarray) -> list[Copy]:
-    """The copies of a unit (``unit``: (m, 5) rows, a window with what is drawn around it, say) along the photo's
-    repeats, as (NCC of its largest element there, [(label, box)] of every element of the unit carried): each
-    shift that the drawn elements and the unit vote for (one vote is enough: a person asked for this unit), where
-    the unit's largest element looks like itself (`MATCH`). Its other elements go with it, each to where it looks
-    most like itself nearby."""
+    """The copies of a unit (``unit``: (m, 5) rows, a window with what is drawn around it, say; ``drawn``: the other
+    drawn elements) along the photo's repeats, as (NCC of its largest element there, [(label, box)] of every
+    element of the unit carried): each shift that the drawn elements and the unit vote for (one vote is enough: a
+    person asked for this unit), where the unit's largest element looks like itself (`MATCH`). Its other elements
+    go with it, each to where it looks most like itself nearby."""
     unit = np.asarray(unit, dtype=float).reshape(-1, 5)
     if not len(unit):
         return []

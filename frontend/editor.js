@@ -130,6 +130,8 @@ function fit() {
 }
 
 const toImage = (sx, sy) => [(sx - view.ox) / view.scale, (sy - view.oy) / view.scale];
+const toScreen = (x, y) => [x * view.scale + view.ox, y * view.scale + view.oy];
+const chipUnder = (e) => chipAt(chips(ui.proposals, toScreen), e.offsetX, e.offsetY);
 
 function draw() {
   if (rectifying) return rectifying.draw();
@@ -179,8 +181,9 @@ canvas.addEventListener("pointerdown", (e) => {
     return draw();
   }
   const pan = ui.space || e.button === 1;
-  // a press on a proposal is the start of a click that rejects it (below): it selects and moves nothing under it
-  if (!pan && proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY))) return;
+  // a press on a proposal or a row's chip is the start of a click that rejects it (below): it selects and moves
+  // nothing under it
+  if (!pan && (chipUnder(e) || proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY)))) return;
   const {gesture, selection} = press(ui.tool, pointerOf(e), toolContext(), view, {pan});
   ui.drag = gesture;
   ui.selection = selection;
@@ -237,8 +240,6 @@ canvas.addEventListener("wheel", (e) => {
 
 // proposals: a click rejects (or takes back) one, with the rest of its copy, before any tool sees the press;
 // Shift+click accepts it alone; a row's or column's chip does the same for all of the row or column
-const chipUnder = (e) => chipAt(chips(ui.proposals, (x, y) => [x * view.scale + view.ox, y * view.scale + view.oy]),
-  e.offsetX, e.offsetY);
 canvas.addEventListener("click", (e) => {
   if (ui.drag) return;
   const chip = chipUnder(e);
@@ -368,7 +369,7 @@ async function findCopies() {
 // completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
 async function completeNow() {
   const drawn = seg.toJSON();
-  await propose({...drawn, rejected: ui.rejected}, drawn, "complete", (n) => n ? `${n} proposals: click one to ` +
+  await propose({...drawn}, drawn, "complete", (n) => n ? `${n} proposals: click one to ` +
     'reject it, Shift+click to add it alone, Enter or "Accept" to add the rest.'
     : "Nothing to propose yet: draw a few elements of a row and a column.");
 }

@@ -69,6 +69,7 @@ def test_find_copies_proposes_the_unit_and_one_click_takes_a_row_or_a_column(lat
     row = [p for p in proposals(page) if p["y0"] < 130]
     assert len(row) == 12 and all(p.get("accepted") is False for p in row)
     assert "Rejected a row of 12 proposals" in page.text_content("#status")
+    assert page.evaluate(f"{E}.ui.selection.size") == 2  # the press on the chip selected nothing under it
     # Shift and the last column's chip, above its first window: the column's copies added, alone
     lx0, ly0, lx1, _ = GRID[5]
     before = len(rects(page))

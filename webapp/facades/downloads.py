@@ -13,7 +13,7 @@ from PIL import Image
 from rest_framework.exceptions import ValidationError
 
 from facaid import interchange
-from facaid.annotation import as_annotated
+from facaid.annotation import written_as
 from facaid.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
 from facaid.cityjson import cityjson_text, procedure_cityjson
 from facaid.gltf import procedure_gltf
@@ -160,9 +160,9 @@ def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
 
 
 def _annotations(fmt: str) -> Callable[[Procedure, Tree, Params], bytes]:
-    """The elements it draws as another tool's annotations, one box each (`facaid.annotation.as_annotated`), of the
+    """The elements it draws as another tool's annotations, one box each (`facaid.annotation.written_as`), of the
     label map downloaded beside them."""
-    return lambda proc, tree, params: interchange.write(as_annotated(to_segmentation(tree)), fmt,
+    return lambda proc, tree, params: interchange.write(written_as(to_segmentation(tree), fmt), fmt,
                                                         image=f"{stem(proc)}-labels.png")
 
 
