@@ -444,6 +444,30 @@ def cmd_convert(args: argparse.Namespace) -> None:
     print(f"wrote {out} ({fmt}, {seg.width}x{seg.height}, {len(seg.rects)} rectangles, read as {source})")
 
 
+def cmd_validate_cityjson(args: argparse.Namespace) -> None:
+    from facaid.cityjson_check import SCHEMAS, check_cityjson
+
+    invalid = 0
+    for path in args.files:
+        try:
+            report = check_cityjson(Path(path).read_bytes())
+        except OSError as exc:
+            raise CliError(f"cannot read {path}: {exc.strerror}") from None
+        if report.valid:
+            schema = SCHEMAS[report.version].split(".min")[0]
+            print(f"{path}: valid CityJSON {report.version} (schema {schema}, vertices, semantics, "
+                  f"parents and children): {report.summary()}")
+        else:
+            invalid += 1
+            print(f"{path}: not valid")
+        for line in report.errors:
+            print(f"  error: {line}")
+        for line in report.warnings:
+            print(f"  warning: {line}")
+    if invalid:
+        raise CliError(f"{invalid} of {len(args.files)} files are not valid CityJSON")
+
+
 def _json_object(data: bytes) -> Any:
     try:
         return json.loads(data)
@@ -698,6 +722,13 @@ def build_parser() -> argparse.ArgumentParser:
                     help="the image to read from a COCO or CVAT file of several (its file name, with or without "
                          "folders, or its id); also names the image in the output where the input does not")
     cv.set_defaults(func=cmd_convert)
+
+    vc = sub.add_parser("validate-cityjson", help="check CityJSON files as the official validator (cjval) does",
+                        description="Check CityJSON 2.0 and 1.0 files: the JSON, the official schema of their "
+                                    "version (shipped), vertex indices, semantics arrays, parents and children; "
+                                    "warn of duplicate and unused vertices. Exit status 2 when a file is not valid.")
+    vc.add_argument("files", nargs="+", metavar="FILE", help="a .city.json file")
+    vc.set_defaults(func=cmd_validate_cityjson)
 
     r2 = sub.add_parser("evaluate-real", help="reconstruct the CMP facades and compare (evaluation only)",
                         description="Reconstruct every facade of an annotations.jsonl (CMP format) and report mean "

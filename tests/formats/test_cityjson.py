@@ -1,31 +1,25 @@
-"""The CityJSON export: the 1.0 form valid against the official CityJSON schema (the 1.0.1 schema files cjio
-0.6.10 ships, checked by jsonschema-rs), the 2.0 form the same model and read by cityjson-lib, one Window semantic
-surface per window and one Door per door where the procedure draws them, every ring facing out."""
+"""The CityJSON export: both forms pass `facaid validate-cityjson` (the official schemas, CityJSON 2.0.2 and 1.0.3,
+checked by jsonschema-rs, and cjval's checks), which bites on broken files; cjio reads the export and cityjson-lib
+parses the 2.0 form; one Window semantic surface per window and one Door per door where the procedure draws them,
+every ring facing out."""
 
 import json
-from importlib.resources import files
+import subprocess
+import sys
+from pathlib import Path
 
 import cityjson_lib
-import jsonschema_rs
 import numpy as np
 import pytest
 from format_helpers import window_grid
 
 from facaid.cityjson import cityjson_text, procedure_cityjson
+from facaid.cityjson_check import check_cityjson
+from facaid.cli import main
 from facaid.generator import generate
 from facaid.relief import DEPTHS, MeshTooLarge, procedure_relief
 
 SCALE = 0.02
-SCHEMAS = files("cjio") / "schemas" / "1.0.1"
-
-
-@pytest.fixture(scope="module")
-def validator():
-    # jsonschema-rs, not jsonschema: the schema's oneOf over every kind of city object takes the pure-Python
-    # validator 13 s a facade here, this 3 ms; a schema without an $id refers to its neighbours as json-schema:///NAME
-    schemas = {p.name: json.loads(p.read_text()) for p in SCHEMAS.iterdir() if p.name.endswith(".schema.json")}
-    registry = jsonschema_rs.Registry([(f"json-schema:///{name}", schema) for name, schema in schemas.items()])
-    return jsonschema_rs.validator_for(schemas["cityjson.schema.json"], registry=registry)
 
 
 @pytest.fixture(scope="module")
@@ -44,14 +38,76 @@ def surfaces(doc: dict) -> list[tuple[dict, np.ndarray]]:
             for surface, value in zip(geometry["boundaries"], semantics["values"], strict=True)]
 
 
-def test_the_1_0_form_is_valid_against_the_official_schema(proc, validator):
-    doc = json.loads(cityjson_text(procedure_cityjson(proc, SCALE, version="1.0")))
-    assert list(validator.iter_errors(doc)) == []
-    broken = json.loads(json.dumps(doc))  # the schema bites: an unknown semantic type, a building without a type
-    broken["CityObjects"]["facade"]["geometry"][0]["semantics"]["surfaces"][0]["type"] = "Windoh"
-    assert not validator.is_valid(broken)
-    del doc["CityObjects"]["facade"]["type"]
-    assert not validator.is_valid(doc)
+@pytest.mark.parametrize("version", ["2.0", "1.0"])
+def test_both_forms_are_valid_against_the_official_schema_and_cjvals_checks(proc, version):
+    doc = procedure_cityjson(proc, SCALE, version=version)
+    report = check_cityjson(cityjson_text(doc))
+    assert (report.valid, report.version, report.errors, report.warnings) == (True, version, [], [])
+    assert report.counts == {"city objects": 1, "vertices": len(doc["vertices"]),
+                             "surfaces": len(doc["CityObjects"]["facade"]["geometry"][0]["boundaries"])}
+
+
+def _broken(doc: dict, how) -> str:
+    copy = json.loads(json.dumps(doc))
+    how(copy)
+    return json.dumps(copy)
+
+
+def test_the_validator_bites(proc):
+    doc = procedure_cityjson(proc, SCALE)
+    geometry = lambda d: d["CityObjects"]["facade"]["geometry"][0]  # noqa: E731
+
+    def errors(how) -> list[str]:
+        return check_cityjson(_broken(doc, how)).errors
+
+    assert errors(lambda d: geometry(d)["semantics"]["surfaces"][0].update(type="Windoh")) == [
+        "schema cityjson-2.0.2: CityObjects/facade/geometry/0/semantics/surfaces/0/type: 'Windoh' is not a type "
+        "CityJSON 2.0 allows here"]
+    assert errors(lambda d: d["CityObjects"]["facade"].update(type="Buildin")) == [
+        "schema cityjson-2.0.2: CityObjects/facade/type: 'Buildin' is not a type CityJSON 2.0 allows here"]
+    assert errors(lambda d: d["CityObjects"]["facade"].pop("type")) == [
+        'schema cityjson-2.0.2: CityObjects/facade: "type" is a required property']
+    assert errors(lambda d: geometry(d).update(lod=3)) == [  # 2.0 writes the LoD as a string
+        'schema cityjson-2.0.2: CityObjects/facade/geometry/0/lod: 3 is not one of "0", "1" or 18 other candidates']
+    out = errors(lambda d: geometry(d)["boundaries"][0][0].__setitem__(2, len(d["vertices"]) + 5))
+    assert out == [f"wrong vertex index: 'facade' geometry 0: 1 indices out of 0..{len(doc['vertices']) - 1}, "
+                   f"the first {len(doc['vertices']) + 5}"]
+    out = errors(lambda d: geometry(d)["semantics"]["values"].pop())
+    n = len(geometry(doc)["boundaries"])
+    assert out == [f"semantics arrays: 'facade' geometry 0: its values are shaped {n - 1}, its surfaces {n}"]
+    out = errors(lambda d: geometry(d)["semantics"]["values"].__setitem__(0, 10_000))
+    assert out[0].startswith("semantics arrays: 'facade' geometry 0: values name surface 10000, of ")
+    out = errors(lambda d: d["CityObjects"].update(part={"type": "BuildingPart", "parents": ["facade"]}))
+    assert out == ["parents and children: 'part' names parent 'facade', which does not name it as a child"]
+    report = check_cityjson(_broken(doc, lambda d: d["vertices"].extend([d["vertices"][0], [1, 2, 3]])))
+    assert report.valid and report.warnings == ["duplicate vertices: 1", "unused vertices: 2"]
+    assert check_cityjson("{").errors[0].startswith("json syntax: ")
+    assert check_cityjson("[1]").errors == ["not a CityJSON file: it is a JSON list, not 'CityJSON'"]
+    assert "version 1.1: this validator knows 2.0 and 1.0" in errors(lambda d: d.update(version="1.1"))[0]
+    many = errors(lambda d: [s.update(type="Windoh") for s in geometry(d)["semantics"]["surfaces"]])
+    assert len(many) == 21 and many[-1].endswith("more")  # 20 named, then a count
+
+
+def test_a_person_validates_and_reads_an_export(tmp_path, capsys):
+    procedure = tmp_path / "p.json"
+    procedure.write_text(json.dumps(generate(3).procedure.to_dict()))
+    out = tmp_path / "facade.city.json"
+    assert main(["export", str(procedure), "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["validate-cityjson", str(out)]) == 0
+    line = capsys.readouterr().out
+    assert line.startswith(f"{out}: valid CityJSON 2.0 (schema cityjson-2.0.2, vertices, semantics, parents and "
+                           "children): 1 city object, ") and "warning" not in line
+    broken = tmp_path / "broken.city.json"
+    broken.write_text(out.read_text().replace('"Door"', '"Dor"'))
+    assert main(["validate-cityjson", str(out), str(broken)]) == 2
+    said = capsys.readouterr()
+    assert f"{broken}: not valid\n  error: schema cityjson-2.0.2: " in said.out and "Dor" in said.out
+    assert "error: 1 of 2 files are not valid CityJSON" in said.err
+    cjio = Path(sys.executable).parent / "cjio"  # the CityJSON project's own tool reads it
+    info = subprocess.run([str(cjio), str(out), "info"], capture_output=True, text=True, timeout=120)
+    assert info.returncode == 0, info.stderr
+    assert "CityJSON version = 2.0" in info.stdout and "Building (1)" in info.stdout
 
 
 def test_the_2_0_form_is_the_same_model_and_cityjson_lib_reads_it(proc):

@@ -1,5 +1,5 @@
 """The 3D downloads of a procedure (glTF, glTF with the photo, IFC, CityJSON): served with their content types,
-read back by their formats' readers, at the scale asked for, and a bad parameter or a procedure too large a 400
+read back by their formats' readers (the CityJSON valid by `facaid validate-cityjson`), at the scale asked for, and a bad parameter or a procedure too large a 400
 (alice owns, charlie is anonymous)."""
 
 import io
@@ -10,6 +10,7 @@ import pytest
 import trimesh
 from format_helpers import window_grid
 
+from facaid.cityjson_check import check_cityjson
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import LABEL_ID
@@ -56,6 +57,8 @@ def test_each_3d_download_reads_back_at_the_scale_asked(procedure, as_alice, tmp
     model = ifcopenshell.open(str(path))
     assert sum(w.PredefinedType == "WINDOW" for w in model.by_type("IfcWindow")) == windows
     assert "0.02 m per pixel (given)" in model.by_type("IfcProject")[0].Description
+    report = check_cityjson(got["facade.city.json"])
+    assert (report.valid, report.version, report.warnings) == (True, "2.0", [])
     city = json.loads(got["facade.city.json"])
     building = city["CityObjects"]["facade"]
     assert building["attributes"]["facaid_metres_per_pixel"] == 0.02
