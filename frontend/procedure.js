@@ -453,3 +453,23 @@ versions.refresh().then(() => {
   const warned = document.querySelector("#rerun-warning [data-compare]");
   if (warned) versions.compare(...warned.dataset.compare.split(",").map(Number));
 });
+
+// Sharing the procedure asks whether to share its photo too (the question shows while the choice is not private),
+// and says what viewers will see once saved, for the choice made (sharing.previews).
+const shareVisibility = document.querySelector("#visibility-form select[name=visibility]");
+if (shareVisibility) {
+  const sharePhoto = document.getElementById("share-photo");
+  const willSee = document.getElementById("viewers-will-see");
+  const previews = JSON.parse(document.getElementById("sharing-previews").textContent);
+  const ask = () => {
+    if (sharePhoto) sharePhoto.hidden = shareVisibility.value === "private";
+    const photo = sharePhoto && !sharePhoto.hidden && sharePhoto.querySelector("input").checked;
+    const changed = shareVisibility.value !== shareVisibility.dataset.saved || photo;
+    willSee.hidden = !changed;
+    willSee.textContent = changed ? `Once saved: ${previews[shareVisibility.value + (photo ? "+photo" : "")]}` : "";
+  };
+  shareVisibility.dataset.saved = shareVisibility.value;
+  shareVisibility.addEventListener("change", ask);
+  if (sharePhoto) sharePhoto.querySelector("input").addEventListener("change", ask);
+  ask();
+}

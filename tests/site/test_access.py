@@ -77,7 +77,7 @@ def test_fork_makes_a_private_copy_with_lineage(objects, as_alice, as_bob):
     assert r.status_code == 201
     fork = r.json()
     assert fork["owner"] == "bob" and fork["parent"] == str(proc.code) and fork["visibility"] == "private"
-    assert fork["photo"] is None  # alice's photo is not bob's
+    assert fork["photo"] is None  # alice's photo is private: linked, but not shown to bob
     assert fork["data"] == proc.data
     r2 = as_bob.post(f"/api/v1/procedures/{fork['code']}/fork").json()
     page = as_bob.get(f"/procedures/{r2['code']}").content.decode()
@@ -128,37 +128,111 @@ def test_a_fork_keeps_the_overlay_and_rerun_while_the_photo_is_visible_to_the_fo
     photo.save()
     page = as_bob.get(f"/procedures/{fork.code}").content.decode()
     assert str(photo.code) not in page and str(seg.code) not in page and "Re-run inference" not in page
-    assert "No photo to overlay" in page and "overlay.png" not in page
+    assert "once its owner shares it" in page and "overlay.png" not in page
     r = as_bob.get(f"/api/v1/procedures/{fork.code}/").json()
     assert (r["photo"], r["segmentation"]) == (None, None)
     assert as_bob.get(f"/api/v1/procedures/{fork.code}/download/overlay.png").status_code == 400
     before = Job.objects.count()
     r = as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2}, format="json")
-    assert r.status_code == 400 and "no longer shared with you" in r.json()["procedure"]
+    assert r.status_code == 400 and "is not shared with you" in r.json()["procedure"]
     r = as_bob.post(f"/procedures/{fork.code}/rerun", {"nodes": 2}, follow=True)
-    assert "no longer shared with you" in r.content.decode() and Job.objects.count() == before
+    assert "is not shared with you" in r.content.decode() and Job.objects.count() == before
 
 
-def test_a_fork_of_a_procedure_whose_photo_the_forker_may_not_see_names_neither(objects, as_alice, as_bob):
+def test_a_fork_of_a_procedure_whose_photo_is_private_shows_it_once_shared(objects, as_alice, as_bob, as_charlie):
     photo, seg, proc, job = objects  # alice's photo stays private; her procedure made from it is public
     proc.visibility = "public"
     proc.save()
     fork = fork_as_bob(as_bob, proc)
-    assert (fork.photo_id, fork.segmentation_id) == (None, None)  # not only hidden: not linked at all
-    r = as_bob.get(f"/api/v1/procedures/{fork.code}/").json()
-    assert (r["photo"], r["segmentation"]) == (None, None)
+    assert (fork.photo_id, fork.segmentation_id) == (photo.id, seg.id)  # linked, and shown only while shared
+
+    def shown(client, code) -> bool:
+        r = client.get(f"/api/v1/procedures/{code}/").json()
+        page = client.get(f"/procedures/{code}").content.decode()
+        overlay = client.get(f"/api/v1/procedures/{code}/download/overlay.png").status_code
+        names = str(photo.code) in page or str(seg.code) in page
+        assert names == ('id="overlay"' in page) == (overlay == 200) == (r["photo"] is not None)
+        assert (overlay == 200) != (overlay == 400)
+        return r["photo"] == str(photo.code) and r["segmentation"] == str(seg.code)
+
+    assert not shown(as_bob, fork.code)
     page = as_bob.get(f"/procedures/{fork.code}").content.decode()
-    assert str(photo.code) not in page and str(seg.code) not in page and "Re-run inference" not in page
-    assert as_bob.get(f"/api/v1/procedures/{fork.code}/download/overlay.png").status_code == 400
+    assert 'id="photo-hidden"' in page and "once its owner shares it" in page and "Re-run inference" not in page
     r = as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2}, format="json")
-    assert r.status_code == 400 and "no segmentation" in r.json()["procedure"]
-    # publishing the photo later does not link an old fork to it; a new fork is linked
+    assert r.status_code == 400 and "is not shared with you" in r.json()["procedure"]
+    mine = as_bob.get(f"/api/v1/procedures/{fork.code}/").json()
+    assert (mine["photo_shared"], mine["viewers_see"]) == (False, "Only you see this procedure.")
+    as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"visibility": "public"}, format="json")
+    assert not shown(as_charlie, fork.code)
+    assert "No photo to overlay" in as_charlie.get(f"/procedures/{fork.code}").content.decode()
+    assert as_charlie.get(f"/api/v1/procedures/{fork.code}/").json()["photo_shared"] is None  # not the owner's
+
+    # alice shares her photo: bob's fork, made before, shows it to bob and to everyone, and re-runs
     photo.visibility = "public"
     photo.save()
-    assert Procedure.objects.get(pk=fork.pk).photo_id is None
-    assert fork_as_bob(as_bob, proc).photo_id == photo.id
-    # alice's own fork keeps her photo, private as it is
+    assert shown(as_bob, fork.code) and shown(as_charlie, fork.code)
+    assert "Re-run inference" in as_bob.get(f"/procedures/{fork.code}").content.decode()
+    assert as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2}, format="json").status_code == 202
+    # and hides it again: never shown while private
     photo.visibility = "private"
     photo.save()
-    r = as_alice.post(f"/api/v1/procedures/{proc.code}/fork")
+    assert not shown(as_bob, fork.code) and not shown(as_charlie, fork.code)
+    r = as_alice.post(f"/api/v1/procedures/{proc.code}/fork")  # alice's own fork shows her photo, private as it is
     assert r.status_code == 201 and r.json()["photo"] == str(photo.code)
+
+
+def test_sharing_a_procedure_asks_about_its_photo_and_says_what_viewers_see(objects, as_alice, as_bob, as_charlie):
+    photo, seg, proc, job = objects  # both alice's and private
+    url = f"/api/v1/procedures/{proc.code}/"
+    r = as_alice.patch(url, {"visibility": "public"}, format="json").json()
+    assert (r["photo_shared"], r["viewers_see"]) == (False, (
+        "Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the photo is "
+        "private."))
+    assert as_charlie.get(url).json()["photo"] is None
+    page = as_alice.get(f"/procedures/{proc.code}").content.decode()
+    assert 'id="share-photo"' in page and "the photo is private" in page and r["viewers_see"] in page
+    # unlisted with its photo: the photo becomes unlisted too
+    r = as_alice.patch(url, {"visibility": "unlisted", "share_photo": True}, format="json").json()
+    photo.refresh_from_db()
+    assert (photo.visibility, r["photo_shared"]) == ("unlisted", True)
+    assert r["viewers_see"] == "Anyone with its link sees the procedure with its photo and the overlay."
+    r = as_alice.patch(url, {"visibility": "public"}, format="json").json()  # the photo stays unlisted
+    assert r["photo_shared"] is False and "the photo is unlisted, so only those with its link" in r["viewers_see"]
+    # the page's form: public, and the photo with it
+    r = as_alice.post(f"/procedures/{proc.code}/visibility", {"visibility": "public", "share_photo": "on"},
+                      follow=True)
+    photo.refresh_from_db()
+    assert photo.visibility == "public"
+    assert "The procedure is now public. Anyone sees the procedure with its photo and the overlay." in (
+        r.content.decode())
+    assert as_charlie.get(url).json()["photo"] == str(photo.code)
+    assert as_charlie.get(url + "download/overlay.png").status_code == 200
+    assert 'id="share-photo"' not in as_alice.get(f"/procedures/{proc.code}").content.decode()  # nothing to ask
+    # making the procedure private again leaves the photo as it is (it may be shared for itself)
+    as_alice.patch(url, {"visibility": "private"}, format="json")
+    photo.refresh_from_db()
+    assert photo.visibility == "public"
+
+
+def test_only_the_photos_owner_shares_it_and_a_refusal_changes_nothing(objects, as_alice, as_bob):
+    photo, seg, proc, job = objects
+    proc.visibility = "public"
+    proc.save()
+    fork = fork_as_bob(as_bob, proc)
+    url = f"/api/v1/procedures/{fork.code}/"
+    r = as_bob.patch(url, {"visibility": "public", "title": "bob's", "share_photo": True}, format="json")
+    assert r.status_code == 400 and r.json() == {"share_photo": "the photo is alice's: only they can share it"}
+    fork.refresh_from_db()
+    photo.refresh_from_db()
+    assert (fork.visibility, fork.title, photo.visibility) == ("private", "Fork of p", "private")
+    r = as_bob.patch(url, {"visibility": "public"}, format="json").json()
+    assert r["viewers_see"].endswith("the photo is private (it is alice's: only they can share it).")
+    assert 'id="share-photo"' not in as_bob.get(f"/procedures/{fork.code}").content.decode()
+    r = as_bob.post(f"/procedures/{fork.code}/visibility", {"visibility": "public", "share_photo": "on"},
+                    follow=True)
+    assert "share_photo: the photo is alice&#x27;s: only they can share it" in r.content.decode()
+    bare = make_procedure(None, None, proc.owner)
+    r = as_alice.patch(f"/api/v1/procedures/{bare.code}/", {"share_photo": True}, format="json")
+    assert r.status_code == 400 and r.json() == {"share_photo": "this procedure has no photo to share"}
+    r = as_alice.patch(f"/api/v1/procedures/{bare.code}/", {"visibility": "public"}, format="json").json()
+    assert r["viewers_see"] == "Anyone sees the procedure, its pictures and 3D models; it has no photo."

@@ -1,6 +1,6 @@
 """The 3D downloads of a procedure (glTF, glTF with the photo, IFC, CityJSON): served with their content types,
-read back by their formats' readers (the CityJSON valid by `facaid validate-cityjson`), at the scale asked for, and a bad parameter or a procedure too large a 400
-(alice owns, charlie is anonymous)."""
+read back by their formats' readers (the CityJSON valid by `facaid validate-cityjson`), at the scale asked for,
+and a bad parameter or a procedure too large a 400 (alice owns, charlie is anonymous)."""
 
 import io
 import json

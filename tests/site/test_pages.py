@@ -175,3 +175,48 @@ def test_cards_say_pixel_accuracy_and_the_photo_page_links_to_the_rectification(
     visitor = Client()
     visitor.force_login(bob)
     assert "Rectify it in the editor" not in visitor.get(f"/photos/{photo.code}").content.decode()
+
+
+def _distinct_colours(image_bytes: bytes) -> int:
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    pixels = np.asarray(Image.open(io.BytesIO(image_bytes)).convert("RGB")).reshape(-1, 3)
+    return len(np.unique(pixels, axis=0))
+
+
+def test_the_front_page_shows_a_newcomer_what_it_does_from_the_demo(alice, bob):
+    """Issue 58: the front page was a bare gallery. A newcomer sees the demo's photo -> procedure -> variations,
+    and a first step: sign up and upload, or try the demo without an account."""
+    from django.core.cache import caches
+
+    from facaid.generator import generate
+    from facaid.grammar import Procedure as Tree
+    from facaid.parameters import named_parameters
+    from webapp.facades.example import VARIANTS
+
+    home = Client().get("/").content.decode()
+    assert 'id="intro"' in home and 'href="/accounts/signup/?next=/photos/new">Sign up and upload a photo' in home
+    assert 'id="example"' not in home and 'id="try-demo"' not in home  # no demo procedure yet
+    call_command("demo")
+    photo = Photo.objects.get()
+    assert _distinct_colours(photo.image.read()) > 1000  # a photo-like picture, not the 12 colours of a label map
+    proc = Procedure.objects.create(owner=photo.owner, data=generate(3).procedure.to_dict(), visibility="public",
+                                    photo=photo, accuracy=0.9987)  # what the worker makes of it
+    home = Client().get("/").content.decode()
+    assert f'<img src="/api/v1/photos/{photo.code}/image"' in home
+    assert f'src="/api/v1/procedures/{proc.code}/thumbnail.png"' in home and "pixel accuracy 99.9 %" in home
+    assert home.count('src="data:image/png;base64,') == VARIANTS
+    assert f'id="try-demo" href="/procedures/{proc.code}">Try the demo</a>' in home
+    floors = next(p for p in named_parameters(Tree.from_dict(proc.data)) if p.name == "floors")
+    assert f"{floors.value:g} upper floors" in home
+    assert Client().get(f"/procedures/{proc.code}").status_code == 200  # the demo is open to anyone
+    assert len(caches["pages"].get(f"front-example:{proc.code}:{proc.digest}")["variations"]) == VARIANTS
+    c = Client()
+    c.force_login(bob)  # logged in, no photo yet: the example, and an upload button
+    page = c.get("/").content.decode()
+    assert 'id="example"' in page and 'href="/photos/new">Upload a photo' in page
+    Photo.objects.create(owner=bob, title="Mine", image=SimpleUploadedFile("f.png", facade_png()[0]))
+    assert 'id="intro"' not in c.get("/").content.decode()  # not a newcomer any more

@@ -92,3 +92,28 @@ def test_disabled_controls_look_disabled(live_server, as_alice, browser):
         assert style["background"] == background and style["cursor"] == "pointer", (selector, style)
     assert page.errors == []
     context.close()
+
+
+def test_a_newcomer_sees_photo_procedure_variations_and_tries_the_demo_offline(live_server, browser, tmp_path):
+    """Issue 58: the front page shows what the product does, from the demo, and the first step."""
+    from django.core.management import call_command
+
+    from facaid.generator import generate
+    from webapp.facades.models import Photo, Procedure
+
+    call_command("demo")
+    photo = Photo.objects.get()
+    proc = Procedure.objects.create(owner=photo.owner, data=generate(3).procedure.to_dict(), visibility="public",
+                                    photo=photo, accuracy=0.9971)  # what the worker makes of the demo
+    page = offline_page(browser, live_server.url, viewport=(1280, 800))
+    page.goto(f"{live_server.url}/")
+    page.wait_for_function("[...document.querySelectorAll('#example img')].every(i => i.complete && i.naturalWidth)")
+    assert page.locator("#example img").count() == 5  # the photo, the procedure, three variations
+    assert page.is_visible("text=Sign up and upload a photo") and page.is_visible("#try-demo")
+    box = page.locator("#try-demo").bounding_box()
+    assert box["y"] + box["height"] <= 800  # the first step is above the fold
+    screenshot(page.locator("#intro"), "front-page.png", tmp_path)
+    page.click("#try-demo")  # no account: the demo's page, with its parameters to change
+    page.wait_for_url(f"{live_server.url}/procedures/{proc.code}")
+    page.wait_for_selector("#named input")
+    assert page.elsewhere == [] and page.errors == []

@@ -372,3 +372,40 @@ def test_floors_plus_one_on_a_real_like_facade_adds_a_row_of_windows(live_server
     listed = page.eval_on_selector_all("#tree .exception", "els => els.map(e => e.parentElement.textContent)")
     assert any("exception: copy " in text and "blind" in text for text in listed), listed
     assert not errors
+
+
+def test_sharing_asks_whether_to_share_the_photo_and_the_overlay_follows(live_server, alice, facade_photo, browser,
+                                                                        tmp_path):
+    from site_helpers import screenshot
+
+    _, seg = facade_photo
+    proc = _faithful(alice, seg)  # alice's photo and procedure, both private
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 800}, advanced=False)
+    assert page.text_content("#viewers-see") == "Only you see this procedure."
+    assert not page.is_visible("#share-photo")  # nothing to ask while it stays private
+    page.select_option("#visibility-form select", "public")
+    assert page.is_visible("#share-photo") and "the photo is private" in page.text_content("#share-photo")
+    assert page.text_content("#viewers-will-see") == (
+        "Once saved: Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the "
+        "photo is private.")
+    page.check("#share-photo input")
+    assert page.text_content("#viewers-will-see") == (
+        "Once saved: Anyone sees the procedure with its photo and the overlay.")
+    page.uncheck("#share-photo input")
+    form = page.locator("#visibility-form").locator("xpath=ancestor::div[contains(@class, 'panel')]")
+    form.scroll_into_view_if_needed()
+    screenshot(form, "share-photo.png", tmp_path)
+    page.click("#visibility-form button")  # public, the photo left private: the page says what viewers see
+    page.wait_for_selector(".msg")
+    assert "not the photo or the overlay: the photo is private." in page.text_content("#viewers-see")
+    anonymous = browser.new_page()
+    anonymous.goto(f"{live_server.url}/procedures/{proc.code}")
+    assert anonymous.locator("#overlay").count() == 0 and "No photo to overlay" in anonymous.content()
+    page.select_option("#visibility-form select", "public")
+    page.check("#share-photo input")
+    page.click("#visibility-form button")
+    page.wait_for_selector("text=Anyone sees the procedure with its photo and the overlay.")
+    anonymous.reload()
+    anonymous.wait_for_function("document.getElementById('overlay') && document.getElementById('overlay').complete "
+                                "&& document.getElementById('overlay').naturalWidth > 0")
+    assert not errors

@@ -11,6 +11,7 @@ from django.conf import settings
 from django.core.cache import caches
 from django.core.files.base import ContentFile
 from django.core.files.storage import default_storage
+from django.db import transaction
 from django.db.models import Count, Max, OuterRef, Q, Subquery
 from django.http import FileResponse, Http404, HttpResponse
 from drf_spectacular.utils import OpenApiParameter, extend_schema
@@ -36,7 +37,7 @@ from facaid.parameters import named_parameters, set_parameters
 from facaid.rectify import rectify_file
 from facaid.relief import MAX_MESH_RECTS, drawn_leaves
 from facaid.variation import vary
-from webapp.facades import access, downloads, pictures, rendering, services, versions
+from webapp.facades import access, downloads, pictures, rendering, services, sharing, versions
 from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import (
@@ -57,6 +58,7 @@ from webapp.facades.serializers import (
     ParametersSerializer,
     PhotoSerializer,
     PhotoUploadSerializer,
+    ProcedureEditSerializer,
     ProcedureSerializer,
     ProcedureSummarySerializer,
     ProcedureVersionSerializer,
@@ -378,7 +380,7 @@ def gallery(request):
 
 
 @extend_schema(methods=["GET"], responses=ProcedureSerializer, summary="A procedure")
-@extend_schema(methods=["PATCH"], request=ProcedureWriteSerializer, responses=ProcedureSerializer,
+@extend_schema(methods=["PATCH"], request=ProcedureEditSerializer, responses=ProcedureSerializer,
                summary="Edit title, visibility or the procedure itself: a changed tree is a new version, re-measured "
                        "(the answer's accuracy and metrics are the new version's)")
 @extend_schema(methods=["DELETE"], responses={204: None}, summary="Delete a procedure")
@@ -394,16 +396,20 @@ def procedure_detail(request, code):
     if request.method == "DELETE":
         proc.delete()
         return Response(status=status.HTTP_204_NO_CONTENT)
-    form = ProcedureWriteSerializer(data=request.data, partial=True)
+    form = ProcedureEditSerializer(data=request.data, partial=True)
     form.is_valid(raise_exception=True)
     changes = dict(form.validated_data)
     tree = changes.pop("data", None)
-    for key, value in changes.items():
-        setattr(proc, key, value)
-    if tree is None:
-        proc.save()
-    else:
-        versions.save_tree(proc, tree)
+    visibility, share_photo = changes.pop("visibility", None), changes.pop("share_photo", False)
+    with transaction.atomic():  # a photo that cannot be shared leaves the title and the tree as they were
+        for key, value in changes.items():
+            setattr(proc, key, value)
+        if tree is None:
+            proc.save()
+        else:
+            versions.save_tree(proc, tree)
+        if visibility is not None or share_photo:
+            sharing.set_visibility(request.user, proc, visibility or proc.visibility, share_photo)
     return Response(ProcedureSerializer(proc, context={"request": request}).data)
 
 

@@ -15,6 +15,10 @@ class VisibilityForm(forms.Form):
     visibility = forms.ChoiceField(choices=Visibility.choices)
 
 
+class ProcedureVisibilityForm(VisibilityForm):
+    share_photo = forms.BooleanField(required=False, label="Share its photo too, so that viewers see the overlay")
+
+
 class RealSizeForm(forms.Form):
     """The facade's real width or height; its range is checked where the API's is (`PhotoSerializer`)."""
 

@@ -14,7 +14,7 @@ from facaid.grammar.procedure import MAX_NODES, ProcedureError
 from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
 from facaid.segmentation import Segmentation as SegmentationData
-from webapp.facades import access
+from webapp.facades import access, sharing
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, ProcedureVersion, Segmentation, Visibility
 
 
@@ -176,13 +176,17 @@ class ProcedureSerializer(serializers.ModelSerializer):
     photo = serializers.SerializerMethodField()
     segmentation = serializers.SerializerMethodField()
     version = serializers.SerializerMethodField(help_text="the current version's number (versions/ lists them)")
+    photo_shared = serializers.SerializerMethodField(
+        help_text="for the owner: whether those who may see the procedure see its photo and overlay too (null: no "
+                  "photo, or not the owner)")
+    viewers_see = serializers.SerializerMethodField(help_text="for the owner: what others see, in a sentence")
 
     class Meta:
         model = Procedure
         fields = ["code", "owner", "title", "visibility", "version", "accuracy", "metrics", "parent", "photo",
-                  "segmentation", "data", "created", "updated"]
+                  "segmentation", "photo_shared", "viewers_see", "data", "created", "updated"]
         read_only_fields = ["code", "owner", "version", "accuracy", "metrics", "parent", "photo", "segmentation",
-                            "created", "updated"]
+                            "photo_shared", "viewers_see", "created", "updated"]
 
     def get_version(self, proc: Procedure) -> int | None:
         current = proc.current_version()
@@ -200,6 +204,12 @@ class ProcedureSerializer(serializers.ModelSerializer):
 
     def get_photo(self, proc: Procedure) -> str | None:
         return str(proc.photo.code) if access.photo_visible_to(self._user(), proc.photo) else None
+
+    def get_photo_shared(self, proc: Procedure) -> bool | None:
+        return sharing.photo_shared(proc) if self._user().id == proc.owner_id else None
+
+    def get_viewers_see(self, proc: Procedure) -> str | None:
+        return sharing.viewers_see(proc) if self._user().id == proc.owner_id else None
 
     def get_segmentation(self, proc: Procedure) -> str | None:
         visible = proc.segmentation_id and access.photo_visible_to(self._user(), proc.photo)
@@ -254,6 +264,12 @@ class SaveAsNewSerializer(serializers.Serializer):
 
 class ProcedureWriteSerializer(SaveAsNewSerializer):
     visibility = serializers.ChoiceField(Visibility.choices, required=False)
+
+
+class ProcedureEditSerializer(ProcedureWriteSerializer):
+    share_photo = serializers.BooleanField(
+        required=False,
+        help_text="share the procedure's photo (yours) as widely as the procedure, so that viewers see the overlay")
 
 
 class JobSerializer(serializers.ModelSerializer):

@@ -210,13 +210,13 @@ def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Pr
 
 
 def fork_procedure(user, proc: Procedure) -> Procedure:
-    """A private copy owned by ``user`` with ``proc`` as its parent. Where ``user`` may see the photo, the copy keeps
-    it and the segmentation (its overlay and re-run); elsewhere it names neither, so that it cannot reveal them."""
+    """A private copy owned by ``user`` with ``proc`` as its parent. It keeps the links to the photo and the
+    segmentation, which show (the overlay, the re-run) only while the photo is shared with the viewer
+    (`access.photo_visible_to`, checked on every view): once a private photo is shared, the fork shows it too."""
     title = proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}"
-    keep = access.photo_visible_to(user, proc.photo)
     return Procedure.objects.create(
         owner=user, title=title[:200], data=proc.data, parent=proc, accuracy=proc.accuracy, metrics=proc.metrics,
-        photo=proc.photo if keep else None, segmentation_id=proc.segmentation_id if keep else None)
+        photo=proc.photo, segmentation_id=proc.segmentation_id)
 
 
 def rerun(user, proc: Procedure, nodes: int, k: int = DEFAULT_K) -> Job:
@@ -226,6 +226,6 @@ def rerun(user, proc: Procedure, nodes: int, k: int = DEFAULT_K) -> Job:
     if proc.segmentation_id is None:
         raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
     if not access.segmentation_visible_to(user, proc):
-        raise ValidationError({"procedure": "the photo this procedure was made from is no longer shared with you, "
+        raise ValidationError({"procedure": "the photo this procedure was made from is not shared with you, "
                                             "so it cannot be re-run"})
     return submit_job(user, proc.segmentation, k=k, seed=0, prefix=proc, prefix_nodes=nodes)

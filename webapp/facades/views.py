@@ -16,10 +16,11 @@ from rest_framework.exceptions import ValidationError
 from facaid.cga import MAX_SCALE
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.grammar import ProcedureError
-from webapp.facades import access, jsonbody, services, throttling
+from webapp.facades import access, example, jsonbody, services, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale
 from webapp.facades.forms import (
     PhotoForm,
+    ProcedureVisibilityForm,
     RealSizeForm,
     ReconstructForm,
     RerunForm,
@@ -51,6 +52,10 @@ def _set_visibility(request, obj, noun: str):
 def home(request):
     gallery = Paginator(access.public_procedures(), 24).get_page(request.GET.get("page"))
     context = {"gallery": gallery}
+    newcomer = not request.user.is_authenticated or not Photo.objects.filter(owner=request.user).exists()
+    if newcomer:  # what the product does, from the demo, and the first step
+        context["example"] = example.front_page_example()
+        context["newcomer"] = True
     if request.user.is_authenticated:
         context.update(photos=Photo.objects.filter(owner=request.user)[:12],
                        procedures=access.listed(Procedure.objects.filter(owner=request.user))[:12],
@@ -195,7 +200,11 @@ def procedure(request, code):
         "other_structure": _other_structure(proc),
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
-        "visibility_form": VisibilityForm(initial={"visibility": proc.visibility}),
+        "visibility_form": ProcedureVisibilityForm(initial={"visibility": proc.visibility}),
+        "may_share_photo": owner and sharing.may_share_photo(request.user, proc),
+        "viewers_see": sharing.viewers_see(proc) if owner else "",
+        "sharing_previews": sharing.previews(request.user, proc) if owner else {},
+        "photo_hidden": proc.photo is not None and not photo_visible,
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
         "max_scale": MAX_SCALE, "scale": _download_scale(proc)})
 
@@ -224,7 +233,17 @@ def _download_scale(proc) -> tuple[float, str] | None:
 @login_required
 @require_POST
 def procedure_visibility(request, code):
-    return _set_visibility(request, access.get_rw_procedure_for_user(request.user, code), "procedure")
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    form = ProcedureVisibilityForm(request.POST)
+    if form.is_valid():
+        try:
+            said = sharing.set_visibility(request.user, proc, form.cleaned_data["visibility"],
+                                          form.cleaned_data["share_photo"])
+        except ValidationError as exc:
+            messages.error(request, _error_text(exc))
+        else:
+            messages.success(request, f"The procedure is now {proc.get_visibility_display().lower()}. {said}")
+    return redirect(proc)
 
 
 @login_required

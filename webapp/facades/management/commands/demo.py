@@ -1,5 +1,6 @@
-"""``python manage.py demo``: a demo account with a demo facade photo, its segmentation and a queued
-reconstruction (the worker turns it into a public procedure). Does nothing if the account exists."""
+"""``python manage.py demo``: a demo account with a demo facade photo (a photo-like picture of a generated facade,
+`facaid.photolike`), its segmentation and a queued reconstruction (the worker turns it into a public procedure,
+the front page's example: `webapp.facades.example`). Does nothing if the account exists."""
 
 from __future__ import annotations
 
@@ -11,11 +12,10 @@ from django.core.management.base import BaseCommand
 
 from facaid.defaults import DEFAULT_K
 from facaid.generator import generate
-from facaid.render import render_segmentation
+from facaid.photolike import render_photo
 from webapp.facades import jobs
+from webapp.facades.example import DEMO_PASSWORD, DEMO_USERNAME
 from webapp.facades.models import Photo, Segmentation, Visibility
-
-USERNAME, PASSWORD = "demo", "demo-facade"
 
 
 class Command(BaseCommand):
@@ -26,13 +26,13 @@ class Command(BaseCommand):
 
     def handle(self, *args, seed: int, **options):
         users = get_user_model()
-        if users.objects.filter(username=USERNAME).exists():
-            self.stdout.write(f"demo account exists: log in as {USERNAME} / {PASSWORD}")
+        if users.objects.filter(username=DEMO_USERNAME).exists():
+            self.stdout.write(f"demo account exists: log in as {DEMO_USERNAME} / {DEMO_PASSWORD}")
             return
-        user = users.objects.create_user(USERNAME, "demo@example.com", PASSWORD)
+        user = users.objects.create_user(DEMO_USERNAME, "demo@example.com", DEMO_PASSWORD)
         sample = generate(seed)
         buf = io.BytesIO()
-        render_segmentation(sample.segmentation).save(buf, "PNG")
+        render_photo(sample.segmentation, seed).save(buf, "PNG")  # a photo of it, made here: walls, glass, light
         photo = Photo(owner=user, title=f"Demo facade ({sample.style})", visibility=Visibility.PUBLIC)
         buf.seek(0)
         photo.image.save("photo.png", ImageFile(buf, name="photo.png"), save=False)
@@ -40,4 +40,4 @@ class Command(BaseCommand):
         seg = Segmentation.objects.create(photo=photo, version=1, data=sample.segmentation.to_dict(),
                                           rect_count=len(sample.segmentation.rects))
         jobs.submit(owner=user, segmentation=seg, params={"k": DEFAULT_K, "seed": 0, "visibility": Visibility.PUBLIC})
-        self.stdout.write(f"demo account created: log in as {USERNAME} / {PASSWORD}; its facade is queued")
+        self.stdout.write(f"demo account created: log in as {DEMO_USERNAME} / {DEMO_PASSWORD}; its facade is queued")

@@ -1,0 +1,81 @@
+"""The front page's example of what FaçAID does, made from the demo (`manage.py demo`): the demo's photo, the
+procedure the worker reconstructed from it, and three variations of that procedure, each with what it drew."""
+
+from __future__ import annotations
+
+import base64
+
+from django.core.cache import caches
+from rest_framework.exceptions import ValidationError
+
+from facaid.grammar import to_segmentation
+from facaid.grammar.procedure import ProcedureError
+from facaid.parameters import named_parameters
+from facaid.variation import vary
+from webapp.facades.models import Procedure, Visibility
+from webapp.facades.rendering import label_map_png
+from webapp.facades.serializers import parse_procedure
+
+DEMO_USERNAME, DEMO_PASSWORD = "demo", "demo-facade"
+VARIANTS = 3
+SIDE = 240  # the variations' pictures, at most this many pixels a side
+
+
+def demo_procedure() -> Procedure | None:
+    """The demo's first public procedure made from its public photo, if the worker has made it."""
+    return (Procedure.objects.filter(owner__username=DEMO_USERNAME, visibility=Visibility.PUBLIC,
+                                     photo__visibility=Visibility.PUBLIC)
+            .select_related("photo").order_by("created").first())
+
+
+def _caption(tree) -> str:
+    found = {p.name: p.value for p in named_parameters(tree)}
+    parts = []
+    if "floors" in found:
+        parts.append(f"{found['floors']:g} upper floor{'s' if found['floors'] != 1 else ''}")
+    if "bays" in found:
+        parts.append(f"{found['bays']:g} tile{'s' if found['bays'] != 1 else ''} a floor")
+    return ", ".join(parts) or f"{tree.width:g} x {tree.height:g} px"
+
+
+def _variations(tree) -> list:
+    """Variations that show what the numbers do: the floors and the tiles a floor drawn around the procedure's
+    own (seed 0), each one unlike the others and the procedure; any variation where it has neither."""
+    ranges = {p.name: (max(p.min, p.value - 2), min(p.max, p.value + 3)) for p in named_parameters(tree)
+              if p.name in ("floors", "bays") and p.min < p.max}
+    if not ranges:
+        return vary(tree, VARIANTS, seed=0)
+    out, seen = [], {_caption(tree)}
+    for variant in vary(tree, 4 * VARIANTS, seed=0, ranges=ranges):
+        if _caption(variant) not in seen and len(out) < VARIANTS:
+            seen.add(_caption(variant))
+            out.append(variant)
+    return out
+
+
+def _pictures(proc: Procedure) -> dict:
+    """The procedure's caption and three variations of it (`_variations`), each a PNG data URI with its caption, kept in
+    the cache by the tree's digest: the front page pays for them once per tree."""
+    key = f"front-example:{proc.code}:{proc.digest}"
+    cache = caches["pages"]
+    found = cache.get(key)
+    if found is None:
+        try:
+            tree = parse_procedure(proc.data)
+            trees = _variations(tree)
+        except (ProcedureError, ValueError, ValidationError):
+            return {"caption": "", "variations": []}
+        found = {"caption": _caption(tree), "variations": [
+            {"picture": "data:image/png;base64," + base64.b64encode(label_map_png(to_segmentation(t), SIDE)).decode(),
+             "caption": _caption(t)} for t in trees]}
+        cache.set(key, found, None)
+    return found
+
+
+def front_page_example() -> dict | None:
+    """The example the front page shows: the demo's procedure, its photo, its caption and its variations; None
+    before the worker has made the procedure."""
+    proc = demo_procedure()
+    if proc is None:
+        return None
+    return {"procedure": proc, "photo": proc.photo, **_pictures(proc)}
