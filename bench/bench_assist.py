@@ -12,7 +12,7 @@ a true element not drawn yet (same class, IoU >= 0.7) and pays one action for ev
 1-189) and the test half (190-378) apart, beside the effort without completion (the 95 % stop alone), with the
 median time of a completion call. CMP is evaluation data: nothing here trains. CMP's photos are not in the repo:
 ``--generated N`` runs the same annotator on N held-out generated facades (seeds 5000 on) drawn on photo-like
-renders of themselves (`facaid.photolike.render_photo`), their wall one rectangle as a person draws it
+renders of themselves (`facaid.photo.photolike.render_photo`), their wall one rectangle as a person draws it
 (`facaid.evaluation.assist.as_drawn`), not the flattened pieces around each element, without and with the photo
 (searched, and checking the proposals). ``--photos DIR`` gives the CMP annotations their own photos
 (``DIR/cmp_bNNNN.jpg``, read out of a public copy of the CMP base set into a git-ignored cache, issue 57: never in the
@@ -114,7 +114,7 @@ def timing(args) -> None:
     from PIL import Image
 
     from facaid.generator import generate
-    from facaid.photolike import render_photo
+    from facaid.photo.photolike import render_photo
     from facaid.segmentation import Rect, Segmentation
 
     took: dict[str, list[float]] = {"structure": [], "photo": []}
@@ -138,7 +138,7 @@ def timing(args) -> None:
 
 def generated(args) -> None:
     from facaid.generator import generate
-    from facaid.photolike import render_photo
+    from facaid.photo.photolike import render_photo
 
     cases = [(as_drawn(g.segmentation), render_photo(g.segmentation, seed))
              for seed in range(5000, 5000 + args.generated) for g in [generate(seed)]]

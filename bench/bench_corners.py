@@ -3,7 +3,7 @@
     .venv/bin/python bench/bench_corners.py --photos var/cmp_photos [--limit N] [--warp SEED] [--json F]
 
 For each CMP dev-half photo in ``--photos`` (``cmp_bNNNN.jpg``, the git-ignored cache of the public copy of CMP's
-base set; CMP's photos are rectified facades), `facaid.rectify.propose_corners_file` proposes the facade's four
+base set; CMP's photos are rectified facades), `facaid.photo.rectify.propose_corners_file` proposes the facade's four
 corners; the figure is the IoU of that quadrilateral with the annotation's facade box (the bounding box of its
 wall rectangles). ``--warp SEED`` first warps each photo by a random perspective of its own (the corners moved
 inwards by up to a fifth of the side, seeded), so the known corners are the warped facade box's, and scores the
@@ -25,7 +25,7 @@ from PIL import Image, ImageDraw
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.labels import FACADE
 from facaid.paths import DEFAULT_CMP
-from facaid.rectify import homography, propose_corners_file
+from facaid.photo.rectify import homography, propose_corners_file
 
 
 def facade_box(seg) -> tuple[int, int, int, int] | None:

@@ -22,11 +22,11 @@ import time
 import torch
 
 from facaid.decoding import decode
+from facaid.decoding.step import library as native_library
 from facaid.defaults import TEMPERATURE
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.model import FacaidConfig, FacaidModel, batch_inputs, batch_outputs, load_model
-from facaid.native.step import library as native_library
 from facaid.paths import DEFAULT_CHECKPOINT
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 

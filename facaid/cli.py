@@ -111,14 +111,14 @@ def _generate_stats(args: argparse.Namespace) -> None:
 def cmd_render(args: argparse.Namespace) -> None:
     from PIL import Image
 
-    from facaid.render import legend, overlay, render_segmentation
+    from facaid.formats.render import legend, overlay, render_segmentation
     from facaid.segmentation import rasterize
 
     seg = load_segmentation_or_procedure(_read_json(args.input))
     if args.out.lower().endswith(".svg"):
         if args.photo or args.legend or args.outline:
             raise CliError("--photo, --legend and --outline draw PNGs; an .svg output is the labels alone")
-        from facaid.render import segmentation_svg
+        from facaid.formats.render import segmentation_svg
 
         Path(args.out).write_text(segmentation_svg(seg), encoding="utf-8")
         print(f"wrote {args.out} ({seg.width}x{seg.height}, {len(seg.rects)} rectangles)")
@@ -175,10 +175,10 @@ def cmd_compare(args: argparse.Namespace) -> None:
 
 
 def cmd_reconstruct(args: argparse.Namespace) -> None:
+    from facaid.formats.render import render_segmentation
     from facaid.grammar.execute import to_segmentation
     from facaid.model import load_model
     from facaid.pipeline import reconstruct
-    from facaid.render import render_segmentation
     from facaid.segmentation import Segmentation
 
     seg = Segmentation.from_dict(_read_json(args.input), clip=args.clip)
@@ -217,14 +217,14 @@ def cmd_complete(args: argparse.Namespace) -> None:
     if args.photo:
         from PIL import Image
 
-        from facaid.appearance import levels
+        from facaid.photo.appearance import levels
 
         try:  # read once, as grey levels of a bounded size (the site's API reads it the same way)
             photo = levels(args.photo, seg.width, seg.height)
         except (OSError, Image.DecompressionBombError) as exc:
             raise CliError(f"cannot read photo {args.photo}: {exc}") from None
     if args.unit is not None:
-        from facaid.copies import UnitError, find_copies
+        from facaid.photo.copies import UnitError, find_copies
 
         try:
             unit = [int(i) for i in args.unit.split(",")]
@@ -242,9 +242,9 @@ def cmd_complete(args: argparse.Namespace) -> None:
 
 
 def cmd_vary(args: argparse.Namespace) -> None:
+    from facaid.formats.render import render_segmentation, side_by_side
     from facaid.grammar.execute import to_segmentation
     from facaid.grammar.procedure import Procedure
-    from facaid.render import render_segmentation, side_by_side
     from facaid.variation import vary
 
     proc = Procedure.from_dict(_read_json(args.input))
@@ -301,7 +301,7 @@ def cmd_params(args: argparse.Namespace) -> None:
 
 
 def cmd_cga(args: argparse.Namespace) -> None:
-    from facaid.cga import default_scale, procedure_cga
+    from facaid.formats.cga import default_scale, procedure_cga
     from facaid.grammar.procedure import Procedure
 
     proc = Procedure.from_dict(_read_json(args.input))
@@ -313,8 +313,8 @@ def cmd_cga(args: argparse.Namespace) -> None:
 
 
 def cmd_mesh(args: argparse.Namespace) -> None:
+    from facaid.formats.mesh import procedure_mesh
     from facaid.grammar.procedure import Procedure
-    from facaid.mesh import procedure_mesh
 
     out = Path(args.out)
     if out.suffix.lower() != ".obj":
@@ -328,8 +328,8 @@ def cmd_mesh(args: argparse.Namespace) -> None:
 
 
 def cmd_export(args: argparse.Namespace) -> None:
-    from facaid.cga import STOREY_M, checked_scale
-    from facaid.exports import EXPORTS, export_for
+    from facaid.formats.cga import STOREY_M, checked_scale
+    from facaid.formats.exports import EXPORTS, export_for
     from facaid.grammar.procedure import Procedure
 
     found = export_for(args.out)
@@ -374,7 +374,7 @@ def _corners_arg(text: str) -> list[list[float]]:
 def cmd_rectify(args: argparse.Namespace) -> None:
     from PIL import Image, ImageOps, UnidentifiedImageError
 
-    from facaid.rectify import output_size, propose_corners, rectify
+    from facaid.photo.rectify import output_size, propose_corners, rectify
 
     if not (args.propose or args.corners):
         raise CliError("give --propose (find the corners) or --corners (use these)")
@@ -414,7 +414,7 @@ def cmd_rectify(args: argparse.Namespace) -> None:
 
 
 def cmd_convert(args: argparse.Namespace) -> None:
-    from facaid import interchange
+    from facaid.formats import interchange
 
     fmt = args.to or interchange.format_for_name(args.out)
     if fmt is None:
@@ -433,7 +433,7 @@ def cmd_convert(args: argparse.Namespace) -> None:
         obj = _json_object(data)
         if not (isinstance(obj, dict) and ("procedure" in obj or obj.get("format") is not None)):
             raise
-        from facaid.annotation import written_as
+        from facaid.formats.annotation import written_as
 
         seg, source, name, warnings = written_as(load_segmentation_or_procedure(obj), fmt), "procedure", None, ()
     for line in warnings:
@@ -445,7 +445,7 @@ def cmd_convert(args: argparse.Namespace) -> None:
 
 
 def cmd_validate_cityjson(args: argparse.Namespace) -> None:
-    from facaid.cityjson_check import SCHEMAS, check_cityjson
+    from facaid.formats.cityjson_check import SCHEMAS, check_cityjson
 
     invalid = 0
     for path in args.files:
@@ -496,10 +496,10 @@ def cmd_evaluate_real(args: argparse.Namespace) -> None:
 
 
 def cmd_demo(args: argparse.Namespace) -> None:
-    from facaid.cga import procedure_cga
+    from facaid.formats.cga import procedure_cga
+    from facaid.formats.mesh import procedure_mesh
+    from facaid.formats.render import render_segmentation, side_by_side
     from facaid.generator import generate
-    from facaid.mesh import procedure_mesh
-    from facaid.render import render_segmentation, side_by_side
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -680,7 +680,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "12 m for the whole facade when it has neither)")
         e.set_defaults(func=func)
 
-    from facaid.exports import EXPORTS
+    from facaid.formats.exports import EXPORTS
 
     x = sub.add_parser("export", help="a procedure in another format, chosen by the output's extension",
                        description="Write a procedure as " + "; ".join(f"{ext} {e.what}" for ext, e in EXPORTS.items())

@@ -21,17 +21,17 @@ a drawn one:
    another type (a sill under each window) is proposed at the same offset for the rest of them (``with
    window``; at most 0.8: right 7 times in 70 on CMP's dev half).
 5. **The photo** (when given: the image the segmentation is drawn on, resized to its size) proposes: every place
-   that looks like a type's drawn elements with the wall around them (`facaid.appearance.search`, NCC at least
+   that looks like a type's drawn elements with the wall around them (`facaid.photo.appearance.search`, NCC at least
    `SEARCH_MATCH`, anywhere in the facade, rows and lattices or not) is proposed at the type's size (score
    `PHOTO_CONFIRMED`, reason ``looks like window``). On photo-like renders of 12 held-out generated facades this
    takes the effort from 0.72 (the structure, checked by the photo) to 0.443. And the drawn elements are carried
-   along **the photo's repeats** (`facaid.repeats`: the shifts they vote for, where they look like themselves on
+   along **the photo's repeats** (`facaid.photo.repeats`: the shifts they vote for, where they look like themselves on
    the contrast-normalised photo) to where they stand in a drawn row or column of their class: at NCC
    `REPEAT_MATCH` by how many of the two are drawn (`COMPANION_EXTRA` more for classes other than windows and
    blinds), scored from `COPY_SCORE` up (reason ``repeat of window``, ``photo`` its NCC). On
    CMP's own photos (dev, every 3rd facade) this takes the effort from 0.793 to 0.74-0.76.
 6. **The photo checks** every proposal scored at least `PHOTO_CANDIDATE`, the searched ones too: it is moved to
-   the best of 25 nearby places and compared with the drawn elements of its class (`facaid.appearance`: normalized
+   the best of 25 nearby places and compared with the drawn elements of its class (`facaid.photo.appearance`: normalized
    cross-correlation of 12 x 12 grey patches); at `PHOTO_MATCH` or more it scores at least `PHOTO_CONFIRMED`,
    below that half its score, and ``photo`` holds the similarity. A proposal the structure is sure of (scored
    `PHOTO_CONFIRMED` or more: a floor's, a full grid's) is only vetoed, below `VETO`: on CMP's own photos real copies
@@ -51,9 +51,9 @@ from typing import Any
 
 import numpy as np
 
-from facaid import appearance, repeats
 from facaid.defaults import DEFAULT_MIN_SCORE
 from facaid.labels import BACKGROUND, FACADE, GLASS, LABELS, PRIORITY
+from facaid.photo import appearance, repeats
 from facaid.segmentation import Segmentation, aligned_lines, parse_segmentation
 
 MAX_DRAWN = 2_000  # more drawn rectangles than this are refused (a CMP facade has at most a few hundred)
@@ -347,7 +347,7 @@ def _companions(types: list[_Type], props: Proposals) -> None:
 
 
 def _search(levels: appearance.Levels, types: list[_Type], props: Proposals) -> None:
-    """Where the photo looks like a type's drawn elements (`facaid.appearance.search`, NCC at least
+    """Where the photo looks like a type's drawn elements (`facaid.photo.appearance.search`, NCC at least
     `SEARCH_MATCH`), anywhere in the facade: each such place is proposed at the type's size (``looks like``). The
     `MAX_SEARCH_TYPES` types drawn most often are searched for (in their order), so that a call costs at most that
     many searches however many types are drawn."""
@@ -359,7 +359,7 @@ def _search(levels: appearance.Levels, types: list[_Type], props: Proposals) -> 
 
 
 def _repeats(levels: appearance.Levels, props: Proposals) -> None:
-    """The drawn elements carried by the photo's repeats (`facaid.repeats`) where it looks like them: proposed
+    """The drawn elements carried by the photo's repeats (`facaid.photo.repeats`) where it looks like them: proposed
     where they also stand in a drawn row or column of their class (`REPEAT_MATCH`: the alike a copy must be, by how
     many of its row and column are drawn; one in neither is not proposed)."""
     for label, box, sim in repeats.repeats(levels, props.drawn):
@@ -375,7 +375,7 @@ def _repeats(levels: appearance.Levels, props: Proposals) -> None:
 
 def _photo_check(levels: appearance.Levels, props: Proposals) -> dict[int, tuple[float, float, np.ndarray]]:
     """{item: (score, similarity, box)} for the proposals the photo has a say on: each is moved to where it looks
-    most like the drawn elements of its class (`facaid.appearance.refine`); one that looks like them scores at least
+    most like the drawn elements of its class (`appearance.refine`); one that looks like them scores at least
     `PHOTO_CONFIRMED`, one that does not half its structural score; a flat place or class keeps its score."""
     out: dict[int, tuple[float, float]] = {}
     items = [i for i, item in enumerate(props.items) if item[2] >= PHOTO_CANDIDATE and not item[3].startswith("repeat")]

@@ -354,7 +354,7 @@ function similar() {
   draw();
 }
 
-// find copies (facaid.copies on the server): where the selected unit, a window with what is drawn around it,
+// find copies (facaid.photo.copies on the server): where the selected unit, a window with what is drawn around it,
 // repeats in the photo
 async function findCopies() {
   if (!ui.selection.size) return status("Find copies looks for copies of the selected unit: select a window and " +

@@ -147,7 +147,7 @@ export function applyHomography(h, x, y) {
   return [(h[0] * x + h[1] * y + h[2]) / w, (h[3] * x + h[4] * y + h[5]) / w];
 }
 
-/** Width and height of the rectified image: the mean lengths of opposite edges (as facaid/rectify.py). */
+/** Width and height of the rectified image: the mean lengths of opposite edges (as facaid/photo/rectify.py). */
 export function rectifiedSize(corners) {
   const d = (p, q) => Math.hypot(p[0] - q[0], p[1] - q[1]);
   const [tl, tr, br, bl] = corners;

@@ -67,8 +67,8 @@ def main():
     ap.add_argument("--half", default="dev", help="dev, test, or generated (12 held-out generated facades)")
     args = ap.parse_args()
     if args.half == "generated":
-        from facaid.generator import generate
         from facaid.evaluation.assist import as_drawn
+        from facaid.generator import generate
         recs = [(str(seed), as_drawn(generate(seed).segmentation)) for seed in range(5000, 5012)]
     else:
         recs = load_records(DEFAULT_CMP)

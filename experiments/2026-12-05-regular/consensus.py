@@ -1,13 +1,15 @@
 """Edge consensus on perturbed CMP dev facades: how much of the annotator noise a rectangle-level denoiser removes."""
 import argparse
+
 import numpy as np
+
 from facaid.augmentation import annotator_noise
+from facaid.completion import complete
 from facaid.evaluation.real import load_records
+from facaid.labels import FACADE, LABELS
+from facaid.metrics import pixel_accuracy
 from facaid.paths import DEFAULT_CMP
 from facaid.segmentation import Rect, Segmentation, flatten, rasterize
-from facaid.metrics import pixel_accuracy
-from facaid.labels import FACADE, LABELS
-from facaid.completion import complete
 
 
 def clusters(values, diameter):

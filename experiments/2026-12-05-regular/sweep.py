@@ -2,7 +2,9 @@
 import argparse
 import json
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -11,11 +13,10 @@ from facaid.evaluation.real import load_records
 from facaid.grammar.execute import to_segmentation
 from facaid.metrics import compression, element_leaves, pixel_accuracy
 from facaid.paths import DEFAULT_CMP
-import sys
-from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 from regular import regular_procedure  # noqa: E402
+
 from facaid.segmentation import flatten, rasterize
 from facaid.sizing import fit_sizes
 

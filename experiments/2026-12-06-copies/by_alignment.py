@@ -3,13 +3,19 @@ of the class), the rule's filter off; only those at NCC >= 0.8 are shown to the 
 
     .venv/bin/python experiments/2026-12-06-copies/by_alignment.py 9
 """
-import numpy as np, sys, ast, collections
-from facaid import appearance, copies, completion, repeats
+import collections
+import sys
+
+import numpy as np
+
+from facaid import completion
 from facaid.completion import complete
 from facaid.evaluation import assist
 from facaid.evaluation.real import load_records
+from facaid.labels import LABEL_ID
 from facaid.paths import DEFAULT_CMP
-from facaid.labels import LABELS, LABEL_ID
+from facaid.photo import appearance, repeats
+
 repeats.MATCH = 0.5
 completion.REPEAT_MATCH = (0.5, 0.5, 0.5)
 completion.COMPANION_EXTRA = 0.0
@@ -41,5 +47,5 @@ for rid, seg in load_records(DEFAULT_CMP, 189)[::int(sys.argv[1])]:
             if ncc >= 0.8: keep.append(p)
         return keep
     assist.simulate(seg, prop)
-for k in sorted(stats): 
+for k in sorted(stats):
     a, r = stats[k]; print(k, a, r, round(a / (a + r), 2))

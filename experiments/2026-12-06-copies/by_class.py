@@ -2,15 +2,20 @@
 
     .venv/bin/python experiments/2026-12-06-copies/by_class.py 9 [NAME=VALUE ...]
 """
-import numpy as np, sys, ast, collections
-from facaid import appearance, copies, completion, repeats
+import ast
+import collections
+import sys
+
+from facaid import completion
 from facaid.completion import complete
 from facaid.evaluation import assist
 from facaid.evaluation.real import load_records
-from facaid.paths import DEFAULT_CMP
 from facaid.labels import LABELS
-from facaid.segmentation import Segmentation, rasterize
 from facaid.metrics import pixel_accuracy
+from facaid.paths import DEFAULT_CMP
+from facaid.photo import appearance, copies, repeats
+from facaid.segmentation import Segmentation, rasterize
+
 for kv in sys.argv[2:]:
     k, v = kv.split("="); setattr(repeats if hasattr(repeats, k) else (copies if hasattr(copies, k) else completion), k, ast.literal_eval(v))
 hand = collections.Counter(); acc = collections.Counter(); total = collections.Counter(); rej = collections.Counter()

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from facaid.appearance import FLAT, Levels
+from facaid.photo.appearance import FLAT, Levels
 
 SIDE = 24  # pixels: the photo is searched scaled so that the type's smaller side is about this long
 CONTEXT = 0.25  # share of its size around each example that is matched with it (a window in its wall)

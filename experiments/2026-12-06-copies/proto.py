@@ -9,9 +9,9 @@ import time
 import cv2
 import numpy as np
 
-from facaid import appearance
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.paths import DEFAULT_CMP
+from facaid.photo import appearance
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--every", type=int, default=3)
@@ -20,13 +20,15 @@ ap.add_argument("--method", default="all")
 ap.add_argument("--photos", default="var/cmp_photos")
 ap.add_argument("--thr_axis", type=float, default=0.35)
 ap.add_argument("--thr_cell", type=float, default=0.45)
-ap.add_argument("--set", nargs="*", default=[], help="facaid.copies knobs, NAME=VALUE (Python literal)")
+ap.add_argument("--set", nargs="*", default=[], help="facaid.photo.copies knobs, NAME=VALUE (Python literal)")
 args = ap.parse_args()
 import ast
 import sys
 from pathlib import Path
+
 sys.path.insert(0, str(Path(__file__).parent))
 import lattice_copies as _copies  # noqa: E402  (the lattice per type, not landed)
+
 for kv in args.set:
     k, v = kv.split("=", 1)
     setattr(_copies, k, ast.literal_eval(v))
@@ -216,6 +218,7 @@ METHODS = {"module": method_module, "ncc": method_ncc, "lattice": method_lattice
 names = list(METHODS) if args.method == "all" else args.method.split(",")
 stats = {n: {"found": [], "prec": [], "prec8": [], "t": []} for n in names}
 from PIL import Image
+
 for rid, seg in load_records(DEFAULT_CMP, args.limit)[:: args.every]:
     try:
         photo = Image.open(f"{args.photos}/{rid}.jpg").convert("L").resize((seg.width, seg.height))

@@ -1,16 +1,18 @@
 """The simulated annotator (facaid.evaluation.assist) on every N-th CMP dev facade with its photo, knobs set as
-NAME=VALUE (Python literals) on facaid.repeats, facaid.completion: median and pooled effort, hit rate.
+NAME=VALUE (Python literals) on facaid.photo.repeats, facaid.completion: median and pooled effort, hit rate.
 
     .venv/bin/python experiments/2026-12-06-copies/sim.py 9 [REPEAT_MATCH="(2.0,0.8,0.6)"] [MATCH=0.6]
 """
-import numpy as np, sys
-from facaid import appearance, copies, completion, repeats
+import statistics
+import sys
+
+from facaid import completion
 from facaid.completion import complete
 from facaid.evaluation.assist import simulate
 from facaid.evaluation.real import load_records
 from facaid.paths import DEFAULT_CMP
-from facaid.labels import LABEL_ID
-import statistics
+from facaid.photo import appearance, copies, repeats
+
 for kv in sys.argv[2:]:
     k, v = kv.split("=")
     mod = repeats if hasattr(repeats, k) else (copies if hasattr(copies, k) else completion)

@@ -6,8 +6,6 @@
 import argparse
 import json
 
-import numpy as np
-
 from facaid import lattice
 from facaid.evaluation.editability import editability, segmentation_lattice
 from facaid.evaluation.real import DEV_FACADES, load_records

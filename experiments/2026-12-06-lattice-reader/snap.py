@@ -1,8 +1,10 @@
 """Snapping an annotation's element edges to the medians of their clusters (one label, one edge, within a share of
 the side): a try at restoring a hand's jitter before reading (notes.md, step 12)."""
 import numpy as np
-from facaid.labels import FACADE, BACKGROUND
+
+from facaid.labels import BACKGROUND, FACADE
 from facaid.segmentation import Rect, Segmentation
+
 
 def _clusters(values, spread):
     order = np.argsort(values, kind="stable")

@@ -11,8 +11,8 @@ from __future__ import annotations
 import torch
 
 from facaid.decoder import DecoderState
+from facaid.decoding.step import native_decoder
 from facaid.model import FacaidModel
-from facaid.native.step import native_decoder
 
 
 class Stepper:

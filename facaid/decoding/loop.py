@@ -14,11 +14,11 @@ import torch
 
 from facaid.decoding.backends import Stepper
 from facaid.decoding.processor import GrammarLogitsProcessor
+from facaid.decoding.step import torch_threads
 from facaid.defaults import FLOOR_TOLERANCE
 from facaid.grammar.floors import merge_repeated_floors
 from facaid.grammar.procedure import Procedure
 from facaid.model import MAX_LOCAL, FacaidModel, batch_inputs
-from facaid.native.step import torch_threads
 from facaid.segmentation import Segmentation
 from facaid.tokenizer import BOS, EOS, PAD, TokenError, Tokenizer
 

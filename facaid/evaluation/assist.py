@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from facaid.annotation import as_drawn  # noqa: F401  (the benches and tests read it here)
 from facaid.completion import complete
+from facaid.formats.annotation import as_drawn  # noqa: F401  (the benches and tests read it here)
 from facaid.labels import LABEL_ID
 from facaid.metrics import pixel_accuracy
 from facaid.segmentation import Rect, Segmentation, rasterize

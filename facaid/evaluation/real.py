@@ -26,12 +26,12 @@ from tqdm import tqdm
 from facaid.augmentation import annotator_noise
 from facaid.defaults import DEFAULT_K
 from facaid.evaluation.editability import editability, segmentation_lattice
+from facaid.formats.render import colorize, side_by_side
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.metrics import compression, pixel_accuracy
 from facaid.model import FacaidModel
 from facaid.pipeline import reconstruct
-from facaid.render import colorize, side_by_side
 from facaid.segmentation import Segmentation, flatten, rasterize
 from facaid.tokenizer import Tokenizer
 

@@ -1,7 +1,8 @@
 """Small C libraries for the hot paths, built on first use with the machine's C compiler.
 
-- `facaid.native.step` (``step.c``): the decoder step, one call per step instead of some 80 torch operations.
-- `facaid.native.grid` (``grid.c``): flattening labelled rectangles (`facaid.segmentation.flatten_array`).
+- ``step.c``: the decoder step, one call per step instead of some 80 torch operations; `facaid.decoding.step`
+  loads it (the model's weights are the decoding layer's, so its Python side lives there).
+- `facaid.native.rects` (``rects.c``): executing and flattening labelled rectangles (`facaid.segmentation`).
 
 Each library is compiled once per source and machine into ``$FACAID_CACHE`` (default ``~/.cache/facaid``) with
 ``-O3 -march=native``; without a C compiler, or with ``FACAID_NATIVE=0``, `load` returns None and the callers keep

@@ -1,10 +1,10 @@
-"""One box per element for the annotation formats (`facaid.annotation`): pieces merged, the wall under them."""
+"""One box per element for the annotation formats (`facaid.formats.annotation`): pieces merged, the wall under them."""
 
 import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from facaid.annotation import as_annotated, merge_pieces
+from facaid.formats.annotation import as_annotated, merge_pieces
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import LABEL_ID

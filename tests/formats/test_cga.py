@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from grammar_helpers import example, facade
 
-from facaid.cga import LEAF_RULES, default_scale, procedure_cga
+from facaid.formats.cga import LEAF_RULES, default_scale, procedure_cga
 from facaid.generator import generate
 from facaid.grammar.execute import execute
 from facaid.grammar.procedure import Node, Override, Procedure, Size

@@ -13,11 +13,11 @@ import numpy as np
 import pytest
 from format_helpers import window_grid
 
-from facaid.cityjson import cityjson_text, procedure_cityjson
-from facaid.cityjson_check import check_cityjson
 from facaid.cli import main
+from facaid.formats.cityjson import cityjson_text, procedure_cityjson
+from facaid.formats.cityjson_check import check_cityjson
+from facaid.formats.relief import DEPTHS, MeshTooLarge, procedure_relief
 from facaid.generator import generate
-from facaid.relief import DEPTHS, MeshTooLarge, procedure_relief
 
 SCALE = 0.02
 

@@ -11,13 +11,13 @@ import trimesh
 from format_helpers import window_grid
 from PIL import Image
 
-from facaid.annotation import as_annotated
 from facaid.cli import main
-from facaid.exports import EXPORTS, export_for
+from facaid.formats.annotation import as_annotated
+from facaid.formats.exports import EXPORTS, export_for
+from facaid.formats.interchange import read as read_annotations
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
-from facaid.interchange import read as read_annotations
 from facaid.labels import LABEL_ID
 from facaid.segmentation import rasterize
 

@@ -8,10 +8,10 @@ from grammar_helpers import example
 from test_cityjson import surfaces
 from test_gltf import elements, load
 
-from facaid.cityjson import procedure_cityjson
-from facaid.gltf import procedure_gltf
-from facaid.ifc import procedure_ifc
-from facaid.relief import procedure_relief
+from facaid.formats.cityjson import procedure_cityjson
+from facaid.formats.gltf import procedure_gltf
+from facaid.formats.ifc import procedure_ifc
+from facaid.formats.relief import procedure_relief
 
 SCALE = 0.02
 

@@ -12,12 +12,12 @@ import pytest
 import trimesh
 from format_helpers import window_grid
 
+from facaid.formats.gltf import procedure_gltf
+from facaid.formats.relief import DEPTHS, MAX_MESH_RECTS, MeshTooLarge
+from facaid.formats.render import render_segmentation
 from facaid.generator import generate
-from facaid.gltf import procedure_gltf
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import LABELS, PALETTE
-from facaid.relief import DEPTHS, MAX_MESH_RECTS, MeshTooLarge
-from facaid.render import render_segmentation
 
 SCALE = 0.02
 
@@ -150,7 +150,7 @@ def test_a_large_photo_is_shrunk_strip_by_strip_as_a_whole_reduce_would(mode):
     """`shrunk_rgb` averages the same blocks as converting to RGB and reducing the whole (no full-size copy)."""
     from PIL import Image
 
-    from facaid.gltf import shrunk_rgb
+    from facaid.formats.gltf import shrunk_rgb
 
     rng = np.random.default_rng(3)
     pixels = rng.integers(0, 256, size=(601, 803, 4), dtype=np.uint8)

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from format_helpers import window_grid
 
+from facaid.formats.ifc import MAX_OPENINGS, WALL_M, procedure_ifc
+from facaid.formats.relief import DEPTHS, MeshTooLarge, procedure_relief
 from facaid.generator import generate
-from facaid.ifc import MAX_OPENINGS, WALL_M, procedure_ifc
-from facaid.relief import DEPTHS, MeshTooLarge, procedure_relief
 
 SCALE = 0.02
 

@@ -11,12 +11,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from facaid import interchange
-from facaid.annotation import as_annotated
 from facaid.cli import main
+from facaid.formats import interchange
+from facaid.formats.annotation import as_annotated
+from facaid.formats.interchange import FORMATS, InterchangeError, format_for_name, load, read, write
 from facaid.generator import generate
 from facaid.grammar import to_segmentation
-from facaid.interchange import FORMATS, InterchangeError, format_for_name, load, read, write
 from facaid.labels import LABEL_ID, LABELS
 from facaid.segmentation import Rect, Segmentation
 
@@ -417,7 +417,7 @@ def test_cli_converts_a_procedure_and_names_the_image(tmp_path):
     assert main(["convert", str(tmp_path / "p.json"), "--out", str(tmp_path / "p.labelme.json"),
                  "--image", "rue-5.jpg"]) == 0
     loaded = load((tmp_path / "p.labelme.json").read_bytes())
-    # an annotation tool's file holds its elements one box each (`facaid.annotation`); our JSON the exact pieces
+    # an annotation tool's file holds its elements one box each (`facaid.formats.annotation`); our JSON the exact pieces
     assert (loaded.segmentation, loaded.image) == (as_annotated(to_segmentation(sample.procedure)), "rue-5.jpg")
     assert main(["convert", str(tmp_path / "p.json"), "--out", str(tmp_path / "p.seg.json"), "--to",
                  "segmentation"]) == 0

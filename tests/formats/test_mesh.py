@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 from format_helpers import window_grid
 
+from facaid.formats.mesh import DEPTHS, procedure_mesh
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import LABEL_ID, PALETTE
-from facaid.mesh import DEPTHS, procedure_mesh
 from facaid.segmentation import rasterize
 
 
@@ -117,7 +117,7 @@ def test_cli_writes_the_obj_and_its_materials(tmp_path, capsys):
 
 
 def test_a_procedure_of_too_many_rectangles_is_refused_with_its_count():
-    from facaid.mesh import MAX_MESH_RECTS, MeshTooLarge
+    from facaid.formats.mesh import MAX_MESH_RECTS, MeshTooLarge
 
     proc = window_grid(200, 60)
     with pytest.raises(MeshTooLarge, match=f"draws 24000 rectangles; a mesh is made of at most {MAX_MESH_RECTS}"):

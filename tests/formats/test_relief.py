@@ -4,10 +4,10 @@ drew it, and its boxes are those rectangles in metres with y up."""
 import numpy as np
 import pytest
 
+from facaid.formats.relief import procedure_relief
 from facaid.generator import generate
 from facaid.grammar.execute import leaf_array
 from facaid.labels import LABELS
-from facaid.relief import procedure_relief
 
 
 @pytest.mark.parametrize("seed", [2, 3, 7])

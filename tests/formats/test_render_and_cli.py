@@ -9,9 +9,9 @@ import pytest
 from PIL import Image
 
 from facaid.cli import main
+from facaid.formats.render import colorize, legend, overlay, render_segmentation, segmentation_svg
 from facaid.generator import generate
 from facaid.labels import LABELS, PALETTE
-from facaid.render import colorize, legend, overlay, render_segmentation, segmentation_svg
 from facaid.segmentation import Segmentation, rasterize
 
 

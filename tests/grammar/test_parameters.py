@@ -6,8 +6,8 @@ import re
 import numpy as np
 import pytest
 
-from facaid.cga import procedure_cga
 from facaid.cli import main
+from facaid.formats.cga import procedure_cga
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.procedure import Node, Procedure, Size

@@ -1,4 +1,4 @@
-"""The decoder step in C (`facaid.native.step`): the same logits as the torch decoder, and a clean fallback."""
+"""The decoder step in C (`facaid.decoding.step`): the same logits as the torch decoder, and a clean fallback."""
 
 import pytest
 import torch
@@ -6,9 +6,9 @@ import torch
 import facaid.native
 from facaid.decoder import DecoderState
 from facaid.decoding import decode
+from facaid.decoding import step as native
 from facaid.generator import generate
 from facaid.model import batch_inputs, batch_outputs
-from facaid.native import step as native
 from facaid.training.surgery import with_box_bias
 
 pytestmark = pytest.mark.skipif(native.library() is None, reason="no C compiler to build the native step")

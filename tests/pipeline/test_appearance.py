@@ -1,11 +1,11 @@
-"""The photo check of completion (`facaid.appearance`, `complete(..., photo)`) on a textured picture made here."""
+"""The photo check of completion (`facaid.photo.appearance`, `complete(..., photo)`) on a textured picture made here."""
 
 import numpy as np
 from PIL import Image
 
-from facaid.appearance import refine, search, similarity
 from facaid.completion import PHOTO_MATCH, complete
 from facaid.labels import FACADE, LABEL_ID
+from facaid.photo.appearance import refine, search, similarity
 from facaid.segmentation import Rect, Segmentation
 
 WINDOW = LABEL_ID["window"]
@@ -87,7 +87,7 @@ def test_with_a_photo_completion_proposes_windows_no_structure_implies():
 def test_levels_of_a_photo_larger_than_the_working_size_answer_in_the_segmentations_pixels():
     """A large photo is read at a smaller scale (`appearance.levels`): the same windows are found and confirmed,
     in the segmentation's pixels."""
-    from facaid.appearance import Levels, levels
+    from facaid.photo.appearance import Levels, levels
 
     boxes = _grid()
     photo = _photo(boxes)
@@ -107,7 +107,8 @@ def test_levels_of_a_photo_larger_than_the_working_size_answer_in_the_segmentati
 def test_completion_searches_the_photo_for_a_bounded_number_of_types(monkeypatch):
     """However many types are drawn, the photo is searched for the `MAX_SEARCH_TYPES` drawn most often (issue 56:
     1,690 types on a 16 MP photo took 135 s)."""
-    from facaid import appearance, completion
+    from facaid import completion
+    from facaid.photo import appearance
 
     calls = []
     real = appearance.search

@@ -15,8 +15,8 @@ from pathlib import Path
 from PIL import Image
 from rest_framework.test import APIClient
 
+from facaid.formats.render import render_segmentation
 from facaid.generator import generate
-from facaid.render import render_segmentation
 
 
 def client_for(user=None) -> APIClient:
@@ -41,11 +41,11 @@ def facade_png(seed: int = 3) -> tuple[bytes, dict]:
 
 
 def photo_like(seed: int = 7):
-    """A PNG photo of a generated facade seen in perspective on a street (`facaid.photolike`) and its true corners
+    """A PNG photo of a generated facade seen in perspective on a street (`facaid.photo.photolike`) and its true corners
     (a (4, 2) array: TL, TR, BR, BL)."""
     import numpy as np
 
-    from facaid.photolike import facade_box, render_photo, warp
+    from facaid.photo.photolike import facade_box, render_photo, warp
 
     g = generate(seed)
     facade = render_photo(g.segmentation, seed).crop(facade_box(g.segmentation))

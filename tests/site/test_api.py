@@ -10,9 +10,9 @@ from format_helpers import window_grid
 from PIL import Image
 from site_helpers import image_bytes, upload
 
-from facaid.cga import procedure_cga
+from facaid.formats.cga import procedure_cga
+from facaid.formats.mesh import procedure_mesh
 from facaid.generator import generate
-from facaid.mesh import procedure_mesh
 from webapp.facades.models import Job
 
 pytestmark = pytest.mark.django_db
@@ -265,7 +265,7 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
 
 
 def test_completion_with_a_unit_proposes_its_copies_in_the_photo(as_alice):
-    """``unit`` in the body: the copies of a window with its sill, found in the photo (`facaid.copies`), each with its
+    """``unit`` in the body: the copies of a window with its sill, found in the photo (`photo.copies`), each with its
     score and the copy it belongs to; a bad unit is a 400 naming it."""
     from photo_helpers import CLOSED, GRID, lattice_photo, sill_of
 

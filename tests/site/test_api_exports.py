@@ -10,7 +10,7 @@ import pytest
 import trimesh
 from format_helpers import window_grid
 
-from facaid.cityjson_check import check_cityjson
+from facaid.formats.cityjson_check import check_cityjson
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import LABEL_ID
@@ -81,7 +81,7 @@ def test_bad_parameters_and_too_large_procedures_are_a_400(procedure, as_alice, 
 
 
 def test_the_page_offers_them_with_their_scale_and_the_photo_only_to_who_sees_it(procedure, as_alice, as_charlie):
-    from facaid.cga import default_scale
+    from facaid.formats.cga import default_scale
 
     page = as_charlie.get(f"/procedures/{procedure.code}").content.decode()
     for name in ("facade.glb", "facade.gltf", "facade.ifc", "facade.city.json"):
@@ -101,8 +101,8 @@ def test_facaid_export_writes_every_site_download(procedure, as_alice, tmp_path,
     from PIL import Image
 
     from facaid.cli import main
-    from facaid.exports import export_for
-    from facaid.interchange import read
+    from facaid.formats.exports import export_for
+    from facaid.formats.interchange import read
     from webapp.facades.downloads import DOWNLOADS
 
     cli = {"procedure.json": ".json", "segmentation.json": ".segmentation.json", "segmentation.coco.json": ".coco.json",
@@ -110,7 +110,7 @@ def test_facaid_export_writes_every_site_download(procedure, as_alice, tmp_path,
            "labels.svg": ".svg", "procedure.cga": ".cga", "mesh.zip": ".obj", "facade.glb": ".glb",
            "facade.gltf": ".gltf", "facade-photo.glb": ".glb", "facade.ifc": ".ifc", "facade.city.json": ".city.json",
            "overlay.png": ".overlay.png"}  # the OBJ and its MTL are zipped there; the textured .glb takes --photo
-    assert set(cli) == set(DOWNLOADS)  # a new download needs its extension here and in facaid.exports
+    assert set(cli) == set(DOWNLOADS)  # a new download needs its extension here and in facaid.formats.exports
     assert all(export_for(f"facade.{name}")[0] == ext for name, ext in cli.items() if name != "mesh.zip")
     source = tmp_path / "p.json"
     source.write_text(json.dumps(procedure.data))

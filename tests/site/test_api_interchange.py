@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from facaid import interchange
-from facaid.annotation import as_annotated
+from facaid.formats import interchange
+from facaid.formats.annotation import as_annotated
 from facaid.generator import generate
 from facaid.grammar import to_segmentation
 from facaid.segmentation import Segmentation

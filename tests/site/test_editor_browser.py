@@ -84,7 +84,7 @@ def test_editor_draw_undo_repeat_save_export(live_server, facade_photo, browser,
 
 
 def test_editor_imports_a_coco_file_of_several_images(live_server, facade_photo, browser, tmp_path):
-    from facaid import interchange
+    from facaid.formats import interchange
     from facaid.segmentation import Segmentation as SegmentationData
 
     photo, _ = facade_photo
@@ -117,7 +117,7 @@ def test_an_annotation_of_the_photo_as_taken_is_carried_through_the_rectificatio
     from editor_helpers import windows_photo
     from site_helpers import upload
 
-    from facaid import interchange
+    from facaid.formats import interchange
     from facaid.segmentation import Rect
     from facaid.segmentation import Segmentation as Drawn
 

@@ -13,8 +13,8 @@ import pytest
 from PIL import Image, ImageOps
 from site_helpers import login
 
+from facaid.formats.render import render_segmentation
 from facaid.generator import generate
-from facaid.render import render_segmentation
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None or shutil.which("redis-server") is None,

@@ -273,8 +273,8 @@ def test_picture_and_tree_select_each_other(live_server, alice, browser, tmp_pat
     """A click on a window in the picture selects its node in the tree (the advanced panel opens on it) and the
     parameters that stand for it, and outlines every copy it draws; a click on a parameter's name or on a node
     outlines what it stands for; a click on no element clears the selection."""
+    from facaid.formats.relief import drawn_leaves
     from facaid.parameters import named_parameters
-    from facaid.relief import drawn_leaves
 
     tree = generate(3).procedure
     proc = Procedure.objects.create(owner=alice, data=tree.to_dict(), visibility="private")

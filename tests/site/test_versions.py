@@ -334,7 +334,7 @@ def _real_like_job(client, structure: str | None = None) -> tuple[Procedure, Job
 
     from grammar_helpers import real_like
 
-    from facaid.render import render_segmentation
+    from facaid.formats.render import render_segmentation
     from tests.site.site_helpers import upload
     from webapp.facades import tasks
 

@@ -29,13 +29,13 @@ from rest_framework.parsers import BaseParser, FormParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
-from facaid import interchange
+from facaid.formats import interchange
+from facaid.formats.relief import MAX_MESH_RECTS, drawn_leaves
 from facaid.grammar import to_segmentation
 from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
 from facaid.parameters import named_parameters, set_parameters
-from facaid.rectify import rectify_file
-from facaid.relief import MAX_MESH_RECTS, drawn_leaves
+from facaid.photo.rectify import rectify_file
 from facaid.variation import vary
 from webapp.facades import access, downloads, pictures, rendering, services, sharing, versions
 from webapp.facades.downloads import DOWNLOADS
@@ -79,7 +79,7 @@ GALLERY_CACHE_SECONDS = 60  # how long an unchanged gallery page stays in a proc
 
 
 class XMLParser(BaseParser):
-    """An XML body (a CVAT file) as its bytes, for `facaid.interchange` to read without DTDs."""
+    """An XML body (a CVAT file) as its bytes, for `facaid.formats.interchange` to read without DTDs."""
 
     media_type = "application/xml"
 
@@ -203,7 +203,7 @@ def photo_rectify(request, code):
 
 @extend_schema(request=None, responses={200: dict},
                summary="Propose the facade's four corners from the photo's lines and vanishing points "
-                       "(facaid.rectify.propose_corners): {'corners': [[x, y] x 4] (top-left, top-right, bottom-right, "
+                       "(rectify.propose_corners): {'corners': [[x, y] x 4] (top-left, top-right, bottom-right, "
                        "bottom-left, in the original photo's pixels, as rectify takes them), 'confidence' (0..1: the "
                        "share of the four sides that detected lines cover), 'notes', 'lines'}; nothing is stored")
 @api_view(["POST"])

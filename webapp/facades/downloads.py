@@ -12,16 +12,16 @@ from dataclasses import dataclass
 from PIL import Image
 from rest_framework.exceptions import ValidationError
 
-from facaid import interchange
-from facaid.annotation import written_as
-from facaid.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
-from facaid.cityjson import cityjson_text, procedure_cityjson
-from facaid.gltf import procedure_gltf
+from facaid.formats import interchange
+from facaid.formats.annotation import written_as
+from facaid.formats.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
+from facaid.formats.cityjson import cityjson_text, procedure_cityjson
+from facaid.formats.gltf import procedure_gltf
+from facaid.formats.ifc import procedure_ifc
+from facaid.formats.mesh import MeshTooLarge, procedure_mesh
+from facaid.formats.render import segmentation_svg
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
-from facaid.ifc import procedure_ifc
-from facaid.mesh import MeshTooLarge, procedure_mesh
-from facaid.render import segmentation_svg
 from webapp.facades import rendering
 from webapp.facades.models import Procedure
 from webapp.facades.serializers import parse_procedure
@@ -134,7 +134,7 @@ def _gltf(binary: bool, photo: bool = False) -> Callable[[Procedure, Tree, float
         if not photo:
             return procedure_gltf(tree, scale, binary=binary, scale_from=source, name=proc.title or stem(proc))
         drawn = proc.photo.image if drawn_on_original(proc) else proc.photo.working_image()
-        with drawn.open("rb") as f:  # read as the texture needs it (`facaid.gltf._add_photo`), not at full size first
+        with drawn.open("rb") as f:  # read as the texture needs it (`gltf._add_photo`), not at full size first
             return procedure_gltf(tree, scale, binary=binary, photo=Image.open(f), scale_from=source,
                                   name=proc.title or stem(proc))
     return write
@@ -160,7 +160,7 @@ def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
 
 
 def _annotations(fmt: str) -> Callable[[Procedure, Tree, Params], bytes]:
-    """The elements it draws as another tool's annotations, one box each (`facaid.annotation.written_as`), of the
+    """The elements it draws as another tool's annotations, one box each (`annotation.written_as`), of the
     label map downloaded beside them."""
     return lambda proc, tree, params: interchange.write(written_as(to_segmentation(tree), fmt), fmt,
                                                         image=f"{stem(proc)}-labels.png")

@@ -12,10 +12,10 @@ import io
 import numpy as np
 from PIL import Image
 
+from facaid.formats.render import colorize
 from facaid.grammar import Procedure as Tree
 from facaid.labels import PRIORITY
 from facaid.metrics import scaled_procedure_map
-from facaid.render import colorize
 from facaid.segmentation import Segmentation as SegmentationData
 
 MAX_RENDER_SIDE = 2048

@@ -7,8 +7,8 @@ from django.contrib.auth.models import AnonymousUser
 from django.http import QueryDict
 from rest_framework import serializers
 
-from facaid import interchange
 from facaid.defaults import DEFAULT_K, MAX_K, STRUCTURES
+from facaid.formats import interchange
 from facaid.grammar import Procedure as ProcedureTree
 from facaid.grammar.procedure import MAX_NODES, ProcedureError
 from facaid.numbers import finite

@@ -15,11 +15,12 @@ from django.utils import timezone
 from PIL import Image
 from rest_framework.exceptions import APIException, ValidationError
 
-from facaid import appearance, interchange
 from facaid.completion import RejectedError, complete
-from facaid.copies import UnitError, find_copies
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE
-from facaid.rectify import propose_corners_file
+from facaid.formats import interchange
+from facaid.photo import appearance
+from facaid.photo.copies import UnitError, find_copies
+from facaid.photo.rectify import propose_corners_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
 from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility, check_quota
@@ -39,7 +40,7 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
 
 
 def propose_corners(photo: Photo) -> dict:
-    """The facade's four corners proposed from the original photo's lines (`facaid.rectify.propose_corners`), in
+    """The facade's four corners proposed from the original photo's lines (`facaid.photo.rectify.propose_corners`), in
     its pixels, as `rectify` takes them; nothing is stored."""
     with _readable(photo.image) as f:
         return propose_corners_file(f)
@@ -61,7 +62,7 @@ def _working_size(photo: Photo) -> tuple[int, int]:
 
 def _foreign(data) -> bool:
     """Is ``data`` another tool's file (COCO, LabelMe, CVAT) rather than the segmentation contract's JSON?"""
-    if isinstance(data, bytes | str):  # a file's content: facaid.interchange reads it, or says why not
+    if isinstance(data, bytes | str):  # a file's content: facaid.formats.interchange reads it, or says why not
         return True
     try:
         return interchange.detect(data) != "segmentation"
@@ -148,7 +149,7 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
     segmentation JSON, optionally with ``rejected`` (rectangles not to propose again), ``min_score`` and
     ``use_photo`` (default true: the photo the segmentation is drawn on confirms or rejects each proposal). With
     ``unit`` (indices of its rectangles: a window and what is drawn around it), the copies of that unit the photo
-    shows instead (`facaid.copies.find_copies`)."""
+    shows instead (`facaid.photo.copies.find_copies`)."""
     seg = _segmentation_of(photo, data, "segmentation").segmentation
     rejected = data.get("rejected") or []
     unit = data.get("unit")

@@ -13,8 +13,8 @@ from django.shortcuts import redirect, render
 from django.views.decorators.http import require_POST
 from rest_framework.exceptions import ValidationError
 
-from facaid.cga import MAX_SCALE
 from facaid.defaults import DEFAULT_K, MAX_K
+from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
 from webapp.facades import access, example, jsonbody, services, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale

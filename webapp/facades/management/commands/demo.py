@@ -1,5 +1,5 @@
 """``python manage.py demo``: a demo account with a demo facade photo (a photo-like picture of a generated facade,
-`facaid.photolike`), its segmentation and a queued reconstruction (the worker turns it into a public procedure,
+`facaid.photo.photolike`), its segmentation and a queued reconstruction (the worker turns it into a public procedure,
 the front page's example: `webapp.facades.example`). Does nothing if the account exists."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from django.core.management.base import BaseCommand
 
 from facaid.defaults import DEFAULT_K
 from facaid.generator import generate
-from facaid.photolike import render_photo
+from facaid.photo.photolike import render_photo
 from webapp.facades import jobs
 from webapp.facades.example import DEMO_PASSWORD, DEMO_USERNAME
 from webapp.facades.models import Photo, Segmentation, Visibility

@@ -38,8 +38,8 @@ def _json(proc, path, scale, photo):
 
 
 def _png(proc, path, scale, photo):
+    from facaid.formats.render import render_segmentation
     from facaid.grammar.execute import to_segmentation
-    from facaid.render import render_segmentation
 
     render_segmentation(to_segmentation(proc)).save(path, "PNG")
     return [path]
@@ -47,9 +47,9 @@ def _png(proc, path, scale, photo):
 
 def _segmentation(fmt: str):
     def write(proc, path, scale, photo):
-        from facaid.annotation import written_as
+        from facaid.formats.annotation import written_as
+        from facaid.formats.interchange import write as write_annotations
         from facaid.grammar.execute import to_segmentation
-        from facaid.interchange import write as write_annotations
 
         picture = path.name[: -len(export_for(path)[0])] + ".png"  # the label map `--out NAME.png` writes beside it
         return _text(path, write_annotations(written_as(to_segmentation(proc), fmt), fmt, image=picture))
@@ -57,8 +57,8 @@ def _segmentation(fmt: str):
 
 
 def _overlay(proc, path, scale, photo):
+    from facaid.formats.render import overlay
     from facaid.grammar.execute import to_segmentation
-    from facaid.render import overlay
     from facaid.segmentation import rasterize
 
     overlay(photo, rasterize(to_segmentation(proc))).save(path, "PNG")
@@ -66,20 +66,20 @@ def _overlay(proc, path, scale, photo):
 
 
 def _svg(proc, path, scale, photo):
+    from facaid.formats.render import segmentation_svg
     from facaid.grammar.execute import to_segmentation
-    from facaid.render import segmentation_svg
 
     return _text(path, segmentation_svg(to_segmentation(proc)))
 
 
 def _cga(proc, path, scale, photo):
-    from facaid.cga import procedure_cga
+    from facaid.formats.cga import procedure_cga
 
     return _text(path, procedure_cga(proc, scale, name=path.name))
 
 
 def _obj(proc, path, scale, photo):
-    from facaid.mesh import procedure_mesh
+    from facaid.formats.mesh import procedure_mesh
 
     mtl = path.with_suffix(".mtl")
     obj, materials = procedure_mesh(proc, scale, mtl_name=mtl.name)
@@ -88,20 +88,20 @@ def _obj(proc, path, scale, photo):
 
 def _gltf(binary: bool):
     def write(proc, path, scale, photo):
-        from facaid.gltf import procedure_gltf
+        from facaid.formats.gltf import procedure_gltf
 
         return _text(path, procedure_gltf(proc, scale, binary=binary, photo=photo, name=path.name))
     return write
 
 
 def _ifc(proc, path, scale, photo):
-    from facaid.ifc import procedure_ifc
+    from facaid.formats.ifc import procedure_ifc
 
     return _text(path, procedure_ifc(proc, scale, name=path.name))
 
 
 def _cityjson(proc, path, scale, photo):
-    from facaid.cityjson import cityjson_text, procedure_cityjson
+    from facaid.formats.cityjson import cityjson_text, procedure_cityjson
 
     return _text(path, cityjson_text(procedure_cityjson(proc, scale, name=path.name)))
 

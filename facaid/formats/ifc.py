@@ -1,7 +1,7 @@
 """A procedure as IFC4 (with IfcOpenShell): the facade as a wall with its windows and doors, for BIM tools.
 
 The wall (`IfcWall`) spans the procedure's elements (background left out), `WALL_M` thick, its outer face in the
-plane y = 0 facing -y, x along the facade and z up, in metres at the relief's scale (`facaid.relief`). Each window,
+plane y = 0 facing -y, x along the facade and z up, in metres at the relief's scale (`relief`). Each window,
 door and shop front is an `IfcOpeningElement` through the wall, voiding it, filled by an `IfcWindow` or `IfcDoor`
 of the opening's size (`OverallWidth`, `OverallHeight`), set back by its label's depth; shop fronts are windows of
 the user-defined type "shop front". Every filling carries its label and its node's path in the tree in the
@@ -11,8 +11,8 @@ description). The other elements (cornices, balconies, ...) are in the glTF, OBJ
 
 from __future__ import annotations
 
+from facaid.formats.relief import DEPTHS, MeshTooLarge, procedure_relief
 from facaid.grammar.procedure import Procedure
-from facaid.relief import DEPTHS, MeshTooLarge, procedure_relief
 
 WALL_M = 0.3  # the wall's thickness
 PANE_M = 0.06  # a window's or a door's thickness
@@ -64,8 +64,8 @@ class _Writer:
 
 def procedure_ifc(proc: Procedure, scale: float | None = None, scale_from: str = "", name: str = "") -> str:
     """The procedure as an IFC4 file's text (see the module's docstring); ``scale`` in metres per pixel (default
-    `facaid.cga.default_scale`) with ``scale_from``, where it came from; ``name`` names the project.
-    `facaid.relief.MeshTooLarge` for a procedure of too many rectangles or openings, a ValueError for a bad
+    `facaid.formats.cga.default_scale`) with ``scale_from``, where it came from; ``name`` names the project.
+    `facaid.formats.relief.MeshTooLarge` for a procedure of too many rectangles or openings, a ValueError for a bad
     scale."""
     import ifcopenshell.guid  # a large library: imported when an IFC is written
     from ifcopenshell import api

@@ -1,9 +1,9 @@
 """Find copies: where a drawn unit (a window with its sill, blind, hood, balcony) repeats in the photo.
 
 A person selects one unit and asks for its copies (the editor's "Find copies", ``unit`` in the API's completion,
-``facaid complete --unit``). The photo's repeats (`facaid.repeats.unit_copies`) carry the unit along the shifts
+``facaid complete --unit``). The photo's repeats (`facaid.photo.repeats.unit_copies`) carry the unit along the shifts
 that it and the other drawn elements vote for; a copy is proposed where the unit's largest element looks like itself
-(normalised cross-correlation on the contrast-normalised photo, at least `facaid.repeats.MATCH`), with the rest of
+(normalised cross-correlation on the contrast-normalised photo, at least `facaid.photo.repeats.MATCH`), with the rest of
 the unit around it. Each proposal has the ``score`` of its copy (that NCC: 1 is the same picture), the ``copy`` it
 belongs to (its unit's elements share it) and the reason ``copy of the unit``. The checks of completion apply:
 nothing outside the drawn facade, over a drawn element of its class or near a rejected box.
@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from facaid import appearance, repeats
 from facaid.completion import proposals_for
 from facaid.defaults import DEFAULT_MIN_COPY
 from facaid.labels import BACKGROUND, FACADE, LABELS
+from facaid.photo import appearance, repeats
 from facaid.segmentation import Segmentation
 
 

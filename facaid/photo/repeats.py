@@ -13,7 +13,7 @@ that make up its lattice are found by voting (after Pauly et al. 2008, "Discover
 4. Every drawn element is carried by every repeat to where the photo looks most like it (`JITTER` around), and
    is as alike as the lower of its NCC with its wall and without: what a window's wall shares with the wall
    between two windows does not make that wall a window. `facaid.completion` proposes the carried elements that
-   stand in a drawn row or column of their class; `facaid.copies` carries one unit a person selected.
+   stand in a drawn row or column of their class; `facaid.photo.copies` carries one unit a person selected.
 
 Pillars and moldings are not carried (`CARRIED`): along their length they look like themselves anywhere. The work
 of a call is bounded: the photo at `SIDE`, `MAX_VOTERS` voters, `MAX_CARRIES` elements carried by a repeat.
@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from facaid.appearance import FLAT, Levels
 from facaid.labels import LABEL_ID
+from facaid.photo.appearance import FLAT, Levels
 
 SIDE = 512  # pixels: the photo is read at this longer side (or its own, when smaller)
 SIGMA = 0.02  # the neighbourhood of the contrast normalisation, a share of the working side

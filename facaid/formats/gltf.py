@@ -1,7 +1,7 @@
 """A procedure as glTF 2.0 (a binary .glb, or a .gltf text with its data inline): the relief facade for 3D tools,
 game engines and the web.
 
-The scene's root node ``facade`` holds one child node per element of the relief (`facaid.relief`), named for its
+The scene's root node ``facade`` holds one child node per element of the relief (`facaid.formats.relief`), named for its
 label and numbered, its ``extras`` carrying the label, its node's path in the tree (``root/1/0``) and its rectangle
 in the procedure's pixels. Elements of one label and size are instances of one mesh (a repeat's windows: one mesh
 and many nodes, each moved into place); a mesh is the element's front and, where it sits back or stands out, the
@@ -21,9 +21,9 @@ import numpy as np
 import pygltflib as gl
 from PIL import Image
 
+from facaid.formats.relief import DEPTHS, NORMALS, Relief, box_quads, procedure_relief
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABELS, PALETTE
-from facaid.relief import DEPTHS, NORMALS, Relief, box_quads, procedure_relief
 
 MAX_TEXTURE = 4096  # pixels on the photo's longer side: what every GPU takes
 PHOTO = -1  # the key of the photo's material
@@ -65,8 +65,8 @@ class _Data:
 def procedure_gltf(proc: Procedure, scale: float | None = None, *, binary: bool = True,
                    photo: Image.Image | None = None, scale_from: str = "", name: str = "") -> bytes:
     """The procedure as a .glb (``binary``) or .gltf (see the module's docstring); ``scale`` in metres per pixel
-    (default `facaid.cga.default_scale`) with ``scale_from``, where it came from; ``photo``: the rectified photo
-    to show on the fronts (it covers the whole facade). `facaid.relief.MeshTooLarge` for a procedure of too many
+    (default `facaid.formats.cga.default_scale`) with ``scale_from``, where it came from; ``photo``: the rectified photo
+    to show on the fronts (it covers the whole facade). `facaid.formats.relief.MeshTooLarge` for a procedure of too many
     rectangles, a ValueError for a bad scale."""
     relief = procedure_relief(proc, scale, scale_from)
     gltf = gl.GLTF2()

@@ -4,7 +4,7 @@ Every rectangle of the executed procedure (whole pixels, as labels.png paints th
 behind the wall plane by its label's depth: windows, doors and shop fronts sit back, cornices, sills, moldings,
 pillars and balconies stand out, and the wall is the plane itself. Each box has its front face and the four sides
 that join it to the wall plane (facing out of a protrusion, into a recess: a window's reveals). Background makes
-no geometry. Units are metres (the scale of `facaid.cga.default_scale` unless given), x to the right, y up, z
+no geometry. Units are metres (the scale of `facaid.formats.cga.default_scale` unless given), x to the right, y up, z
 towards the viewer, so the facade stands upright in Blender's and most tools' default OBJ import; one material
 per label, in the palette's colours.
 """
@@ -15,9 +15,9 @@ import io
 
 import numpy as np
 
+from facaid.formats.relief import DEPTHS, MAX_MESH_RECTS, NORMALS, MeshTooLarge, box_quads, procedure_relief
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABELS, PALETTE
-from facaid.relief import DEPTHS, MAX_MESH_RECTS, NORMALS, MeshTooLarge, box_quads, procedure_relief
 
 __all__ = ["DEPTHS", "MAX_MESH_RECTS", "MeshTooLarge", "procedure_mesh"]
 
@@ -25,7 +25,7 @@ __all__ = ["DEPTHS", "MAX_MESH_RECTS", "MeshTooLarge", "procedure_mesh"]
 def procedure_mesh(proc: Procedure, scale: float | None = None, mtl_name: str = "facade.mtl",
                    scale_from: str = "") -> tuple[str, str]:
     """The OBJ text and the MTL text (the OBJ names it ``mtl_name``); ``scale`` in metres per pixel (default
-    `facaid.cga.default_scale`), stated in the OBJ's header with ``scale_from``, where it came from."""
+    `facaid.formats.cga.default_scale`), stated in the OBJ's header with ``scale_from``, where it came from."""
     relief = procedure_relief(proc, scale, scale_from)
     rows = relief.rows
     out = io.StringIO()

@@ -5,7 +5,7 @@ completion's photo checks) without shipping photos.
 reflections, shutters with slats, shadows under sills and cornices, light falling off across the facade, sensor
 noise and a little blur; the background class is sky. `warp(image, seed)` puts such a picture into a larger scene
 as a camera would see it (a homography of the rectangle: keystone, yaw, a little roll) and returns the true
-corners, in the order `facaid.rectify.rectify` takes them, so that a test knows where the facade is.
+corners, in the order `facaid.photo.rectify.rectify` takes them, so that a test knows where the facade is.
 Everything is deterministic by seed.
 """
 
@@ -15,7 +15,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFilter
 
 from facaid.labels import LABEL_ID, LABELS
-from facaid.rectify import homography
+from facaid.photo.rectify import homography
 from facaid.segmentation import Segmentation, rasterize
 
 WALLS = ((205, 190, 165), (176, 98, 72), (150, 150, 148), (222, 214, 196), (196, 160, 96), (120, 112, 104))

@@ -3,7 +3,7 @@
 Every rectangle of the executed procedure (whole pixels, as labels.png paints them) is an element: a box in front of
 or behind the wall plane by its label's depth (windows, doors and shop fronts sit back, cornices, sills, moldings,
 pillars and balconies stand out, the wall is the plane itself). Background is no element. Units are metres at the
-scale of `facaid.cga.default_scale` unless given, x to the right, y up, z towards the viewer.
+scale of `facaid.formats.cga.default_scale` unless given, x to the right, y up, z towards the viewer.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from facaid.cga import STOREY_M, checked_scale
+from facaid.formats.cga import STOREY_M, checked_scale
 from facaid.grammar.execute import execute_with_nodes, leaf_rows
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABELS
@@ -66,7 +66,7 @@ class Relief:
 
 
 def procedure_relief(proc: Procedure, scale: float | None = None, scale_from: str = "") -> Relief:
-    """The relief of ``proc`` at ``scale`` metres per pixel (default `facaid.cga.default_scale`); ``scale_from``
+    """The relief of ``proc`` at ``scale`` metres per pixel (default `facaid.formats.cga.default_scale`); ``scale_from``
     says where a given scale came from ("given" if empty). `MeshTooLarge` past `MAX_MESH_RECTS` elements, a
     ValueError for a bad scale."""
     given = scale is not None

@@ -4,7 +4,7 @@ cjval, the CityJSON project's validator, is a Rust program; its Python bindings 
 platform and `cjio validate` needs them, so FaçAID ships the checks a person would run:
 
 - errors: the JSON syntax; the official schema of the file's version, CityJSON 2.0.2 or 1.0.3 (the minified
-  schema files of github.com/cityjson/specs, CC0, in `facaid/schemas/`), which names every unknown city object or
+  schema files of github.com/cityjson/specs, CC0, in `schemas/` here), which names every unknown city object or
   semantic type, a missing member and a wrong LoD; then, as cjval, vertex indices out of range, semantics arrays
   whose shape is not the geometry's, and parents and children that do not name each other;
 - warnings, as cjval: duplicate vertices and unused vertices.
@@ -74,7 +74,7 @@ def _by_type(node: Any) -> Any:
 def _validator(version: str):
     import jsonschema_rs
 
-    schema = json.loads((files("facaid") / "schemas" / SCHEMAS[version]).read_text())
+    schema = json.loads((files("facaid.formats") / "schemas" / SCHEMAS[version]).read_text())
     return jsonschema_rs.validator_for(_by_type(schema))
 
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 from PIL import Image
 
-from facaid.vanishing import (
+from facaid.photo.vanishing import (
     Family,
     affine_frame,
     apply,

@@ -1,6 +1,6 @@
 """A procedure as CityJSON (2.0, or 1.0 for older tools): the facade as an LoD3 building for GIS and city models.
 
-One `Building` whose LoD3 `MultiSurface` is the relief (`facaid.relief`): every element's front and the sides
+One `Building` whose LoD3 `MultiSurface` is the relief (`facaid.formats.relief`): every element's front and the sides
 that join it to the wall plane, each a rectangle wound counter-clockwise seen from outside. Each window and shop
 front is a `Window` semantic surface of its own and each door a `Door` (its label, and its node's path in the
 tree, beside its type); everything else, reveals included, is a `WallSurface`, one per label. Coordinates are local
@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
+from facaid.formats.relief import DEPTHS, box_quads, procedure_relief
 from facaid.grammar.procedure import Procedure
-from facaid.relief import DEPTHS, box_quads, procedure_relief
 
 VERSIONS = ("2.0", "1.0")
 OPENINGS = {"window": "Window", "shop": "Window", "door": "Door"}  # label -> semantic surface; else WallSurface
@@ -26,8 +26,8 @@ UNIT = 0.001  # metres per integer of the vertices: millimetres, or finer for a 
 def procedure_cityjson(proc: Procedure, scale: float | None = None, scale_from: str = "", name: str = "",
                        version: str = "2.0") -> dict:
     """The procedure as a CityJSON object (see the module's docstring) of ``version`` (`VERSIONS`); ``scale`` in
-    metres per pixel (default `facaid.cga.default_scale`) with ``scale_from``, where it came from; ``name`` titles
-    it. `facaid.relief.MeshTooLarge` for a procedure of too many rectangles, a ValueError for a bad scale."""
+    metres per pixel (default `cga.default_scale`) with ``scale_from``, where it came from; ``name`` titles
+    it. `relief.MeshTooLarge` for a procedure of too many rectangles, a ValueError for a bad scale."""
     if version not in VERSIONS:
         raise ValueError(f"CityJSON version must be one of {', '.join(VERSIONS)}, got {version!r}")
     relief = procedure_relief(proc, scale, scale_from)
