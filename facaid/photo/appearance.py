@@ -14,6 +14,8 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
+from facaid.photo.files import open_photo
+
 PATCH = 12  # side of the patches compared: a window's panes and frame at any size, little of the noise
 FLAT = 0.5  # grey levels: a patch whose spread is below this (a flat colour, a render) has no appearance
 
@@ -70,10 +72,8 @@ def levels(photo: Any, width: int, height: int, max_pixels: int = WORK_PIXELS) -
     elif isinstance(photo, Image.Image):
         image = photo.convert("L")
     else:
-        with Image.open(photo) as opened:
-            if s < 1:  # a large JPEG decodes at a reduced scale (at scale 1 the decode is the full one, as before)
-                opened.draft("L", (tw, th))
-            image = opened.convert("L")
+        # upright as a viewer shows it; a large JPEG decodes at a reduced scale (at scale 1, the full decode)
+        image = open_photo(photo, draft=(tw, th) if s < 1 else None, grey=True)
     if image.size != (tw, th):
         image = image.resize((tw, th), Image.Resampling.BILINEAR)
     return Levels(np.asarray(image, dtype=np.float32), (tw / width, th / height))

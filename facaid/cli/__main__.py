@@ -1,0 +1,5 @@
+import sys
+
+from facaid.cli import main
+
+sys.exit(main())
