@@ -192,6 +192,11 @@ def _margins(proc: Procedure, inst: _Instances) -> list[tuple[str, Node]]:
     return out
 
 
+def _most_laid_out(inst: _Instances, nodes: list[tuple[str, Node]]) -> Node:
+    """Of these nodes, the one laid out most often (the first of those): whose size a parameter shows."""
+    return max(nodes, key=lambda pn: inst.count[id(pn[1])])[1]
+
+
 def named_parameters(proc: Procedure) -> list[Parameter]:
     """The named parameters this procedure has (those whose roles it holds), in `NAMES` order."""
     inst = _Instances(proc)
@@ -204,8 +209,8 @@ def named_parameters(proc: Procedure) -> list[Parameter]:
     for name, (label, role, axis) in _LENGTHS.items():
         nodes = [(p, n) for p, n in proc.nodes() if n.role == role and inst.outer.get(id(n))
                  and inst.parent_axis[id(n)] == axis]
-        if nodes:
-            w, h = inst.extent[id(nodes[0][1])]
+        if nodes:  # the size of the most repeated (a floor's tile, not the attic's)
+            w, h = inst.extent[id(_most_laid_out(inst, nodes))]
             out.append(Parameter(name, label, round(w if axis == "x" else h, 2), "px", False, 1.0, MAX_EXTENT,
                                  [p for p, _ in nodes]))
         if name == "ground_height" and (bays := _bays(proc, inst)):
@@ -369,8 +374,11 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             if id(node) not in inst.extent:  # a row an exception replaces wherever it would be laid out
                 continue
             delta = change
-            if name == "bays":  # rows of another length change in proportion, by one at least
-                delta = round(change * node.count / p.value) or (1 if change > 0 else -1 if change < 0 else 0)
+            if name == "bays":  # rows of other tiles change in proportion (3 attic tiles over 7 bays: +1 bay is
+                # +0.43 of theirs, so none: they widen with the facade, as they would with a tile of their own)
+                delta = round(change * node.count / p.value)
+                if delta == 0:
+                    continue
             new = node.count + delta
             if not 1 <= new <= MAX_COUNT:
                 raise ValueError(f"{name} {value:g} needs a repeat of {new} copies (1 to {MAX_COUNT})")

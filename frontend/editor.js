@@ -44,7 +44,11 @@ async function load() {
   buildPalette($("#palette"), pickLabel);
   pickLabel(ui.label);
   changed();
-  if (location.hash === "#rectify") await openRectify();  // the photo page's "Rectify it in the editor"
+  if (sessionStorage.getItem("facaid-rectified") === photoCode) {
+    sessionStorage.removeItem("facaid-rectified");
+    status(`Rectified: this is the rectified photo, ${photo.naturalWidth}×${photo.naturalHeight} px. Draw its ` +
+           "elements on it; Rectify again starts from the original.", "success");
+  } else if (location.hash === "#rectify") await openRectify();  // the photo page's "Rectify it in the editor"
 }
 
 function changed() {
@@ -55,7 +59,7 @@ function changed() {
   $("#dirty").textContent = history.dirty ? "unsaved changes" : "saved";
   const twice = identical([...seg.rects.values()]);
   const note = layersNote(ui.layers);
-  $("#count").textContent = `${seg.size} rectangles, ${ui.selection.size} selected` + (note ? ` · ${note}` : "") +
+  $("#count").textContent = `${seg.size} rectangle${seg.size === 1 ? "" : "s"}, ${ui.selection.size} selected` + (note ? ` · ${note}` : "") +
     (twice.length ? " · " + twice.map((t) => `${t.count} identical ${t.label} rectangles`).join(", ") +
     " (delete the copies)" : "");
   $("#count").classList.toggle("warning", twice.length > 0);
@@ -363,7 +367,7 @@ async function findCopies() {
   await propose({...drawn, unit}, drawn, "find copies", (n, copies) => n
     ? `${copies} copies of the unit (${n} proposals), scored by how alike they look: click one to reject its copy, ` +
       "a row's or column's chip to reject all of it (Shift: add it alone), Enter or \"Accept\" to add the rest."
-    : "No copies of the unit found in the photo.");
+    : `No copies of the unit found in the photo${rejectedNote()}.`);
 }
 
 // completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
@@ -371,8 +375,13 @@ async function completeNow() {
   const drawn = seg.toJSON();
   await propose({...drawn}, drawn, "complete", (n) => n ? `${n} proposals: click one to ` +
     'reject it, Shift+click to add it alone, Enter or "Accept" to add the rest.'
-    : "Nothing to propose yet: draw a few elements of a row and a column.");
+    : `Nothing to propose yet: draw a few elements of a row and a column${rejectedNote()}.`);
 }
+
+// the places rejected before are never proposed again in this session: said where nothing comes back
+const rejectedNote = () => ui.rejected.length
+  ? ` (${ui.rejected.length} place${ui.rejected.length === 1 ? "" : "s"} you rejected before ` +
+    `${ui.rejected.length === 1 ? "is" : "are"} not proposed again)` : "";
 
 // one request for proposals at a time; those shown stay until the answer replaces them (the rejected ones are
 // remembered and passed back), unless the drawing changed meanwhile
@@ -403,6 +412,8 @@ function acceptProposals() {
   const cmd = acceptCommand(ui.proposals, ui.proposalsFrom);
   ui.proposals = [];
   if (cmd) run(cmd);
+  status(cmd ? `Added ${cmd.records.length} proposal${cmd.records.length === 1 ? "" : "s"}.` : "Nothing was added: " +
+    "every proposal was rejected.", cmd ? "success" : "");
   changed();
 }
 
@@ -499,7 +510,9 @@ async function applyRectify() {
     }
     await rectify(api, photoCode, rectifying.corners);
     history.markSaved();
-    location.reload();
+    // the editor anew on the rectified photo, saying so; without the #rectify that opened the step
+    sessionStorage.setItem("facaid-rectified", photoCode);
+    location.replace(location.pathname + location.search);
   } catch (err) {
     status(`Not rectified: ${err.message}`, "error");
   }

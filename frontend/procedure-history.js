@@ -79,8 +79,11 @@ export function mountHistory({code, owner, csrf}) {
     }
     patientImage(document.getElementById("compare-diff"), body.overlay);
     document.getElementById("compare-diff").style.width = "100%";
+    const [sa, sb] = [body.a, body.b].map((v) => `${Math.round(v.width)}×${Math.round(v.height)}`);
     document.getElementById("compare-diff-caption").textContent =
-      `in magenta, ${(100 * body.differing).toFixed(2)} % of the pixels: their label differs`;
+      `in magenta, ${(100 * body.differing).toFixed(2)} % of the pixels: their label differs` + (sa === sb ? ""
+        : ` (the two are of different sizes, ${sa} and ${sb} px: laid over each other from the top left, what ` +
+          "one has beyond the other counts as differing)");
     document.getElementById("comparison").hidden = false;
     status.textContent = "";
   }

@@ -328,6 +328,7 @@ function scheduleRender() {
       document.getElementById("render").src = url;
       const overlay = document.getElementById("overlay");
       if (overlay) overlay.src = url;
+      fitOverlay();
       const saved = document.getElementById("saved");
       if (saved) saved.textContent = "unsaved changes";
       if (namedStale) { namedStale = false; askNamed(); }
@@ -432,8 +433,15 @@ document.getElementById("vary").addEventListener("click", async () => {
       leaves = [];  // until the server says where the variant draws them
       keepSelection();
       drawTree();
-      askNamed();
       scheduleRender();
+      // the variant is now the picture and the parameters above: shown there, and said
+      document.getElementById("render").scrollIntoView({behavior: "smooth", block: "start"});
+      const keep = script.dataset.owner === "1" ? "save it as a new version, or as a new procedure (Advanced)"
+        : script.dataset.user === "1" ? "save it as a procedure of your own (Advanced)" : "log in to keep it";
+      askNamed().then(() => {
+        document.getElementById("named-status").textContent = `Loaded the variant ${caption.textContent}: ` +
+          `change it, then ${keep}.`;
+      });
     });
     card.append(img, caption, use);
     if (script.dataset.user === "1") {
@@ -446,7 +454,23 @@ document.getElementById("vary").addEventListener("click", async () => {
   }
 });
 
+// The overlay lays the procedure over its photo only while the two have one size: a tree resized by an edit (a
+// floor more) would be stretched over the photo, so it is hidden, and the note says why.
+function fitOverlay() {
+  const box = document.getElementById("overlay-box");
+  if (!box) return;
+  const [w, h] = [Math.round(proc.width), Math.round(proc.height)];
+  const [pw, ph] = [Number(box.dataset.photoWidth), Number(box.dataset.photoHeight)];
+  const fits = w === pw && h === ph;
+  document.getElementById("overlay").hidden = !fits;
+  const note = document.getElementById("overlay-note");
+  note.hidden = fits;
+  note.textContent = fits ? "" : `This procedure is ${w}×${h} px and its photo ${pw}×${ph}: the overlay shows a ` +
+    "procedure of the photo's size, so it is hidden (an edit of the parameters resized it).";
+}
+
 drawTree();
+fitOverlay();
 askNamed();
 versions.refresh().then(() => {
   // a re-run that fits worse is shown beside the version it continued

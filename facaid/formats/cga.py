@@ -119,12 +119,15 @@ def _camel(word: str) -> str:
 
 
 MIN_PART_M = 0.01  # no part of a split is written shorter than this: it goes to its neighbour
+ROUNDING = 0.006  # pixels: a named length is given to 2 decimals (`facaid.parameters`)
 
 
 def _attributes(proc: Procedure, boxes: dict, scale: float) -> tuple[list[tuple[str, str, float, float, float]],
                                                                       dict[int, str]]:
     """The named lengths (`facaid.parameters`) as CGA attributes: (name, label, metres, low, high) each, and the
-    nodes whose size is that attribute (those whose length is the parameter's, within half a pixel)."""
+    nodes whose size is that attribute: those whose length is the parameter's to its rounding (a hundredth of a
+    pixel); one a fraction of a pixel off keeps its own length, as a floating size beside others would otherwise
+    share its split in other proportions than the procedure's."""
     from facaid.parameters import AXES, named_parameters
 
     attrs, uses = [], {}
@@ -136,7 +139,7 @@ def _attributes(proc: Procedure, boxes: dict, scale: float) -> tuple[list[tuple[
         # a node's length is written in its parent's split: only where that split runs along the parameter's axis
         used = [id(nodes[path]) for path in p.nodes if path != "root"
                 and nodes[path.rsplit("/", 1)[0]].axis == AXES[p.name]]
-        used = [key for key in used if abs(boxes[key][axis + 2] - boxes[key][axis] - p.value) <= 0.5]
+        used = [key for key in used if abs(boxes[key][axis + 2] - boxes[key][axis] - p.value) <= ROUNDING]
         if not used:
             continue
         metres = p.value * scale

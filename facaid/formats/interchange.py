@@ -137,9 +137,32 @@ def write(seg: Segmentation, format: str, *, image: str = "facade.png") -> bytes
 
 # --- reading: the document, its parts -----------------------------------------------------------------------------
 
+KINDS = ((b"\xff\xd8\xff", "a JPEG image"), (b"\x89PNG", "a PNG image"), (b"GIF8", "a GIF image"),
+         (b"%PDF", "a PDF document"), (b"PK\x03\x04", "a ZIP archive"), (b"II*\x00", "a TIFF image"),
+         (b"MM\x00*", "a TIFF image"), (b"BM", "a BMP image"))
+WANTED = "annotations are our segmentation JSON, COCO or LabelMe JSON, or CVAT XML (docs/interchange.md)"
+
+
+def not_annotations(data: bytes | str) -> str | None:
+    """Where ``data`` is plainly no annotation file (an image, a PDF, a ZIP, binary), the message that says so and
+    what is; else None. A person picks the photo instead of its annotations more often than a broken file."""
+    if isinstance(data, bytes):
+        head = data[:16]
+        kind = next((what for magic, what in KINDS if head.startswith(magic)), None)
+        if kind is None and head[:4] == b"RIFF" and head[8:12] == b"WEBP":
+            kind = "a WebP image"
+        if kind is None and b"\x00" in data[:1024]:
+            kind = "a binary file"
+    else:
+        kind = "a binary file" if "\x00" in data[:1024] or "\ufffd" in data[:16] else None
+    return f"this is {kind}, not annotations: {WANTED}" if kind else None
+
+
 def _parse(data: bytes | str | dict) -> tuple[str, Any]:
     if isinstance(data, dict):
         return _json_format(data), data
+    if isinstance(data, bytes | str) and (message := not_annotations(data)):
+        raise InterchangeError(message)
     if isinstance(data, bytes):
         try:
             text = data.decode("utf-8-sig")
@@ -155,6 +178,10 @@ def _parse(data: bytes | str | dict) -> tuple[str, Any]:
         doc = json.loads(text)
     except RecursionError:
         raise InterchangeError("malformed JSON: nested too deeply") from None
+    except json.JSONDecodeError as exc:
+        if text.lstrip()[:1] in ("{", "["):  # JSON, broken: say where
+            raise InterchangeError(f"malformed JSON at line {exc.lineno}, column {exc.colno}: {exc.msg}") from None
+        raise InterchangeError(f"neither JSON nor XML: {exc}") from None
     except ValueError as exc:
         raise InterchangeError(f"neither JSON nor XML: {exc}") from None
     if not isinstance(doc, dict):

@@ -234,11 +234,15 @@ BAD = [  # (file, what the message says[, the image to read, where the file has 
     ('<annotations><version>1.1</version><track id="0" label="car"/></annotations>', "CVAT for video"),
     ("<svg/>", "the XML's root is <svg>, not CVAT's <annotations>"),
     ("<annotations><image", "malformed or unsafe XML"),
-    ('{"images": 5', "neither JSON nor XML"),
+    ('{"images": 5', "malformed JSON at line 1, column 13: Expecting ',' delimiter"),
+    ("width: 5", "neither JSON nor XML"),
+    (b"\xff\xd8\xff\xe0\x00\x10JFIF", "this is a JPEG image, not annotations: annotations are our segmentation"),
+    (b"RIFF\x00\x00\x00\x00WEBPVP8 ", "this is a WebP image, not annotations"),
+    ("\ufffdPNG\r\n\x1a\n\x00", "this is a binary file, not annotations"),  # a PNG read as text
     ("[1, 2]", "the JSON is a list"),
     ('{"width": 10}', "its keys are 'width'"),
     ('{"width": 10, "height": 10, "rects": [{"label": "window"}]}', r"rects\[0\] is missing 'x0'"),
-    (b"\xff\xfe\x00", "not a UTF-8 text file"),
+    (b"\xff\xfeA", "not a UTF-8 text file"),
     ("[" * 100_000, "nested too deeply"),
 ]
 

@@ -212,3 +212,26 @@ def test_variations_draw_named_parameters_from_ranges(tmp_path):
     assert len(written) == 3 and all(_values(Procedure.from_json(f.read_text()))["floors"] == 6 for f in written)
     with pytest.raises(SystemExit):
         main(["vary", str(src), "--range", "floors=6", "--out", str(tmp_path / "w")])
+
+
+def _with_attic_tiles():
+    """`_built` whose attic is a row of 2 dormer tiles of its own over the floors' 4 (the first tiles in the tree)."""
+    proc = _built()
+    dormer = Node.split("x", [(Size("flt", 30), Node.leaf("facade")), (Size("abs", 20), Node.leaf("window")),
+                              (Size("flt", 30), Node.leaf("facade"))], role="tile")
+    proc.root.children[0] = Node.repeat("x", 2, [(Size("flt", 80), dormer)], role="attic")
+    return proc
+
+
+def test_the_tile_width_is_the_floors_tile_and_a_bay_more_widens_by_one_of_them():
+    """A newcomer saw "tile (bay) width 129 px", the attic's tile, and a bay more made the facade that much wider,
+    the attic a dormer more and every floor's tile stretched."""
+    proc = _with_attic_tiles()
+    before = _values(proc)
+    assert before["tile_width"] == pytest.approx(40.0) and before["bays"] == 4  # not the attic's 80
+    out = set_parameter(proc, "bays", 5)
+    after = _values(out)
+    assert out.width == pytest.approx(proc.width + 40)  # one floor tile
+    assert after["bays"] == 5 and after["tile_width"] == pytest.approx(40.0)
+    dormers = [r for r in execute(out) if r[0] == 2 and r[2] < 30]
+    assert len(dormers) == 2  # 2 x 0.5 = 1 tile: the attic keeps its dormers, wider apart

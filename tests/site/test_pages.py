@@ -24,6 +24,18 @@ def test_signup_login_logout():
     assert c.post("/accounts/login/", {"username": "dora", "password": "a-long-secret-9"}).status_code == 302
 
 
+def test_signup_goes_where_it_was_asked_to_and_only_on_this_site():
+    """A newcomer's "Sign up and upload a photo" landed on the front page, not on the upload form."""
+    fields = {"email": "e@example.com", "password1": "a-long-secret-9", "password2": "a-long-secret-9"}
+    c = Client()
+    page = c.get("/accounts/signup/?next=/photos/new").content.decode()
+    assert '<input type="hidden" name="next" value="/photos/new">' in page
+    r = c.post("/accounts/signup/", {**fields, "username": "erin", "next": "/photos/new"})
+    assert (r.status_code, r["Location"]) == (302, "/photos/new")
+    r = Client().post("/accounts/signup/?next=https://elsewhere.example/x", {**fields, "username": "fay"})
+    assert (r.status_code, r["Location"]) == (302, "/")  # never to another site
+
+
 def test_upload_page_and_photo_page_flow(alice):
     c = Client()
     c.force_login(alice)
@@ -37,6 +49,14 @@ def test_upload_page_and_photo_page_flow(alice):
 
     r = c.post(f"/photos/{photo.code}/segmentation", {"text": "{bad json"}, follow=True)
     assert "not valid JSON" in r.content.decode()
+    # the photo picked instead of its annotations is named as such (a newcomer read a UTF-8 codec error)
+    r = c.post(f"/photos/{photo.code}/segmentation", {"file": SimpleUploadedFile("f.png", data)}, follow=True)
+    assert "this is a PNG image, not annotations: annotations are our segmentation JSON" in r.content.decode()
+    assert 'accept=".json,.xml,application/json,text/xml"' in c.get(f"/photos/{photo.code}").content.decode()
+    r = c.post("/api/v1/convert", {"text": data.decode("latin-1")}, content_type="application/json")
+    assert r.status_code == 400 and r.json()["text"] == [
+        "this is a binary file, not annotations: annotations are our segmentation JSON, COCO or LabelMe JSON, or "
+        "CVAT XML (docs/interchange.md)"]
     r = c.post(f"/photos/{photo.code}/segmentation", {"text": json.dumps(seg)}, follow=True)
     assert "version 1 saved" in r.content.decode()
     r = c.post(f"/photos/{photo.code}/reconstruct", {"k": 2, "seed": 0})

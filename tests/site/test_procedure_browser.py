@@ -409,3 +409,24 @@ def test_sharing_asks_whether_to_share_the_photo_and_the_overlay_follows(live_se
     anonymous.wait_for_function("document.getElementById('overlay') && document.getElementById('overlay').complete "
                                 "&& document.getElementById('overlay').naturalWidth > 0")
     assert not errors
+
+
+def test_the_overlay_hides_while_the_procedure_is_not_the_photos_size(live_server, alice, facade_photo, browser):
+    """A newcomer saw a floor more drawn stretched over the photo, as if the reconstruction had broken."""
+    from facaid.parameters import named_parameters
+
+    _, seg = facade_photo
+    proc = _faithful(alice, seg)  # the photo's size
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900}, advanced=False)
+    page.wait_for_selector("#named input[name=floors]")
+    assert page.is_visible("#overlay") and page.is_hidden("#overlay-note")
+    floors = next(p.value for p in named_parameters(Tree.from_dict(proc.data)) if p.name == "floors")
+    field = page.locator("#named input[name=floors]")
+    field.fill(str(floors + 1))
+    field.dispatch_event("change")
+    page.wait_for_function("!document.getElementById('overlay-note').hidden")
+    assert page.is_hidden("#overlay") and "its photo" in page.text_content("#overlay-note")
+    field.fill(str(floors))  # back to the photo's size: the overlay again
+    field.dispatch_event("change")
+    page.wait_for_function("document.getElementById('overlay-note').hidden")
+    assert page.is_visible("#overlay") and not errors

@@ -91,4 +91,12 @@ def test_at_1280x800_the_rectification_step_keeps_its_size_field_and_apply_in_vi
     page.goto(f"{live_server.url}/photos/{photo['code']}")
     page.click("text=Rectify it in the editor")
     page.wait_for_function(f"{E}?.rectifying && !document.querySelector('#rectify-panel').hidden")
+    # Apply leaves the step and says what happened (a newcomer saw the step open again, as if nothing had)
+    page.click("#rectify-apply")
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Rectified:')")
+    assert page.url.endswith(f"/photos/{photo['code']}/edit") and page.is_hidden("#rectify-panel")
+    assert Photo.objects.get(code=photo["code"]).rectified
+    page.reload()  # said once
+    page.wait_for_function(f"{E}?.seg !== null && {E}?.seg !== undefined")
+    assert not page.text_content("#status").startswith("Rectified:")
     assert page.errors == []

@@ -148,5 +148,6 @@ def test_run_script_gives_each_server_its_own_control_socket_and_recycles_worker
     path in the home folder, let stopping one remove the other's (issue 56)."""
     text = (ROOT / "scripts" / "run").read_text()
     line = text[text.index(".venv/bin/gunicorn"):].split("&")[0]
-    assert '--control-socket "var/gunicorn-$PORT.ctl"' in line and "--max-requests 1000" in line
+    assert '--control-socket "$VAR/gunicorn-$PORT.ctl"' in line and "--max-requests 1000" in line
+    assert 'VAR=${FACAID_VAR:-var}' in text and '>"$VAR/worker.log"' in text  # the data folder the site uses
     assert "--max-requests-jitter" in line

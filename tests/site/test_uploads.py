@@ -45,6 +45,7 @@ def _png_header_only(width: int, height: int) -> bytes:
     (image_bytes("PNG")[:60], "cut.png", "damaged or truncated"),
     (_png_header_only(100_000, 100_000), "bomb.png", "too large"),
     (_png_header_only(8_000, 6_000), "big.png", "48 megapixels"),
+    (image_bytes("PNG", size=(4, 4)), "tiny.png", "the image is 4x4 px; a facade photo needs at least 16 px a side"),
 ])
 def test_bad_uploads_are_refused_with_a_message(as_alice, data, name, message):
     r = upload(as_alice, data, name=name)

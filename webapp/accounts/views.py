@@ -5,8 +5,9 @@ from django.contrib import messages
 from django.contrib.auth import get_user_model, login
 from django.contrib.auth.decorators import login_required
 from django.db import transaction
-from django.shortcuts import redirect, render
+from django.shortcuts import redirect, render, resolve_url
 from django.utils import timezone
+from django.utils.http import url_has_allowed_host_and_scheme
 from django.views.decorators.cache import never_cache
 from django.views.decorators.http import require_http_methods
 from rest_framework.authtoken.models import Token
@@ -21,9 +22,17 @@ class SignupThrottle(AnonRateThrottle):
     scope = "signup"
 
 
+def _next(request) -> str:
+    """Where the page was asked to go after signing up (``next``), if it is a path of this site; else home."""
+    target = request.POST.get("next") or request.GET.get("next") or ""
+    safe = url_has_allowed_host_and_scheme(target, allowed_hosts={request.get_host()},
+                                           require_https=request.is_secure())
+    return target if target and safe else resolve_url("home")
+
+
 def signup(request):
     if request.user.is_authenticated:
-        return redirect("home")
+        return redirect(_next(request))
     form = SignupForm(request.POST or None)
     if request.method == "POST":
         throttle = SignupThrottle()
@@ -31,14 +40,15 @@ def signup(request):
             wait = math.ceil(throttle.wait() or 60)
             form.add_error(None, f"Too many new accounts from your address; try again in {math.ceil(wait / 60)} "
                                  "minutes.")
-            response = render(request, "registration/signup.html", {"form": form}, status=429)
+            response = render(request, "registration/signup.html", {"form": form, "next": _next(request)},
+                              status=429)
             response["Retry-After"] = str(wait)
             return response
     if request.method == "POST" and form.is_valid():
         user = form.save()
         login(request, user, backend="django.contrib.auth.backends.ModelBackend")
-        return redirect("home")
-    return render(request, "registration/signup.html", {"form": form})
+        return redirect(_next(request))
+    return render(request, "registration/signup.html", {"form": form, "next": _next(request)})
 
 
 @never_cache  # the page shows the secret

@@ -539,7 +539,8 @@ def procedure_download(request, code, name):
     else:
         proc = access.get_procedure_for_user(request.user, code)
         if download.needs_photo and not access.photo_visible_to(request.user, proc.photo):
-            raise ValidationError({"name": "this procedure has no photo you may see to overlay"})
+            raise ValidationError({"photo": f"{name} is drawn with the photo, and this procedure has no photo you "
+                                            "may see"})
         resp = HttpResponse(downloads.build(name, proc, request.query_params), content_type=download.content_type)
     resp["Content-Disposition"] = f'attachment; filename="{downloads.stem(proc)}-{name}"'
     return resp

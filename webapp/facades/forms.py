@@ -29,7 +29,8 @@ class RealSizeForm(forms.Form):
 
 class SegmentationForm(forms.Form):
     file = forms.FileField(required=False, help_text="a segmentation JSON file, or COCO, LabelMe or CVAT XML "
-                                                     "annotations (the image of the photo's size)")
+                                                     "annotations (the image of the photo's size)",
+                           widget=forms.ClearableFileInput(attrs={"accept": ".json,.xml,application/json,text/xml"}))
     text = forms.CharField(widget=forms.Textarea(attrs={"rows": 4}), required=False,
                            help_text="or paste the JSON (or XML) here")
 

@@ -4,6 +4,7 @@ name the offending field or grammar node."""
 from __future__ import annotations
 
 from django.contrib.auth.models import AnonymousUser
+from django.core.validators import ProhibitNullCharactersValidator
 from django.http import QueryDict
 from rest_framework import serializers
 
@@ -334,8 +335,23 @@ class ParametersSerializer(serializers.Serializer):
         return parse_procedure(value).to_dict()
 
 
+class AnnotationTextField(TextField):
+    """An annotation file's text; a binary file (the photo picked instead) is named as such, not as "null
+    characters"."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.validators = [v for v in self.validators if not isinstance(v, ProhibitNullCharactersValidator)]
+
+    def to_internal_value(self, data):
+        text = super().to_internal_value(data)
+        if message := interchange.not_annotations(text):
+            raise serializers.ValidationError(message)
+        return text
+
+
 class ConvertSerializer(serializers.Serializer):
-    text = TextField(trim_whitespace=False, help_text="the annotation file's content")
+    text = AnnotationTextField(trim_whitespace=False, help_text="the annotation file's content")
     format = serializers.ChoiceField(interchange.FORMATS, required=False,
                                      help_text="its format (default: found from the content)")
     image = TextField(max_length=1000, required=False,

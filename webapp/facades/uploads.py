@@ -11,6 +11,7 @@ from django.core.files.images import ImageFile
 from PIL import Image, ImageOps, UnidentifiedImageError
 
 FORMATS = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
+MIN_SIDE = 16  # pixels: smaller is no photo of a facade (a newcomer's 4 x 4 test image was taken)
 ALIASES = {"MPO": "JPEG"}  # a phone's JPEG with more frames (a second view, depth): the first is the photo
 
 
@@ -39,6 +40,8 @@ def normalize_photo(upload) -> tuple[ImageFile, int, int]:
             w, h = img.size
             if w < 1 or h < 1:
                 raise UploadError("the image has no pixels")
+            if min(w, h) < MIN_SIDE:
+                raise UploadError(f"the image is {w}x{h} px; a facade photo needs at least {MIN_SIDE} px a side")
             if w * h > max_pixels:
                 raise UploadError(f"the image is {w}x{h} ({w * h / 1e6:.0f} megapixels); at most "
                                   f"{max_pixels / 1e6:.0f} megapixels are accepted")

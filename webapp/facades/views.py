@@ -14,6 +14,7 @@ from django.views.decorators.http import require_POST
 from rest_framework.exceptions import ValidationError
 
 from facaid.defaults import DEFAULT_K, MAX_K
+from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
 from webapp.facades import access, example, jsonbody, services, sharing, throttling
@@ -140,6 +141,9 @@ def photo_segmentation(request, code):
                                     f"{limit / 2**20:.0f} MB are read.")
             return redirect(photo)
         raw = upload.read() if upload else form.cleaned_data["text"]
+        if message := interchange.not_annotations(raw):  # the photo picked instead of its annotations
+            messages.error(request, f"The segmentation could not be read: {message}.")
+            return redirect(photo)
         try:
             # XML is a CVAT file, read as it is; JSON is ours, COCO's or LabelMe's, read with bounded nesting
             data = raw if raw.lstrip()[:1] in ("<", b"<") else jsonbody.loads(raw)
@@ -205,8 +209,17 @@ def procedure(request, code):
         "viewers_see": sharing.viewers_see(proc) if owner else "",
         "sharing_previews": sharing.previews(request.user, proc) if owner else {},
         "photo_hidden": proc.photo is not None and not photo_visible,
+        "photo_size": _drawn_on_size(proc) if photo_visible else None,
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
         "max_scale": MAX_SCALE, "scale": _download_scale(proc)})
+
+
+def _drawn_on_size(proc) -> tuple[int, int]:
+    """The size of the photo's image the procedure was drawn on: the original's where the tree has its size, else
+    the working (rectified) image's, which the overlay needs the tree to have."""
+    original = (proc.photo.width, proc.photo.height)
+    size = (round(proc.data.get("width", 0)), round(proc.data.get("height", 0)))
+    return original if size == original else proc.photo.working_size()
 
 
 def _other_structure(proc):
