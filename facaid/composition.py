@@ -15,7 +15,7 @@ tells decoded sizes more than structure.
 Chosen on the candidates of 300 held-out facades of dataset seed 7777; confirmed on 300 of seed 4444 and on the
 1,000 held-out facades after the standard evaluation's 500 (mean TED 3.26 -> 2.89, TED <= 5 86.4 -> 87.6 %); on
 those 500 the exact-structure rate and the noise curve gain, TED <= 5 and the clean mean TED move by a few
-facades either way (best of 16; figures in docs/experiments.md, "Composing candidates").
+facades either way (best of 16; figures in experiments/diary.md, "Composing candidates").
 """
 
 from __future__ import annotations
