@@ -24,7 +24,7 @@ from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
 from webapp.facades import rendering
 from webapp.facades.models import Procedure
-from webapp.facades.serializers import parse_procedure
+from webapp.facades.parsing import parse_procedure
 
 Params = Mapping[str, str]
 

@@ -13,8 +13,8 @@ from facaid.grammar.procedure import ProcedureError
 from facaid.parameters import named_parameters
 from facaid.variation import vary
 from webapp.facades.models import Procedure, Visibility
+from webapp.facades.parsing import parse_procedure
 from webapp.facades.rendering import label_map_png
-from webapp.facades.serializers import parse_procedure
 
 DEMO_USERNAME, DEMO_PASSWORD = "demo", "demo-facade"
 VARIANTS = 3

@@ -10,27 +10,12 @@ from rest_framework import serializers
 
 from facaid.defaults import DEFAULT_K, MAX_K, STRUCTURES
 from facaid.formats import interchange
-from facaid.grammar import Procedure as ProcedureTree
-from facaid.grammar.procedure import MAX_NODES, ProcedureError
+from facaid.grammar.procedure import MAX_NODES
 from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
-from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, sharing
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, ProcedureVersion, Segmentation, Visibility
-
-
-def parse_segmentation(data) -> SegmentationData:
-    try:
-        return SegmentationData.from_dict(data)
-    except (ValueError, TypeError) as exc:
-        raise serializers.ValidationError({"segmentation": str(exc)}) from None
-
-
-def parse_procedure(data) -> ProcedureTree:
-    try:
-        return ProcedureTree.from_dict(data)
-    except (ProcedureError, ValueError, TypeError, KeyError) as exc:
-        raise serializers.ValidationError({"data": str(exc)}) from None
+from webapp.facades.parsing import parse_procedure
 
 
 class TextField(serializers.CharField):

@@ -4,12 +4,18 @@ raises DRF's `ValidationError` naming the field; the callers turn it into a 400 
 
 from __future__ import annotations
 
+import hashlib
+import io
+from collections.abc import Callable
 from contextlib import contextmanager
+from typing import Any
 
 from django.conf import settings
 from django.contrib.auth import get_user_model
+from django.core.cache import caches
+from django.core.files.base import ContentFile
 from django.db import transaction
-from django.db.models import Max
+from django.db.models import Count, Max, Q
 from django.http import Http404
 from django.utils import timezone
 from PIL import Image
@@ -20,11 +26,11 @@ from facaid.defaults import DEFAULT_K, DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE
 from facaid.formats import interchange
 from facaid.photo import appearance
 from facaid.photo.copies import UnitError, find_copies
-from facaid.photo.rectify import propose_corners_file
+from facaid.photo.rectify import propose_corners_file, rectify_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
 from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility, check_quota
-from webapp.facades.serializers import parse_segmentation
+from webapp.facades.parsing import parse_segmentation
 from webapp.facades.uploads import UploadError, normalize_photo
 
 
@@ -36,6 +42,38 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
     photo = Photo(owner=owner, title=title, visibility=visibility)
     photo.image.save(content.name, content, save=False)
     photo.save()
+    return photo
+
+
+def delete_photo(photo: Photo) -> None:
+    """The photo, its files and its segmentations gone."""
+    photo.image.delete(save=False)
+    if photo.rectified:
+        photo.rectified.delete(save=False)
+    photo.delete()
+
+
+def rectify_photo(photo: Photo, corners) -> Photo:
+    """Rectify the photo from four corners (top-left, top-right, bottom-right, bottom-left, in the original's
+    pixels) and store the result; the draft, drawn on the image before, goes. A `ValidationError` names
+    ``corners`` for corners far outside the photo or that make no facade."""
+    for x, y in corners:
+        if not (-photo.width <= x <= 2 * photo.width and -photo.height <= y <= 2 * photo.height):
+            raise ValidationError({"corners": f"corner ({x}, {y}) lies far outside the {photo.width}x"
+                                              f"{photo.height} photo"})
+    with photo.image.open("rb") as f:
+        try:
+            out = rectify_file(f, corners, max_pixels=settings.FACAID_MAX_RECTIFIED_PIXELS)
+        except ValueError as exc:
+            raise ValidationError({"corners": str(exc)}) from None
+    buf = io.BytesIO()
+    out.save(buf, "PNG")
+    if photo.rectified:
+        photo.rectified.delete(save=False)
+    photo.rectified.save("rectified.png", ContentFile(buf.getvalue()), save=False)
+    photo.corners = corners
+    photo.save()
+    drop_draft(photo)  # drawn on the image before: it no longer fits
     return photo
 
 
@@ -108,8 +146,16 @@ def add_segmentation(photo: Photo, data, format: str | None = None,
         last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
         version = Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
                                               rect_count=len(seg.rects))
-        Draft.objects.filter(photo=photo).delete()  # saved: the draft it was is the version now
+        drop_draft(photo)  # saved: the draft it was is the version now
     return version, loaded.warnings
+
+
+def draft_of(photo: Photo) -> Draft | None:
+    return Draft.objects.filter(photo=photo).first()
+
+
+def drop_draft(photo: Photo) -> None:
+    Draft.objects.filter(photo=photo).delete()
 
 
 def save_draft(photo: Photo, data) -> Draft:
@@ -208,6 +254,34 @@ def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Pr
                               f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
         check_quota(user.pk, QUOTA_ROOM)  # a full quota refuses the job now, not its result after the work
         return jobs.submit(owner=user, segmentation=segmentation, params=params)
+
+
+def create_procedure(user, fields: dict) -> Procedure:
+    """A procedure of ``user``'s from a validated procedure JSON (``data``) with its title and visibility."""
+    if "data" not in fields:
+        raise ValidationError({"data": "a procedure JSON is required"})
+    return Procedure.objects.create(owner=user, **fields)
+
+
+GALLERY_CACHE_SECONDS = 60  # how long an unchanged gallery page stays in a process's memory (the most a title edit
+# committed out of order with another change could show late)
+
+
+def gallery_page(where: tuple, build: Callable[[], Any]) -> Any:
+    """The public gallery's page at ``where`` (the request's scheme, host and full path: the page's links are made
+    from it), from each process's memory while no procedure has changed, else ``build()``'s. The key holds the time
+    of the latest change and the counts, one aggregate query, so a procedure made private leaves the listing at
+    once (the cache of pages holds at most 500 of them)."""
+    changed = Procedure.objects.aggregate(at=Max("updated"), n=Count("id"),
+                                          public=Count("id", filter=Q(visibility=Visibility.PUBLIC)))
+    state = (changed["at"], changed["n"], changed["public"], *where)
+    key = "gallery:" + hashlib.sha256(repr(state).encode()).hexdigest()
+    pages = caches["pages"]
+    page = pages.get(key)
+    if page is None:
+        page = build()
+        pages.set(key, page, GALLERY_CACHE_SECONDS)
+    return page
 
 
 def fork_procedure(user, proc: Procedure) -> Procedure:

@@ -13,9 +13,9 @@ from rest_framework.exceptions import ValidationError
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
-from webapp.facades import rendering, services
+from webapp.facades import rendering, services, sharing
 from webapp.facades.models import Change, Procedure, ProcedureVersion
-from webapp.facades.serializers import parse_procedure
+from webapp.facades.parsing import parse_procedure
 
 # figures of the job that made a tree (its timings, the decoded candidate's accuracy, how it searched): true of that
 # tree alone, so an edit, a revert or a copy drops them; `source` (where the structure came from) stays
@@ -42,12 +42,38 @@ def remeasure(proc: Procedure) -> None:
 
 
 def save_tree(proc: Procedure, data: dict, change: Change | None = None) -> None:
-    """Give the procedure ``data`` (a validated procedure JSON), re-measured, and save it with its other fields as
-    a new version (an edit unless ``change`` says otherwise); an edit that leaves the tree as it is makes none
-    (`models.Procedure._record_version`), and the current version stays."""
+    """Give the procedure ``data`` (a validated procedure JSON), re-measured, and save it with its other fields;
+    whether that makes a version, and of which kind, is the versioning rule's, in one place
+    (`models.Procedure._record_version`: an edit, unless ``change`` says otherwise, and none for an unchanged
+    tree)."""
     proc.data = data
     remeasure(proc)
-    proc.save(change=change or Change(ProcedureVersion.Kind.EDIT))
+    proc.save(change=change)
+
+
+def save_parameters(proc: Procedure, data: dict, values: dict) -> None:
+    """Save ``data``, the procedure with its named parameters set to ``values``, as an edit that names them."""
+    names = ", ".join(f"{k} {v:g}" for k, v in values.items())
+    save_tree(proc, data, Change(ProcedureVersion.Kind.EDIT, f"set {names}"[:200]))
+
+
+def edit_procedure(user, proc: Procedure, changes: dict) -> Procedure:
+    """Apply a validated edit (title, ``data``: a new version, re-measured; ``visibility``, with ``share_photo``:
+    `sharing.set_visibility`) all or nothing: a photo that cannot be shared leaves the title and the tree as they
+    were."""
+    changes = dict(changes)
+    tree = changes.pop("data", None)
+    visibility, share_photo = changes.pop("visibility", None), changes.pop("share_photo", False)
+    with transaction.atomic():
+        for key, value in changes.items():
+            setattr(proc, key, value)
+        if tree is None:
+            proc.save()
+        else:
+            save_tree(proc, tree)
+        if visibility is not None or share_photo:
+            sharing.set_visibility(user, proc, visibility or proc.visibility, share_photo)
+    return proc
 
 
 def version_number(text, field: str | None = None) -> int:

@@ -29,7 +29,8 @@ from webapp.facades.forms import (
     VisibilityForm,
 )
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure
-from webapp.facades.serializers import PhotoSerializer, parse_procedure
+from webapp.facades.parsing import parse_procedure
+from webapp.facades.serializers import PhotoSerializer
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
 

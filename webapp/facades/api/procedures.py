@@ -1,0 +1,237 @@
+"""The API's procedures: list, store, read, edit, delete, fork, save as new, vary, named parameters, re-run,
+the live preview and the downloads."""
+
+from __future__ import annotations
+
+from django.http import Http404, HttpResponse
+from drf_spectacular.utils import OpenApiParameter, extend_schema
+from rest_framework import status
+from rest_framework.decorators import (
+    api_view,
+    parser_classes,
+    permission_classes,
+    throttle_classes,
+)
+from rest_framework.exceptions import ValidationError
+from rest_framework.permissions import AllowAny, IsAuthenticated
+from rest_framework.response import Response
+
+from facaid.formats.relief import MAX_MESH_RECTS, drawn_leaves
+from facaid.grammar import to_segmentation
+from facaid.grammar.procedure import ProcedureError
+from facaid.labels import LABELS
+from facaid.parameters import named_parameters, set_parameters
+from facaid.variation import vary
+from webapp.facades import access, downloads, rendering, services, versions
+from webapp.facades.api.common import (
+    page,
+    stored_picture,
+)
+from webapp.facades.downloads import DOWNLOADS
+from webapp.facades.jsonbody import JSONParser
+from webapp.facades.models import (
+    Procedure,
+)
+from webapp.facades.parsing import parse_procedure
+from webapp.facades.serializers import (
+    JobSerializer,
+    ParametersSerializer,
+    ProcedureEditSerializer,
+    ProcedureSerializer,
+    ProcedureSummarySerializer,
+    ProcedureWriteSerializer,
+    RerunSerializer,
+    SaveAsNewSerializer,
+    VariationsSerializer,
+)
+from webapp.facades.throttling import HEAVY
+
+
+@extend_schema(methods=["GET"], responses=ProcedureSummarySerializer(many=True), summary="Your procedures")
+@extend_schema(methods=["POST"], request=ProcedureWriteSerializer, responses={201: ProcedureSerializer},
+               summary="Store a procedure JSON (imported or edited)")
+@api_view(["GET", "POST"])
+@throttle_classes(HEAVY)
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def procedure_list(request):
+    if request.method == "GET":
+        return page(request, access.listed(Procedure.objects.filter(owner=request.user)), ProcedureSummarySerializer)
+    form = ProcedureWriteSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    proc = services.create_procedure(request.user, form.validated_data)
+    return Response(ProcedureSerializer(proc, context={"request": request}).data, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(methods=["GET"], responses=ProcedureSerializer, summary="A procedure")
+@extend_schema(methods=["PATCH"], request=ProcedureEditSerializer, responses=ProcedureSerializer,
+               summary="Edit title, visibility or the procedure itself: a changed tree is a new version, re-measured "
+                       "(the answer's accuracy and metrics are the new version's)")
+@extend_schema(methods=["DELETE"], responses={204: None}, summary="Delete a procedure")
+@api_view(["GET", "PATCH", "DELETE"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def procedure_detail(request, code):
+    if request.method == "GET":
+        return Response(ProcedureSerializer(access.get_procedure_for_user(request.user, code),
+                                           context={"request": request}).data)
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    if request.method == "DELETE":
+        proc.delete()
+        return Response(status=status.HTTP_204_NO_CONTENT)
+    form = ProcedureEditSerializer(data=request.data, partial=True)
+    form.is_valid(raise_exception=True)
+    versions.edit_procedure(request.user, proc, form.validated_data)
+    return Response(ProcedureSerializer(proc, context={"request": request}).data)
+
+
+@extend_schema(request=None, responses={201: ProcedureSerializer},
+               summary="Fork: your own private copy, with a link to its parent")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([IsAuthenticated])
+def procedure_fork(request, code):
+    fork = services.fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
+    return Response(ProcedureSerializer(fork, context={"request": request}).data, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(request=SaveAsNewSerializer, responses={201: ProcedureSerializer},
+               summary="Save as a new procedure: yours, private, whose parent is this one (kept with its photo as a "
+                       "fork keeps it), holding 'data' (an edited tree or a variation; default: this one's tree) as "
+                       "its second version, re-measured; titled from 'title', else from the variation that made it "
+                       "or a running number, so that it is told apart from its parent")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def procedure_save_as_new(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    form = SaveAsNewSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    copy = versions.save_as_new(request.user, proc, form.validated_data.get("data"),
+                                form.validated_data.get("title", ""))
+    return Response(ProcedureSerializer(copy, context={"request": request}).data, status=status.HTTP_201_CREATED)
+
+
+@extend_schema(request=VariationsSerializer, responses={200: dict},
+               summary="Variants of a procedure (counts, resizes, swaps), deterministic by seed; not stored")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def procedure_variations(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    form = VariationsSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    try:
+        ranges = {k: tuple(v) for k, v in form.validated_data.get("ranges", {}).items()} or None
+        variants = vary(parse_procedure(proc.data), form.validated_data["n"], form.validated_data["seed"], ranges)
+    except (ProcedureError, ValueError) as exc:
+        field = "ranges" if form.validated_data.get("ranges") else "data"
+        raise ValidationError({field: f"no variations of this procedure: {exc}"}) from None
+    return Response({"variants": [v.to_dict() for v in variants]})
+
+
+def _leaves(tree) -> list | None:
+    """Where the tree draws each leaf, for the page's picture-to-tree selection: [label, x0, y0, x1, y1, node path]
+    in whole pixels; None past `MAX_MESH_RECTS` rectangles (a real facade draws a few hundred)."""
+    rows, paths = drawn_leaves(tree)
+    if len(rows) > MAX_MESH_RECTS:
+        return None
+    return [[LABELS[r[0]], *r[1:], path] for r, path in zip(rows.tolist(), paths, strict=True)]
+
+
+@extend_schema(methods=["GET"], request=None, responses={200: dict},
+               summary="The named parameters (floors, floor height, bays, ...) and where each leaf is drawn: "
+                       "{'parameters': [...], 'leaves': [[label, x0, y0, x1, y1, node path], ...]}")
+@extend_schema(methods=["POST"], request=ParametersSerializer, responses={200: dict},
+               summary="Set named parameters: {'data', 'parameters', 'leaves', 'accuracy', 'metrics', 'version'}; "
+                       "with save, the result is the next version (the accuracy is that version's, measured on save)")
+@api_view(["GET", "POST"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def procedure_parameters(request, code):
+    proc = access.get_procedure_for_user(request.user, code)
+    if request.method == "GET":
+        tree = parse_procedure(proc.data)
+        return Response({"parameters": [p.to_dict() for p in named_parameters(tree)], "leaves": _leaves(tree)})
+    form = ParametersSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    try:
+        tree = form.validated_data.get("data") or proc.data
+        edited = set_parameters(parse_procedure(tree), form.validated_data["values"])
+    except (ProcedureError, ValueError) as exc:
+        raise ValidationError({"values": str(exc)}) from None
+    answer = {"data": edited.to_dict(), "parameters": [p.to_dict() for p in named_parameters(edited)],
+              "leaves": _leaves(edited), "accuracy": None, "metrics": None, "version": None}
+    if form.validated_data["save"]:
+        proc = access.get_rw_procedure_for_user(request.user, code)
+        versions.save_parameters(proc, answer["data"], form.validated_data["values"])
+        answer.update(accuracy=proc.accuracy, metrics=proc.metrics, version=proc.current_version().version)
+    return Response(answer)
+
+
+@extend_schema(request={"application/json": dict}, responses={(200, "image/png"): bytes},
+               summary="Render a procedure JSON (the live preview of edited parameters)")
+@api_view(["POST"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+@parser_classes([JSONParser])
+def render_preview(request):
+    seg = to_segmentation(parse_procedure(request.data))
+    return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
+
+
+@extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),
+                           OpenApiParameter("metres_per_pixel", float,
+                                            description="the scale of procedure.cga, mesh.zip and the 3D models "
+                                                        "(default: the photo's real size, else a storey is 3 m)")],
+               responses={(200, "application/octet-stream"): bytes},
+               summary="Downloads: procedure.json, segmentation.json (executed; segmentation.coco.json, "
+                       "segmentation.labelme.json and segmentation.cvat.xml the same as another tool's annotations of "
+                       "labels.png), labels.png, labels.svg (one group "
+                       "of rectangles per class), procedure.cga (CityEngine CGA rules), mesh.zip (a relief mesh: "
+                       "facade.obj and facade.mtl), facade.glb and facade.gltf (glTF), facade-photo.glb (with the "
+                       "photo), facade.ifc (IFC4), facade.city.json (CityJSON 2.0), overlay.png")
+@api_view(["GET"])
+@throttle_classes(HEAVY)
+@permission_classes([AllowAny])
+def procedure_download(request, code, name):
+    download = DOWNLOADS.get(name)
+    if download is None:
+        raise Http404(f"no download named {name!r}; there are {', '.join(DOWNLOADS)}")
+    if download.build is None:  # kept in storage: served as a file, the tree read only if it must be drawn
+        proc = access.get_procedure_picture_for_user(request.user, code)
+        resp = stored_picture(request, proc, name)
+    else:
+        proc = access.get_procedure_for_user(request.user, code)
+        if download.needs_photo and not access.photo_visible_to(request.user, proc.photo):
+            raise ValidationError({"photo": f"{name} is drawn with the photo, and this procedure has no photo you "
+                                            "may see"})
+        resp = HttpResponse(downloads.build(name, proc, request.query_params), content_type=download.content_type)
+    resp["Content-Disposition"] = f'attachment; filename="{downloads.stem(proc)}-{name}"'
+    return resp
+
+
+@extend_schema(responses={(200, "image/png"): bytes, 304: None},
+               summary="The procedure's thumbnail (its label map, at most 320 px a side), as the gallery shows it")
+@api_view(["GET"])
+@permission_classes([AllowAny])
+def procedure_thumbnail(request, code):
+    return stored_picture(request, access.get_procedure_picture_for_user(request.user, code), "thumbnail.png")
+
+
+@extend_schema(request=RerunSerializer, responses={202: JobSerializer},
+               summary="Re-run inference keeping the procedure's first `nodes` nodes (BFS)")
+@api_view(["POST"])
+@permission_classes([IsAuthenticated])
+@parser_classes([JSONParser])
+def procedure_rerun(request, code):
+    proc = access.get_rw_procedure_for_user(request.user, code)
+    form = RerunSerializer(data=request.data)
+    form.is_valid(raise_exception=True)
+    job = services.rerun(request.user, proc, form.validated_data["nodes"], form.validated_data["k"])
+    return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
+
