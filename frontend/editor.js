@@ -1,8 +1,8 @@
 // The editor page: the glue between the DOM and the editor's DOM-free parts. All changes go through commands and
 // the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
-import {acceptCommand, proposalAt, rejectedOf, repeatByPitch, repeatSelection, similarProposals, splitCommand}
-  from "./assist.js";
-import {AddRects, DeleteRects, ReplaceAll, duplicateRects, moveRects, setLabel} from "./commands.js";
+import {rejectedOf, repeatByPitch, repeatSelection, splitCommand} from "./assist.js";
+import {DeleteRects, duplicateRects, moveRects, setLabel} from "./commands.js";
+import {mountFiles} from "./editor-files.js";
 import {identical} from "./geometry.js";
 import {buildHelp} from "./help.js";
 import {BOX_FIELDS, boxFields, setBoxCommand} from "./inspect.js";
@@ -10,13 +10,12 @@ import {ACTIONS, keyAction} from "./keys.js";
 import {buildObjectList} from "./object-list.js";
 import {freeView, layersNote, objectGroups, pickable, pickableSelection, toggleLayer} from "./objects.js";
 import {buildPalette, markActive} from "./panel.js";
-import {chipAt, chipMembers, chips, copyOf, toggleRejected, unitIndices} from "./proposals.js";
-import {openRectifyMode} from "./rectify-mode.js";
-import {drawScene, grayPixels} from "./render.js";
+import {mountProposing} from "./proposing.js";
+import {drawScene} from "./render.js";
 import {download, makeApi} from "./server.js";
-import {DraftKeeper, loadPhoto, readSegmentationFile, rectify, save, submit} from "./session.js";
-import {PinchGesture, clampScale, fitView, photoFilter, reveal} from "./tools/view.js";
-import {press} from "./tools/select.js";
+import {DraftKeeper, loadPhoto} from "./session.js";
+import {mountPointer} from "./tools/pointer.js";
+import {fitView, photoFilter, reveal} from "./tools/view.js";
 
 const $ = (sel) => document.querySelector(sel);
 const root = $("#editor");
@@ -59,7 +58,8 @@ function changed() {
   $("#dirty").textContent = history.dirty ? "unsaved changes" : "saved";
   const twice = identical([...seg.rects.values()]);
   const note = layersNote(ui.layers);
-  $("#count").textContent = `${seg.size} rectangle${seg.size === 1 ? "" : "s"}, ${ui.selection.size} selected` + (note ? ` · ${note}` : "") +
+  $("#count").textContent = `${seg.size} rectangle${seg.size === 1 ? "" : "s"}, ${ui.selection.size} selected` +
+    (note ? ` · ${note}` : "") +
     (twice.length ? " · " + twice.map((t) => `${t.count} identical ${t.label} rectangles`).join(", ") +
     " (delete the copies)" : "");
   $("#count").classList.toggle("warning", twice.length > 0);
@@ -135,7 +135,6 @@ function fit() {
 
 const toImage = (sx, sy) => [(sx - view.ox) / view.scale, (sy - view.oy) / view.scale];
 const toScreen = (x, y) => [x * view.scale + view.ox, y * view.scale + view.oy];
-const chipUnder = (e) => chipAt(chips(ui.proposals, toScreen), e.offsetX, e.offsetY);
 
 function draw() {
   if (rectifying) return rectifying.draw();
@@ -164,104 +163,14 @@ function setTool(tool) {
   canvas.style.cursor = tool === "draw" ? "crosshair" : "default";
 }
 
-// --- pointer: frontend/tools/ turns presses and moves into previews and commands ----------------------------------
-const toolContext = () => ({seg, selection: ui.selection, label: ui.label, scale: view.scale, snap: $("#snap").checked,
-  layers: ui.layers});
-const pointers = new Map();  // pointerId -> [offsetX, offsetY] while down: two pinch
-
-function pointerOf(e) {
-  const [x, y] = toImage(e.offsetX, e.offsetY);
-  return {x, y, sx: e.offsetX, sy: e.offsetY, shift: e.shiftKey, alt: e.altKey};
-}
-
-canvas.addEventListener("pointerdown", (e) => {
-  canvas.setPointerCapture(e.pointerId);
-  if (rectifying) return rectifying.pointerdown(e);
-  pointers.set(e.pointerId, [e.offsetX, e.offsetY]);
-  if (pointers.size > 2) return;
-  if (pointers.size === 2) {  // a gesture started by the first finger is dropped
-    ui.drag = new PinchGesture([...pointers.values()], view);
-    ui.guides = [];
-    return draw();
-  }
-  const pan = ui.space || e.button === 1;
-  // a press on a proposal or a row's chip is the start of a click that rejects it (below): it selects and moves
-  // nothing under it
-  if (!pan && (chipUnder(e) || proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY)))) return;
-  const {gesture, selection} = press(ui.tool, pointerOf(e), toolContext(), view, {pan});
-  ui.drag = gesture;
-  ui.selection = selection;
-  changed();
-});
-
-canvas.addEventListener("pointermove", (e) => {
-  if (seg && !rectifying) readout(...toImage(e.offsetX, e.offsetY));
-  if (rectifying) return rectifying.pointermove(e);
-  if (pointers.has(e.pointerId)) pointers.set(e.pointerId, [e.offsetX, e.offsetY]);
-  const d = ui.drag;
-  if (!d) return;
-  if (d.kind === "pinch") {
-    if (pointers.size >= 2) Object.assign(view, d.view([...pointers.values()]));
-    return draw();
-  }
-  const result = d.move(pointerOf(e), toolContext());
-  ui.guides = result.guides;
-  if (result.view) Object.assign(view, result.view);
-  draw();
-});
-
-canvas.addEventListener("pointercancel", (e) => {  // the browser took the gesture: nothing is committed
-  pointers.delete(e.pointerId);
-  if (!rectifying) [ui.drag, ui.guides] = [null, []];
-  draw();
-});
-
-canvas.addEventListener("pointerup", (e) => {
-  pointers.delete(e.pointerId);
-  if (rectifying) return rectifying.pointerup();
-  const d = ui.drag;
-  ui.drag = null;
-  ui.guides = [];
-  if (!d || d.kind === "pinch") return draw();
-  const {command, selection, selectAdded} = d.up(toolContext());
-  if (selection) ui.selection = selection;
-  if (command) {
-    run(command);
-    if (selectAdded && command.ids) ui.selection = new Set(command.ids);
-  }
-  changed();
-  if (d.kind === "draw" && command && $("#auto-complete").checked) completeNow();  // proposals after each drawn one
-});
-
-canvas.addEventListener("wheel", (e) => {
-  e.preventDefault();
-  const [x, y] = toImage(e.offsetX, e.offsetY);
-  view.scale = clampScale(view.scale * Math.exp(-e.deltaY * 0.0015));
-  view.ox = e.offsetX - x * view.scale;
-  view.oy = e.offsetY - y * view.scale;
-  draw();
-}, {passive: false});
-
-// proposals: a click rejects (or takes back) one, with the rest of its copy, before any tool sees the press;
-// Shift+click accepts it alone; a row's or column's chip does the same for all of the row or column
-canvas.addEventListener("click", (e) => {
-  if (ui.drag) return;
-  const chip = chipUnder(e);
-  const p = chip ? null : proposalAt(ui.proposals, ...toImage(e.offsetX, e.offsetY));
-  const members = chip ? chipMembers(ui.proposals, chip) : p ? copyOf(ui.proposals, p) : [];
-  if (!members.length) return;
-  if (e.shiftKey) {  // a row or column adds what is not rejected in it; one proposal is added as it is
-    const taken = chip ? members.filter((q) => q.accepted !== false) : members;
-    ui.proposals = ui.proposals.filter((q) => !taken.includes(q));
-    const what = chip ? `a ${chip.kind} of ${taken.length}` : `one ${p.label}`;
-    if (taken.length) run(acceptCommand(taken.map((q) => ({...q, accepted: true})), `accept ${what}`));
-    changed();
-  } else {
-    const rejected = toggleRejected(members);
-    if (chip) status(`${rejected ? "Rejected" : "Took back"} a ${chip.kind} of ${members.length} proposals.`);
-    draw();
-  }
-}, true);
+// --- the editor's parts (tools/pointer.js, proposing.js, editor-files.js) share the state and its echo -------------
+const ed = {api, photoCode, root, canvas, ui, view, status, run, changed, draw, toImage, toScreen,
+  get info() { return info; }, get photo() { return photo; }, get seg() { return seg; },
+  get history() { return history; }, get gray() { return gray; }, set gray(g) { gray = g; },
+  get rectifying() { return rectifying; }, set rectifying(r) { rectifying = r; }};
+const {similar, findCopies, completeNow, acceptProposals} = mountProposing(ed);
+const {importJSON, saveNow, submitNow, openRectify, applyRectify} = mountFiles(ed);
+mountPointer(ed, {readout, afterDrawn: () => { if ($("#auto-complete").checked) completeNow(); }});
 
 // --- keyboard: frontend/keys.js maps keys to actions ---------------------------------------------------------------
 const keyHandlers = {undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: () => removeSelected(),
@@ -269,7 +178,8 @@ const keyHandlers = {undo: () => history.undo(), redo: () => history.redo(), dup
     ui.selection = new Set([...seg.rects.values()].filter((r) => pickable(ui.layers, r)).map((r) => r.id));
     changed();
   },
-  fit, clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
+  fit,
+  clear: () => { ui.selection.clear(); ui.rejected.push(...rejectedOf(ui.proposals)); ui.proposals = []; changed(); },
   tool: (a) => setTool(a.tool), label: (a) => pickLabel(a.label), accept: () => acceptProposals(),
   complete: () => completeNow(), similar: () => similar(), help: (a) => showHelp(a.open),
   applyBox: () => applyBox(),
@@ -337,187 +247,6 @@ function carryOut(plan, select = false) {
   changed();
 }
 
-// run again by Enter in the threshold field (keys.js), with the new threshold; the old proposals go
-function similar() {
-  // with no single selection, while its proposals are shown, the search runs again for the rectangle it ran for
-  const again = ui.proposalsFrom === "find similar" && ui.proposals.length && seg.rects.has(ui.similarSource);
-  if (ui.selection.size !== 1 && !again) {
-    return status(`Find similar looks for copies of one rectangle, and ${ui.selection.size} are selected.`, "error");
-  }
-  const source = ui.selection.size === 1 ? [...ui.selection][0] : ui.similarSource;
-  const field = $("#sim-threshold"), threshold = Number(field.value);
-  if (!(field.value !== "" && threshold >= Number(field.min) && threshold <= Number(field.max))) {
-    return status(`The threshold must be a number from ${field.min} to ${field.max}.`, "error");
-  }
-  gray = gray || grayPixels(photo, seg.width, seg.height);
-  ui.proposals = similarProposals(gray, seg, source, threshold);
-  [ui.proposalsFrom, ui.similarSource] = ["find similar", source];
-  status(ui.proposals.length ? `${ui.proposals.length} proposals at threshold ${threshold}: click one to reject it; ` +
-    '"Accept" or Enter adds the rest (Enter in the threshold field searches again).'
-    : `No similar places found at threshold ${threshold}.`);
-  draw();
-}
-
-// find copies (facaid.photo.copies on the server): where the selected unit, a window with what is drawn around it,
-// repeats in the photo
-async function findCopies() {
-  if (!ui.selection.size) return status("Find copies looks for copies of the selected unit: select a window and " +
-    "what belongs to it (sill, blind, hood) first.", "error");
-  const drawn = seg.toJSON(), unit = unitIndices(seg, ui.selection);
-  await propose({...drawn, unit}, drawn, "find copies", (n, copies) => n
-    ? `${copies} copies of the unit (${n} proposals), scored by how alike they look: click one to reject its copy, ` +
-      "a row's or column's chip to reject all of it (Shift: add it alone), Enter or \"Accept\" to add the rest."
-    : `No copies of the unit found in the photo${rejectedNote()}.`);
-}
-
-// completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
-async function completeNow() {
-  const drawn = seg.toJSON();
-  await propose({...drawn}, drawn, "complete", (n) => n ? `${n} proposals: click one to ` +
-    'reject it, Shift+click to add it alone, Enter or "Accept" to add the rest.'
-    : `Nothing to propose yet: draw a few elements of a row and a column${rejectedNote()}.`);
-}
-
-// the places rejected before are never proposed again in this session: said where nothing comes back
-const rejectedNote = () => ui.rejected.length
-  ? ` (${ui.rejected.length} place${ui.rejected.length === 1 ? "" : "s"} you rejected before ` +
-    `${ui.rejected.length === 1 ? "is" : "are"} not proposed again)` : "";
-
-// one request for proposals at a time; those shown stay until the answer replaces them (the rejected ones are
-// remembered and passed back), unless the drawing changed meanwhile
-async function propose(body, drawn, from, message) {
-  if (ui.completing) return;
-  const known = new Set(ui.rejected.map((r) => JSON.stringify(r)));
-  ui.rejected.push(...rejectedOf(ui.proposals).filter((r) => !known.has(JSON.stringify(r))));
-  body.rejected = ui.rejected;
-  ui.completing = true;
-  try {
-    const {proposals} = await api(`/api/v1/photos/${photoCode}/complete`, {method: "POST", body: JSON.stringify(body)});
-    if (JSON.stringify(seg.toJSON()) !== JSON.stringify(drawn)) {
-      return status(`The drawing changed meanwhile: ${from === "complete" ? "press C" : "ask"} again.`);
-    }
-    ui.proposals = proposals;
-    ui.proposalsFrom = from;
-    status(message(proposals.length, new Set(proposals.map((p) => p.copy)).size));
-  } catch (err) {
-    status(`No proposals: ${err.message}`, "error");
-  } finally {
-    ui.completing = false;
-    draw();
-  }
-}
-
-function acceptProposals() {
-  ui.rejected.push(...rejectedOf(ui.proposals));
-  const cmd = acceptCommand(ui.proposals, ui.proposalsFrom);
-  ui.proposals = [];
-  if (cmd) run(cmd);
-  status(cmd ? `Added ${cmd.records.length} proposal${cmd.records.length === 1 ? "" : "s"}.` : "Nothing was added: " +
-    "every proposal was rejected.", cmd ? "success" : "");
-  changed();
-}
-
-// --- files, saving, submitting, rectifying (frontend/session.js) ------------------------------------------------
-async function importJSON(file) {
-  try {
-    const original = info.rectified && info.corners ? {width: info.width, height: info.height, corners: info.corners}
-      : null;  // an annotation of the photo as taken is carried through its rectification
-    const {rects, warnings} = await readSegmentationFile(file, seg.width, seg.height, api, original);
-    const choice = seg.size ? await askImport(seg.size, rects.length) : "replace";
-    if (choice === "cancel") return status("Not imported: nothing changed.");
-    run(choice === "merge" ? new AddRects(rects, "import") : new ReplaceAll(rects));
-    status(`Imported ${rects.length} rectangles${choice === "merge" ? `, added to the ${seg.size - rects.length} ` +
-      "drawn" : ""}.${warnings.map((w) => ` Note: ${w}.`).join("")}`, "success");
-  } catch (err) {
-    status(`Not imported: ${err.message}`, "error");
-  }
-}
-
-// "replace", "merge" or "cancel": what to do with the rectangles drawn when a file brings others
-function askImport(drawn, coming) {
-  const dialog = $("#import-choice");
-  $("#import-question").textContent = `${drawn} rectangles are drawn and the file has ${coming}: replace the drawn ` +
-    "ones with the file's, or add the file's to them?";
-  return new Promise((resolve) => {
-    dialog.addEventListener("close", () => resolve(dialog.returnValue || "cancel"), {once: true});
-    dialog.returnValue = "";
-    dialog.showModal();
-  });
-}
-
-async function saveNow() {
-  try {
-    status(`Saved as version ${(await save(api, photoCode, seg, history)).version}.`, "success");
-  } catch (err) {
-    status(`Not saved: ${err.message}`, "error");
-  }
-}
-
-async function submitNow() {
-  try {
-    const k = Number($("#k").value);
-    if (!Number.isInteger(k) || k < 1 || k > Number($("#k").max)) {
-      return status(`Not submitted: K must be a whole number from 1 to ${$("#k").max}.`, "error");
-    }
-    const job = await submit(api, photoCode, seg, history, {saved: root.dataset.segmentation, k,
-      onSaved: (code) => { root.dataset.segmentation = code; },
-      progress: (j) => {
-        $("#job").hidden = false;
-        $("#job-status").textContent = `${j.status}${j.status === "running" && j.stage ? ` (${j.stage})` : ""}`;
-        $("#job-progress").value = j.progress;
-      }});
-    if (job.status === "failed") return status(`The reconstruction failed: ${job.message}`, "error");
-    ui.overlay = new Image();
-    ui.overlay.src = `/api/v1/procedures/${job.result}/download/labels.png`;
-    await ui.overlay.decode();
-    $("#result-link").href = `/procedures/${job.result}`;
-    $("#result").hidden = false;
-    draw();
-  } catch (err) {
-    status(`Not submitted: ${err.message}`, "error");
-  }
-}
-
-async function openRectify() {
-  rectifying = await openRectifyMode(canvas, $("#rectify-preview"), info);
-  $("#rectify-panel").hidden = false;
-  $("#rectify-panel").scrollIntoView({block: "nearest"});  // its step in view in the side panel
-  const side = info.real_height_m != null ? "height" : "width";
-  $("#real-side").value = side;
-  $("#real-metres").value = info[`real_${side}_m`] ?? "";
-  status("Drag the four corners onto the facade's corners; the preview shows the result.");
-}
-
-/** The real size typed in the rectification panel, as the photo's fields ({real_width_m: 12.5}: the other side
- * cleared; both null when the field is empty); throws a message for what is not a size. */
-function typedRealSize() {
-  const input = $("#real-metres"), side = $("#real-side").value;
-  const size = {real_width_m: null, real_height_m: null};
-  if (input.value === "" && !input.validity.badInput) return size;
-  const metres = Number(input.value);
-  if (!Number.isFinite(metres) || metres < Number(input.min) || metres > Number(input.max)) {
-    throw new Error(`the real ${side} must be a number of metres from ${input.min} to ${input.max}`);
-  }
-  return {...size, [`real_${side}_m`]: metres};
-}
-
-async function applyRectify() {
-  if (seg.size && !confirm("Rectifying changes the image: the rectangles drawn so far do not carry over. Go on?")) return;
-  try {
-    const size = typedRealSize();
-    if (size.real_width_m !== info.real_width_m || size.real_height_m !== info.real_height_m) {
-      Object.assign(info, await api(`/api/v1/photos/${photoCode}/`, {method: "PATCH", body: JSON.stringify(size)}));
-    }
-    await rectify(api, photoCode, rectifying.corners);
-    history.markSaved();
-    // the editor anew on the rectified photo, saying so; without the #rectify that opened the step
-    sessionStorage.setItem("facaid-rectified", photoCode);
-    location.replace(location.pathname + location.search);
-  } catch (err) {
-    status(`Not rectified: ${err.message}`, "error");
-  }
-}
-
 // --- wiring ----------------------------------------------------------------------------------------------------------
 for (const b of document.querySelectorAll("[data-tool]")) b.addEventListener("click", () => setTool(b.dataset.tool));
 const on = (sel, event, fn) => $(sel).addEventListener(event, fn);
@@ -564,5 +293,6 @@ adjustPhoto();
 load().catch((err) => status(`Could not load the photo: ${err.message}`, "error"));
 
 // for tests and the console
-window.facaidEditor = {get seg() { return seg; }, get history() { return history; }, get rectifying() { return rectifying; },
+window.facaidEditor = {get seg() { return seg; }, get history() { return history; },
+  get rectifying() { return rectifying; },
   ui, view};

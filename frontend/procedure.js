@@ -4,6 +4,7 @@
 // selects its node in the tree and the parameters that stand for it; a click on a parameter's name or a node's
 // outlines what it stands for in the picture.
 import {accuracyText, mountHistory} from "./procedure-history.js";
+import {treeElement} from "./procedure-tree.js";
 import {leafAt, leavesUnder, parametersOf, pictureToProcedure} from "./selection.js";
 import {busy, patientFetch} from "./server.js";
 
@@ -20,112 +21,9 @@ let selected = [];  // the node paths selected, what selected them, and the para
 let selectedBy = null;
 let selectedName = null;
 
-function label(node) {
-  const role = node.role ? ` · ${node.role}` : "";
-  if (node.rule === "leaf") return `${node.label}${role}`;
-  const extra = node.rule === "mirror" && node.center ? " (centre)" : "";
-  return `${node.rule}_${node.axis}${role}${extra}`;
-}
-
-// Shown to 2 decimals (pixels and weights) or 4 (fractions): the value itself changes only when edited.
-function numberInput(value, step, onChange, decimals = 2) {
-  const input = document.createElement("input");
-  input.type = "number"; input.step = step; input.value = String(Number(value.toFixed(decimals))); input.min = 0;
-  input.addEventListener("input", () => {
-    const v = Number(input.value);
-    if (input.value !== "" && Number.isFinite(v) && v >= 0) { onChange(v); namedStale = true; scheduleRender(); }
-  });
-  return input;
-}
-
-// Each node shows its breadth-first index (#k), the order in which a re-run from a prefix keeps nodes: clicking
-// it sets the re-run form to keep the nodes up to and including it.
-function buildTree(node, order, sizeInput = null, path = "root") {
-  const li = document.createElement("li");
-  li.dataset.path = path;
-  const k = order.get(node);
-  const name = document.createElement("span");
-  name.className = "node-label"; name.textContent = label(node);
-  name.title = "select this node: what it draws is outlined in the picture";
-  name.addEventListener("click", () => select([path], "tree"));
-  if (k !== undefined) {  // an exception's node is not among the nodes a re-run keeps
-    const badge = document.createElement("span");
-    badge.className = "bfs"; badge.textContent = `#${k}`;
-    badge.title = `node ${k} breadth first: a re-run keeping ${k + 1} node${k ? "s" : ""} keeps #0 to #${k}`;
-    badge.addEventListener("click", () => {
-      const field = document.getElementById("id_nodes");
-      if (field) { field.value = k + 1; field.focus(); }
-    });
-    li.append(badge, " ");
-  }
-  li.append(name);
-  if (sizeInput) li.append(sizeInput);
-  if (node.rule === "repeat" && node.count !== "fill") {
-    li.append(" × ", numberInput(node.count, 1, (v) => { recount(node, Math.max(1, Math.round(v))); }, 0));
-  }
-  if (node.children && node.children.length) {
-    const ul = document.createElement("ul");
-    node.children.forEach((child, i) => {
-      const size = node.sizes[i];  // [mode, value]
-      const span = document.createElement("span");
-      const rel = size[0] === "rel";
-      span.append(` ${size[0]} `, numberInput(size[1], rel ? 0.01 : 1, (v) => { size[1] = v; }, rel ? 4 : 2));
-      ul.append(buildTree(child, order, span, `${path}/${i}`));
-    });
-    li.append(ul);
-  }
-  if (node.exceptions && node.exceptions.length) li.append(exceptionList(node, order, path));
-  return li;
-}
-
-// A repeat's exceptions, each the copy it changes, the path of the node in it, its size and its node (the node's
-// path is `${path}/!${e}`, as the server names it).
-function exceptionList(node, order, path) {
-  const ul = document.createElement("ul");
-  ul.className = "exceptions";
-  node.exceptions.forEach((o, e) => {
-    const span = document.createElement("span");
-    span.className = "exception";
-    span.title = "an exception of the repeat: this copy differs from the typical one here";
-    span.append(` exception: copy ${o.copy} at ${o.path.join("/")}`);
-    if (o.size) {
-      const rel = o.size[0] === "rel";
-      span.append(` ${o.size[0]} `, numberInput(o.size[1], rel ? 0.01 : 1, (v) => { o.size[1] = v; }, rel ? 4 : 2));
-    }
-    if (o.node) {
-      ul.append(buildTree(o.node, order, span, `${path}/!${e}`));
-    } else {
-      const li = document.createElement("li");
-      li.append(span);
-      ul.append(li);
-    }
-  });
-  return ul;
-}
-
-// A repeat's count set in the tree: the exceptions of copies it no longer lays out go, the tail's follow it.
-function recount(node, count) {
-  const old = node.count;
-  node.exceptions = (node.exceptions || []).filter((o) => o.copy < count || o.copy === old)
-    .map((o) => (o.copy === old ? {...o, copy: count} : o));
-  if (!node.exceptions.length) delete node.exceptions;
-  node.count = count;
-}
-
-function breadthFirst(root) {
-  const order = new Map();
-  const queue = [root];
-  for (let i = 0; i < queue.length; i++) {
-    order.set(queue[i], i);
-    queue.push(...(queue[i].children || []));
-  }
-  return order;
-}
-
 function drawTree() {
-  const root = document.createElement("ul");
-  root.append(buildTree(proc.root, breadthFirst(proc.root)));
-  document.getElementById("tree").replaceChildren(root);
+  document.getElementById("tree").replaceChildren(treeElement(proc.root, {
+    edited: () => { namedStale = true; scheduleRender(); }, select: (path) => select([path], "tree")}));
   showSelection();
 }
 
@@ -379,7 +277,8 @@ document.getElementById("save-new")?.addEventListener("click", () => saveAsNew(p
 // The CGA rules and the 3D models (the links marked data-scaled) are in metres: a facade width the user knows sets
 // their scale (metres per pixel of the saved procedure); left empty, the server's default (the page says which).
 const widthField = document.getElementById("width-m");
-if (widthField) widthField.max = Number(widthField.dataset.maxScale) * Number(widthField.dataset.px);  // the server's bound
+// the server's bound
+if (widthField) widthField.max = Number(widthField.dataset.maxScale) * Number(widthField.dataset.px);
 widthField?.addEventListener("input", () => {
   const metres = Number(widthField.value);
   const scaled = widthField.value !== "" && Number.isFinite(metres) && metres > 0 && metres <= Number(widthField.max);

@@ -1,0 +1,98 @@
+// Proposals in the editor: find similar (in the browser, assist.js), find copies and completion (the server's
+// facaid.photo.copies and facaid.complete), each shown as ghosts until accepted; the places rejected are passed
+// back so that they are not proposed again. `ed` is what the editor's parts share (editor.js).
+import {acceptCommand, rejectedOf, similarProposals} from "./assist.js";
+import {unitIndices} from "./proposals.js";
+import {grayPixels} from "./render.js";
+
+const $ = (sel) => document.querySelector(sel);
+
+export function mountProposing(ed) {
+  // run again by Enter in the threshold field (keys.js), with the new threshold; the old proposals go
+  function similar() {
+    // with no single selection, while its proposals are shown, the search runs again for the rectangle it ran for
+    const {ui, seg} = ed;
+    const again = ui.proposalsFrom === "find similar" && ui.proposals.length && seg.rects.has(ui.similarSource);
+    if (ed.ui.selection.size !== 1 && !again) {
+      return ed.status(`Find similar looks for copies of one rectangle, and ${ed.ui.selection.size} are selected.`,
+        "error");
+    }
+    const source = ed.ui.selection.size === 1 ? [...ed.ui.selection][0] : ed.ui.similarSource;
+    const field = $("#sim-threshold"), threshold = Number(field.value);
+    if (!(field.value !== "" && threshold >= Number(field.min) && threshold <= Number(field.max))) {
+      return ed.status(`The threshold must be a number from ${field.min} to ${field.max}.`, "error");
+    }
+    ed.gray = ed.gray || grayPixels(ed.photo, ed.seg.width, ed.seg.height);
+    ed.ui.proposals = similarProposals(ed.gray, ed.seg, source, threshold);
+    [ed.ui.proposalsFrom, ed.ui.similarSource] = ["find similar", source];
+    const n = ed.ui.proposals.length;
+    ed.status(n ? `${n} proposals at threshold ${threshold}: click one to reject it; ` +
+      '"Accept" or Enter adds the rest (Enter in the threshold field searches again).'
+      : `No similar places found at threshold ${threshold}.`);
+    ed.draw();
+  }
+
+  // find copies (facaid.photo.copies on the server): where the selected unit, a window with what is drawn around it,
+  // repeats in the photo
+  async function findCopies() {
+    if (!ed.ui.selection.size) {
+      return ed.status("Find copies looks for copies of the selected unit: select a window and " +
+        "what belongs to it (sill, blind, hood) first.", "error");
+    }
+    const drawn = ed.seg.toJSON(), unit = unitIndices(ed.seg, ed.ui.selection);
+    await propose({...drawn, unit}, drawn, "find copies", (n, copies) => n
+      ? `${copies} copies of the unit (${n} proposals), scored by how alike they look: click one to reject its copy, ` +
+        "a row's or column's chip to reject all of it (Shift: add it alone), Enter or \"Accept\" to add the rest."
+      : `No copies of the unit found in the photo${rejectedNote()}.`);
+  }
+
+  // completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
+  async function completeNow() {
+    const drawn = ed.seg.toJSON();
+    await propose({...drawn}, drawn, "complete", (n) => n ? `${n} proposals: click one to ` +
+      'reject it, Shift+click to add it alone, Enter or "Accept" to add the rest.'
+      : `Nothing to propose yet: draw a few elements of a row and a column${rejectedNote()}.`);
+  }
+
+  // the places rejected before are never proposed again in this session: said where nothing comes back
+  const rejectedNote = () => ed.ui.rejected.length
+    ? ` (${ed.ui.rejected.length} place${ed.ui.rejected.length === 1 ? "" : "s"} you rejected before ` +
+      `${ed.ui.rejected.length === 1 ? "is" : "are"} not proposed again)` : "";
+
+  // one request for proposals at a time; those shown stay until the answer replaces them (the rejected ones are
+  // remembered and passed back), unless the drawing changed meanwhile
+  async function propose(body, drawn, from, message) {
+    if (ed.ui.completing) return;
+    const known = new Set(ed.ui.rejected.map((r) => JSON.stringify(r)));
+    ed.ui.rejected.push(...rejectedOf(ed.ui.proposals).filter((r) => !known.has(JSON.stringify(r))));
+    body.rejected = ed.ui.rejected;
+    ed.ui.completing = true;
+    try {
+      const {proposals} = await ed.api(`/api/v1/photos/${ed.photoCode}/complete`,
+        {method: "POST", body: JSON.stringify(body)});
+      if (JSON.stringify(ed.seg.toJSON()) !== JSON.stringify(drawn)) {
+        return ed.status(`The drawing changed meanwhile: ${from === "complete" ? "press C" : "ask"} again.`);
+      }
+      ed.ui.proposals = proposals;
+      ed.ui.proposalsFrom = from;
+      ed.status(message(proposals.length, new Set(proposals.map((p) => p.copy)).size));
+    } catch (err) {
+      ed.status(`No proposals: ${err.message}`, "error");
+    } finally {
+      ed.ui.completing = false;
+      ed.draw();
+    }
+  }
+
+  function acceptProposals() {
+    ed.ui.rejected.push(...rejectedOf(ed.ui.proposals));
+    const cmd = acceptCommand(ed.ui.proposals, ed.ui.proposalsFrom);
+    ed.ui.proposals = [];
+    if (cmd) ed.run(cmd);
+    const added = cmd ? cmd.records.length : 0;
+    ed.status(cmd ? `Added ${added} proposal${added === 1 ? "" : "s"}.` : "Nothing was added: " +
+      "every proposal was rejected.", cmd ? "success" : "");
+    ed.changed();
+  }
+  return {similar, findCopies, completeNow, acceptProposals};
+}
