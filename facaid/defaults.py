@@ -18,7 +18,7 @@ FLOOR_TOLERANCE = 0.25
 # completion (facaid.completion): proposals scored lower are not returned; chosen on the CMP dev half with
 # bench/bench_assist.py (a simulated annotator)
 DEFAULT_MIN_SCORE = 0.85
-DEFAULT_MIN_COPY = 0.6  # the copies of a unit (`photo.copies`) scored below this are not returned unless asked for
+DEFAULT_MIN_COPY = 0.6  # the copies of a unit (`completion.copies`) scored below this are not returned unless asked for
 # the two procedures of a real reconstruction (`facaid.pipeline.reconstruct`): floors of tiles with exceptions, what
 # the named parameters edit (the default), and the annotation as drawn
 STRUCTURES = ("editable", "exact")

@@ -1,26 +1,26 @@
 """The lattice reader: a real facade's editable procedure, read top-down from its rows and columns of windows.
 
-A person describes a facade as floors of tiles: "five floors of six windows, a shop floor below, the attic above,
-the third window of the fourth floor has its blind closed". `read_lattice` reads a segmentation the same way
-(after Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013):
+A person describes a facade as floors of tiles: "five floors of six windows, a shop floor below, the attic above, the
+third window of the fourth floor has its blind closed". `read_lattice` reads a segmentation the same way (after
+Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013):
 
-1. **Windows**: connected window-or-blind regions of the building (the longest run of columns that are mostly
-   not background: a neighbour's strip is left out), but for the strips a balcony or sill leaves uncovered
-   (`WHOLE`), their **rows** and **columns** (bands of centres split where the gap is over half the median window
-   height, width; bands whose extents overlap are one; a column needs windows in `COLUMN_SUPPORT` of the floors).
-2. **Floors**: horizontal bands that each hold one row of windows with its companions, cut between two rows where
-   the label map is most wall; the last rows whose bands hold doors or shops are the **ground** floor. **Tiles**:
-   the columns within the floors, cut the same way; the side margins; the **attic** above the first floor. The
-   attic and the ground floor are rows on the same columns, so a bay more adds one to them too.
+1. **Windows**: connected window-or-blind regions of the building (the longest run of columns that are mostly not
+   background: a neighbour's strip is left out), but for the strips a balcony or sill leaves uncovered (`WHOLE`),
+   their **rows** and **columns** (bands of centres split where the gap is over half the median window height, width;
+   bands whose extents overlap are one; a column needs windows in `COLUMN_SUPPORT` of the floors).
+2. **Floors**: horizontal bands that each hold one row of windows with its companions, cut between two rows where the
+   label map is most wall; the last rows whose bands hold doors or shops are the **ground** floor. **Tiles**: the
+   columns within the floors, cut the same way; the side margins; the **attic** above the first floor. The attic and
+   the ground floor are rows on the same columns, so a bay more adds one to them too.
 3. **Typical copies**: the tiles of the grid resampled to the median tile and voted pixel by pixel, the majority
    tidied as a person draws (each element a box, slivers left out) and written as an exact tree: one subtree that
    every copy of the repeats shares. Floors and columns whose lengths are within `JITTER` of the median share it.
-4. **Exceptions** (`facaid.grammar.procedure.Override`), each a delta of the typical copy that must earn its
-   leaves (`LEAF_GAIN`): a column that differs alike on every floor gets its own tile (on the row's repeat, so
-   a new floor has it too), a floor whose tiles differ alike (the balcony floor) its own row of them, and a copy
-   its deltas: sizes where its tree has the typical shape but lays out differently by more than a hand's jitter
-   (no leaf), leaves it paints with another label (a closed blind: one leaf; a missing sill: none), or its own
-   tree. Pixels within `EDGE` of an edge count for nothing: a hand's jitter is restored, not copied.
+4. **Exceptions** (`facaid.grammar.procedure.Override`), each a delta of the typical copy that must earn its leaves
+   (`LEAF_GAIN`): a column that differs alike on every floor gets its own tile (on the row's repeat, so a new floor
+   has it too), a floor whose tiles differ alike (the balcony floor) its own row of them, and a copy its deltas:
+   sizes where its tree has the typical shape but lays out differently by more than a hand's jitter (no leaf), leaves
+   it paints with another label (a closed blind: one leaf; a missing sill: none), or its own tree. Pixels within
+   `EDGE` of an edge count for nothing: a hand's jitter is restored, not copied.
 
 The result is an ordinary procedure: the pipeline sizes it (`facaid.sizing`) like any other structure.
 """
@@ -32,6 +32,7 @@ import numpy as np
 from facaid.grammar.decompose import tree_of_label_map
 from facaid.grammar.execute import execute
 from facaid.grammar.procedure import MAX_COUNT, Node, Override, Procedure, ProcedureError, Size
+from facaid.grammar.shapes import elements, leaf_paths, shape
 from facaid.labels import BACKGROUND, FACADE, GLASS, LABEL_ID, LABELS, PRIORITY
 from facaid.metrics import near_edges
 from facaid.segmentation import Segmentation, decompose_grid, flatten, rasterize, region_boxes
@@ -149,13 +150,6 @@ def _windows(node: Node) -> Node:
     return node
 
 
-def _leaf_paths(node: Node, path: tuple[int, ...] = ()) -> list[tuple[tuple[int, ...], Node]]:
-    """The leaves of a tree of splits with their child-index paths, depth-first (`execute`'s leaf order)."""
-    if node.rule == "leaf":
-        return [(path, node)]
-    return [lp for i, c in enumerate(node.children) for lp in _leaf_paths(c, (*path, i))]
-
-
 class _Unit:
     """A typical unit (a tile, a margin, a column's own tile): the tidied majority of its copies, resampled to one
     size, and the exact tree of that map."""
@@ -165,7 +159,7 @@ class _Unit:
         self.map = _tidy(_vote([_resample(c, h, w) for c in crops]))
         self.tree = _windows(tree_of_label_map(self.map))
         boxes = execute(Procedure(w, h, self.tree))
-        self.leaves = [(path, leaf, box[1:]) for (path, leaf), box in zip(_leaf_paths(self.tree), boxes,
+        self.leaves = [(path, leaf, box[1:]) for (path, leaf), box in zip(leaf_paths(self.tree), boxes,
                                                                           strict=True)]
 
     def wrong(self, crop: np.ndarray) -> int:
@@ -182,17 +176,6 @@ def _jitter_band(crop: np.ndarray) -> np.ndarray:
 
 def _off(drawn: np.ndarray, crop: np.ndarray) -> int:
     return int(((drawn != crop) & ~_jitter_band(crop)).sum())
-
-
-def _elements(node: Node) -> int:
-    return sum(1 for _, n in node.walk() if n.rule == "leaf" and n.label not in ("facade", "background"))
-
-
-def _shape(node: Node) -> tuple:
-    """A tree without its sizes: rules, axes and labels."""
-    if node.rule == "leaf":
-        return ("leaf", node.label)
-    return (node.rule, node.axis, tuple(_shape(c) for c in node.children))
 
 
 def _resized(reference: Node, own: Node, jitter: float, path: tuple[int, ...] = ()) -> list[tuple[tuple, Size]]:
@@ -224,7 +207,7 @@ class _Choice:
             return []
         tidy = _tidy(crop)
         node = tree_of_label_map(tidy)
-        if _shape(node) == _shape(reference.tree):
+        if shape(node) == shape(reference.tree):
             jitter = max(1.0, EDGE * min(crop.shape))
             return [(path, size, None) for path, size in _resized(reference.tree, node, jitter)]
         drawn = _resample(reference.map, *crop.shape)
@@ -248,7 +231,7 @@ class _Choice:
                 cost += price
         relabelled = before - int(((drawn != crop) & steady).sum())
         whole = before - _off(tidy, crop)
-        if self.net(whole, ONE_OFF * max(DELETE, _elements(node))) > max(0.0, self.net(relabelled, cost)):
+        if self.net(whole, ONE_OFF * max(DELETE, elements(node))) > max(0.0, self.net(relabelled, cost)):
             return [((), None, node)]
         return relabels if self.net(relabelled, cost) > 0 else []
 
@@ -351,7 +334,7 @@ def _read_main(label_map: np.ndarray, windows: np.ndarray) -> Node | None:
     for j in range(n_cols):
         column = _Unit([cells[i][j] for i in range(n_rows)], th, tw)
         gain = sum(tile.wrong(cells[i][j]) - column.wrong(cells[i][j]) for i in range(n_rows))
-        if n_rows > 1 and EXCEPTIONS and choice.worth(gain, _elements(column.tree)):
+        if n_rows > 1 and EXCEPTIONS and choice.worth(gain, elements(column.tree)):
             bays.exceptions.append(Override(j, (0,), node=column.tree))
             reference.append(column)
         else:
@@ -375,7 +358,7 @@ def _read_main(label_map: np.ndarray, windows: np.ndarray) -> Node | None:
         row = _Unit(cells[i], th, tw)
         gain = sum(reference[j].wrong(cells[i][j]) - row.wrong(cells[i][j]) for j in range(n_cols))
         refs = reference
-        if n_cols > 1 and n_rows > 1 and EXCEPTIONS and choice.worth(gain, _elements(row.tree)):
+        if n_cols > 1 and n_rows > 1 and EXCEPTIONS and choice.worth(gain, elements(row.tree)):
             variant = Node.repeat("x", n_cols, [(bays.sizes[0], _role(row.tree, "tile"))], role=bays.role)
             variant.exceptions = _widths(tile_w)
             floors.exceptions.append(Override(i, inside, node=variant))

@@ -19,7 +19,8 @@ from dataclasses import asdict, dataclass, field
 from facaid.grammar.execute import parameter_lengths
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
-from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, copies_moved, recount, validate
+from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
+from facaid.grammar.repeats import copies_moved, recount
 from facaid.resizing import copy_procedure, repeat_unit, resize
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]

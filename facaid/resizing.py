@@ -7,7 +7,8 @@ from __future__ import annotations
 
 from facaid.grammar.execute import first_boxes
 from facaid.grammar.layout import expand_over, layout
-from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Procedure, recount, validate
+from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Procedure, validate
+from facaid.grammar.repeats import recount
 
 
 def copy_procedure(proc: Procedure) -> Procedure:

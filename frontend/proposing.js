@@ -1,5 +1,5 @@
 // Proposals in the editor: find similar (in the browser, assist.js), find copies and completion (the server's
-// facaid.photo.copies and facaid.complete), each shown as ghosts until accepted; the places rejected are passed
+// facaid.completion.copies and facaid.complete), each shown as ghosts until accepted; the places rejected are passed
 // back so that they are not proposed again. `ed` is what the editor's parts share (editor.js).
 import {acceptCommand, rejectedOf, similarProposals} from "./assist.js";
 import {unitIndices} from "./proposals.js";
@@ -32,7 +32,7 @@ export function mountProposing(ed) {
     ed.draw();
   }
 
-  // find copies (facaid.photo.copies on the server): where the selected unit, a window with what is drawn around it,
+  // find copies (facaid.completion.copies on the server): where the selected unit, a window with what is drawn around it,
   // repeats in the photo
   async function findCopies() {
     if (!ed.ui.selection.size) {

@@ -101,3 +101,49 @@ def test_no_import_cycles():
             visit(v)
     assert not cycles
     assert len(graph) > 60  # the walk found the code
+
+
+# facaid's own layers: a package may import those of its layer and below, never one above (issue 59)
+BELOW = {
+    "facaid.native": {"facaid.labels"},
+    "facaid.grammar": {"facaid.labels", "facaid.numbers", "facaid.segmentation", "facaid.native"},
+    "facaid.formats": {"facaid.labels", "facaid.numbers", "facaid.segmentation", "facaid.native", "facaid.grammar",
+                       "facaid.paths", "facaid.parameters", "facaid.resizing"},  # the CGA's attributes
+    "facaid.photo": {"facaid.labels", "facaid.numbers", "facaid.segmentation", "facaid.native", "facaid.grammar",
+                     "facaid.metrics", "facaid.defaults"},
+    "facaid.tokenizer": {"facaid.labels", "facaid.numbers", "facaid.segmentation", "facaid.native", "facaid.grammar"},
+}
+ABOVE_ALL = ("facaid.cli", "facaid.evaluation", "facaid.docs")  # only the command line and the lab import these
+
+
+def _package(module: str) -> str:
+    parts = module.split(".")
+    name = ".".join(parts[:2])
+    return name if name in MODULES or f"{name}.__init__" in MODULES else module
+
+
+def test_facaid_imports_point_down():
+    bad = []
+    for name, path in MODULES.items():
+        if not name.startswith("facaid."):
+            continue
+        mine = ".".join(name.split(".")[:2])
+        for module, _ in _imports(path):
+            if not module.startswith("facaid.") or module.startswith(mine):
+                continue
+            theirs = ".".join(module.split(".")[:2])
+            if mine in BELOW and theirs not in BELOW[mine]:
+                bad.append(f"{name} imports {module}")
+            if theirs in ABOVE_ALL and mine not in ABOVE_ALL:
+                bad.append(f"{name} imports {module}")
+    assert bad == []
+
+
+def test_facaid_has_at_most_20_top_level_modules_and_no_source_file_over_450_lines():
+    top = [p for p in (ROOT / "facaid").glob("*.py") if p.name != "__init__.py"]
+    assert len(top) <= 20, sorted(p.name for p in top)
+    sources = [p for folder in ("facaid", "webapp", "worker", "bench") for p in (ROOT / folder).rglob("*.py")
+               if "migrations" not in p.parts]
+    sources += [p for p in (ROOT / "frontend").rglob("*.js") if "tests" not in p.parts]
+    long = {str(p.relative_to(ROOT)): n for p in sources if (n := len(p.read_text().splitlines())) > 450}
+    assert long == {}

@@ -7,13 +7,13 @@ import collections
 import sys
 
 from facaid import completion
-from facaid.completion import complete
+from facaid.completion import complete, copies
 from facaid.evaluation import assist
 from facaid.evaluation.real import load_records
 from facaid.labels import LABELS
 from facaid.metrics import pixel_accuracy
 from facaid.paths import DEFAULT_CMP
-from facaid.photo import appearance, copies, repeats
+from facaid.photo import appearance, repeats
 from facaid.segmentation import Segmentation, rasterize
 
 for kv in sys.argv[2:]:

@@ -20,7 +20,7 @@ ap.add_argument("--method", default="all")
 ap.add_argument("--photos", default="var/cmp_photos")
 ap.add_argument("--thr_axis", type=float, default=0.35)
 ap.add_argument("--thr_cell", type=float, default=0.45)
-ap.add_argument("--set", nargs="*", default=[], help="facaid.photo.copies knobs, NAME=VALUE (Python literal)")
+ap.add_argument("--set", nargs="*", default=[], help="facaid.completion.copies knobs, NAME=VALUE (Python literal)")
 args = ap.parse_args()
 import ast
 import sys

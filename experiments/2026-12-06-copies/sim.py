@@ -7,11 +7,11 @@ import statistics
 import sys
 
 from facaid import completion
-from facaid.completion import complete
+from facaid.completion import complete, copies
 from facaid.evaluation.assist import simulate
 from facaid.evaluation.real import load_records
 from facaid.paths import DEFAULT_CMP
-from facaid.photo import appearance, copies, repeats
+from facaid.photo import appearance, repeats
 
 for kv in sys.argv[2:]:
     k, v = kv.split("=")

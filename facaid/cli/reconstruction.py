@@ -81,7 +81,7 @@ def cmd_complete(args: argparse.Namespace) -> None:
         except (OSError, Image.DecompressionBombError) as exc:
             raise CliError(f"cannot read photo {args.photo}: {exc}") from None
     if args.unit is not None:
-        from facaid.photo.copies import UnitError, find_copies
+        from facaid.completion.copies import UnitError, find_copies
 
         try:
             unit = [int(i) for i in args.unit.split(",")]

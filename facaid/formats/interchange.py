@@ -42,37 +42,37 @@ listing them. Bad input raises
 from __future__ import annotations
 
 import json
-import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from pathlib import PurePosixPath
 from typing import Any
 
 import defusedxml.ElementTree as SafeET
 from defusedxml import DefusedXmlException
 
-from facaid.labels import LABEL_ID, LABELS, PRIORITY
-from facaid.segmentation import MAX_PIXELS, MAX_RECTS, MAX_SIDE, Rect, Segmentation, SegmentationError
+from facaid.formats.fields import (
+    Choice,
+    InterchangeError,
+    Notes,
+    SeveralImages,
+    as_list,
+    as_object,
+    check_count,
+    label_of,
+    number,
+    pick,
+    rect,
+    size_of,
+)
+from facaid.labels import LABELS, PRIORITY
+from facaid.segmentation import Rect, Segmentation, SegmentationError
 
+__all__ = ["CONTENT_TYPES", "FORMATS", "SUFFIXES", "InterchangeError", "Loaded", "SeveralImages", "detect",
+           "format_for_name", "load", "not_annotations", "read", "write"]  # the errors are fields.py's
 FORMATS = ("segmentation", "coco", "labelme", "cvat")
 SUFFIXES = {"coco": ".coco.json", "labelme": ".labelme.json", "cvat": ".cvat.xml", "segmentation": ".json"}
 CONTENT_TYPES = {"coco": "application/json", "labelme": "application/json", "cvat": "application/xml",
                  "segmentation": "application/json"}
 LABELME_VERSION = "5.5.0"  # labelme warns on a file of another major version than its own
-ALIASES = {"moulding": "molding", "decoration": "deco"}
-
-
-class InterchangeError(SegmentationError):
-    """A file that cannot be read as annotations of the 12 classes; the message names the offending field."""
-
-
-class SeveralImages(InterchangeError):
-    """A file of several images read without naming one; ``names`` are theirs."""
-
-    def __init__(self, names: list[str]):
-        listing = ", ".join(names[:20]) + (f" and {len(names) - 20} more" if len(names) > 20 else "")
-        super().__init__(f"the file holds {len(names)} images ({listing}): name the one to read")
-        self.names = names
 
 
 @dataclass(frozen=True)
@@ -111,13 +111,13 @@ def load(data: bytes | str | dict, format: str | None = None, *, image: str | No
     found, doc = _parse(data)
     if format is not None and format != found:
         raise InterchangeError(f"the file is not {format}: it reads as {found}")
-    notes = _Notes()
+    notes = Notes()
     if found == "segmentation":
         try:
             return Loaded(Segmentation.from_dict(doc), found, None, ())
         except SegmentationError as exc:
             raise InterchangeError(str(exc)) from None
-    seg, name = _READERS[found](doc, _Choice(image, size), notes)
+    seg, name = _READERS[found](doc, Choice(image, size), notes)
     return Loaded(seg, found, name, notes.lines())
 
 
@@ -212,183 +212,61 @@ def _xml(text: str) -> ET.Element:
     return root
 
 
-class _Notes:
-    """Warnings, one line per kind, naming the items."""
-
-    def __init__(self):
-        self.items: dict[str, list[str]] = {}
-
-    def add(self, message: str, where: str) -> None:
-        self.items.setdefault(message, []).append(where)
-
-    def lines(self) -> tuple[str, ...]:
-        return tuple(f"{message}: {', '.join(items[:10])}" + (f" and {len(items) - 10} more" if len(items) > 10
-                                                               else "")
-                     for message, items in self.items.items())
-
-
-def _number(value: Any, where: str) -> float:
-    if isinstance(value, str):  # XML attributes
-        try:
-            value = float(value)
-        except ValueError:
-            raise InterchangeError(f"{where} must be a number, got {value[:40]!r}") from None
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InterchangeError(f"{where} must be a number, got {type(value).__name__} {str(value)[:40]}")
-    try:
-        if math.isfinite(value):
-            return value
-    except OverflowError:  # an integer too large for a float
-        pass
-    raise InterchangeError(f"{where} must be a finite number, got {str(value)[:40]}")
-
-
-def _side(value: Any, where: str) -> int:
-    if value is None:
-        raise InterchangeError(f"{where} is missing: the image's size is needed")
-    side = _number(value, where)
-    if side != int(side) or not 1 <= side <= MAX_SIDE:
-        raise InterchangeError(f"{where} must be a whole number of pixels from 1 to {MAX_SIDE}, got {value!r}")
-    return int(side)
-
-
-def _size(width: Any, height: Any, where: str, names=("width", "height")) -> tuple[int, int]:
-    w, h = _side(width, f"{where}.{names[0]}".lstrip(".")), _side(height, f"{where}.{names[1]}".lstrip("."))
-    if w * h > MAX_PIXELS:
-        raise InterchangeError(f"{where or 'the image'} is too large: {w}x{h} is over {MAX_PIXELS} pixels")
-    return w, h
-
-
-def _label(name: Any, where: str) -> int:
-    if isinstance(name, str):
-        key = " ".join(name.lower().replace("_", " ").replace("-", " ").split())
-        for candidate in (key, key[:-3] + "y" if key.endswith("ies") else None, key[:-1] if key.endswith("s")
-                          else None):
-            candidate = ALIASES.get(candidate, candidate)
-            if candidate in LABEL_ID:
-                return LABEL_ID[candidate]
-    raise InterchangeError(f"{where} {str(name)[:60]!r} is not one of the 12 labels: {', '.join(LABELS)}")
-
-
-def _rect(label: int, x0: Any, y0: Any, x1: Any, y1: Any, size: tuple[int, int], where: str, fields=None) -> Rect:
-    """A box from its edges (``fields`` names them in the message), rounded to whole pixels and clipped."""
-    names = fields or ("x0", "y0", "x1", "y1")
-    x0, y0, x1, y1 = (_number(v, f"{where}.{n}" if fields else where) for v, n in zip((x0, y0, x1, y1), names,
-                                                                                        strict=True))
-    w, h = size
-    a, b, c, d = max(0, round(x0)), max(0, round(y0)), min(w, round(x1)), min(h, round(y1))
-    if a >= c or b >= d:
-        raise InterchangeError(f"{where} is empty once rounded to whole pixels and clipped to the {w}x{h} image: "
-                               f"x {x0:g} to {x1:g}, y {y0:g} to {y1:g}")
-    return Rect(label, a, b, c, d)
-
-
-def _list(value: Any, where: str) -> list:
-    if not isinstance(value, list):
-        raise InterchangeError(f"{where} must be a list, got {type(value).__name__}")
-    return value
-
-
-def _object(value: Any, where: str) -> dict:
-    if not isinstance(value, dict):
-        raise InterchangeError(f"{where} must be an object, got {type(value).__name__}")
-    return value
-
-
-def _count(rects: list, where: str) -> None:
-    if len(rects) > MAX_RECTS:
-        raise InterchangeError(f"too many {where}: more than {MAX_RECTS}")
-
-
-@dataclass(frozen=True)
-class _Choice:
-    image: str | None  # a name or id
-    size: tuple[int, int] | None  # else the only image of this size
-
-
-def _whole(value: Any) -> int | None:
-    try:
-        return int(float(value))
-    except (TypeError, ValueError, OverflowError):
-        return None
-
-
-def _pick(names: list[str], ids: list[str], sizes: list[tuple], choice: _Choice, where: str) -> int:
-    """The index of the image to read: named by its name, its name without folders, or its id; else the only
-    one, or the only one of the size asked for."""
-    if not names:
-        raise InterchangeError(f"{where}: the file holds no image")
-    image = choice.image
-    if image is None:
-        fits = [i for i, (w, h) in enumerate(sizes) if choice.size == (_whole(w), _whole(h))]
-        if len(names) == 1 or len(fits) == 1:
-            return 0 if len(names) == 1 else fits[0]
-        raise SeveralImages(names)
-    for keys in (names, [PurePosixPath(n.replace("\\", "/")).name for n in names], ids):
-        hits = [i for i, key in enumerate(keys) if key == image]
-        if len(hits) == 1:
-            return hits[0]
-        if hits:
-            raise InterchangeError(f"{len(hits)} images are named {image!r}: give the whole name")
-    listing = ", ".join(names[:20]) + (f" and {len(names) - 20} more" if len(names) > 20 else "")
-    raise InterchangeError(f"no image named {image!r}; the file holds {listing}")
-
-
 # --- the formats -------------------------------------------------------------------------------------------------
 
-def _read_coco(doc: dict, choice: _Choice, notes: _Notes) -> tuple[Segmentation, str]:
-    images = _list(doc.get("images"), "images")
+def _read_coco(doc: dict, choice: Choice, notes: Notes) -> tuple[Segmentation, str]:
+    images = as_list(doc.get("images"), "images")
     for i, entry in enumerate(images):
-        _object(entry, f"images[{i}]")
+        as_object(entry, f"images[{i}]")
     names = [e["file_name"] if isinstance(e.get("file_name"), str) and e["file_name"] else str(e.get("id"))
              for e in images]
-    k = _pick(names, [str(e.get("id")) for e in images], [(e.get("width"), e.get("height")) for e in images],
+    k = pick(names, [str(e.get("id")) for e in images], [(e.get("width"), e.get("height")) for e in images],
               choice, "images")
     entry = images[k]
     if "id" not in entry:
         raise InterchangeError(f"images[{k}].id is missing")
-    size = _size(entry.get("width"), entry.get("height"), f"images[{k}]")
+    size = size_of(entry.get("width"), entry.get("height"), f"images[{k}]")
     categories = {}
-    for i, cat in enumerate(_list(doc.get("categories"), "categories")):
-        cat = _object(cat, f"categories[{i}]")
+    for i, cat in enumerate(as_list(doc.get("categories"), "categories")):
+        cat = as_object(cat, f"categories[{i}]")
         if isinstance(cat.get("id"), bool) or not isinstance(cat.get("id"), int | str):
             raise InterchangeError(f"categories[{i}].id must be a number, got {str(cat.get('id'))[:40]}")
         categories[cat["id"]] = (cat.get("name"), f"categories[{i}].name")
     rects = []
-    for i, ann in enumerate(_list(doc.get("annotations"), "annotations")):
+    for i, ann in enumerate(as_list(doc.get("annotations"), "annotations")):
         where = f"annotations[{i}]"
-        ann = _object(ann, where)
+        ann = as_object(ann, where)
         if ann.get("image_id") != entry["id"] or isinstance(ann.get("image_id"), bool):
             continue
         cat = ann.get("category_id")
         if isinstance(cat, bool) or not isinstance(cat, int | str) or cat not in categories:
             raise InterchangeError(f"{where}.category_id {str(cat)[:40]} is not the id of one of the categories")
         name, cat_where = categories[cat]
-        label = _label(name, f"{cat_where} (of {where})")
-        box = _list(ann.get("bbox"), f"{where}.bbox")
+        label = label_of(name, f"{cat_where} (of {where})")
+        box = as_list(ann.get("bbox"), f"{where}.bbox")
         if len(box) != 4:
             raise InterchangeError(f"{where}.bbox must be [x, y, width, height], got {len(box)} numbers")
-        x, y, w, h = (_number(v, f"{where}.bbox") for v in box)
+        x, y, w, h = (number(v, f"{where}.bbox") for v in box)
         if w < 0 or h < 0:
             raise InterchangeError(f"{where}.bbox has a negative width or height: {box}")
         if ann.get("iscrowd") == 1:
             notes.add("crowd annotations (iscrowd 1) read as one box each", where)
-        rects.append(_rect(label, x, y, x + w, y + h, size, f"{where}.bbox"))
-        _count(rects, "annotations")
+        rects.append(rect(label, x, y, x + w, y + h, size, f"{where}.bbox"))
+        check_count(rects, "annotations")
     return Segmentation(*size, tuple(rects)), names[k]
 
 
-def _read_labelme(doc: dict, choice: _Choice, notes: _Notes) -> tuple[Segmentation, str | None]:
-    size = _size(doc.get("imageWidth"), doc.get("imageHeight"), "", ("imageWidth", "imageHeight"))
-    shapes = _list(doc.get("shapes"), "shapes")
-    _count(shapes, "shapes")
+def _read_labelme(doc: dict, choice: Choice, notes: Notes) -> tuple[Segmentation, str | None]:
+    size = size_of(doc.get("imageWidth"), doc.get("imageHeight"), "", ("imageWidth", "imageHeight"))
+    shapes = as_list(doc.get("shapes"), "shapes")
+    check_count(shapes, "shapes")
     rects = []
     for i, shape in enumerate(shapes):
         where = f"shapes[{i}]"
-        shape = _object(shape, where)
-        label = _label(shape.get("label"), f"{where}.label")
+        shape = as_object(shape, where)
+        label = label_of(shape.get("label"), f"{where}.label")
         kind = shape.get("shape_type") or "polygon"  # as labelme reads a shape without one
-        points = _list(shape.get("points"), f"{where}.points")
+        points = as_list(shape.get("points"), f"{where}.points")
         if kind == "rectangle" and len(points) != 2:
             raise InterchangeError(f"{where}.points: a rectangle has 2 corners, got {len(points)} points")
         if kind == "polygon" and len(points) < 3:
@@ -399,11 +277,11 @@ def _read_labelme(doc: dict, choice: _Choice, notes: _Notes) -> tuple[Segmentati
         for j, p in enumerate(points):
             if not isinstance(p, list) or len(p) != 2:
                 raise InterchangeError(f"{where}.points[{j}] must be [x, y]")
-            xs.append(_number(p[0], f"{where}.points[{j}]"))
-            ys.append(_number(p[1], f"{where}.points[{j}]"))
+            xs.append(number(p[0], f"{where}.points[{j}]"))
+            ys.append(number(p[1], f"{where}.points[{j}]"))
         if kind == "polygon":
             notes.add("polygons read as their bounding boxes", where)
-        rects.append(_rect(label, min(xs), min(ys), max(xs), max(ys), size, where))
+        rects.append(rect(label, min(xs), min(ys), max(xs), max(ys), size, where))
     name = doc.get("imagePath")
     return Segmentation(*size, tuple(rects)), name if isinstance(name, str) and name else None
 
@@ -411,16 +289,16 @@ def _read_labelme(doc: dict, choice: _Choice, notes: _Notes) -> tuple[Segmentati
 CVAT_SHAPES = ("box", "polygon", "polyline", "points", "ellipse", "cuboid", "mask", "skeleton")
 
 
-def _read_cvat(root: ET.Element, choice: _Choice, notes: _Notes) -> tuple[Segmentation, str]:
+def _read_cvat(root: ET.Element, choice: Choice, notes: Notes) -> tuple[Segmentation, str]:
     images = root.findall("image")
     if not images and root.find("track") is not None:
         raise InterchangeError("this is CVAT for video (<track>s of frames): export the task as CVAT for images")
     names = [el.get("name") or el.get("id") or f"#{i}" for i, el in enumerate(images)]
-    k = _pick(names, [str(el.get("id")) for el in images], [(el.get("width"), el.get("height")) for el in images],
+    k = pick(names, [str(el.get("id")) for el in images], [(el.get("width"), el.get("height")) for el in images],
               choice, "<image>")
     el = images[k]
     at = f"image[{k}]"
-    size = _size(el.get("width"), el.get("height"), at)
+    size = size_of(el.get("width"), el.get("height"), at)
     rects: list[Rect] = []
     seen: dict[str, int] = {}
     for child in el:
@@ -431,19 +309,19 @@ def _read_cvat(root: ET.Element, choice: _Choice, notes: _Notes) -> tuple[Segmen
             continue
         if child.tag not in CVAT_SHAPES:
             continue  # not an annotation (CVAT adds elements in minor versions)
-        label = _label(child.get("label"), f"{where}.label")
+        label = label_of(child.get("label"), f"{where}.label")
         if child.tag == "box":
             box = (child.get("xtl"), child.get("ytl"), child.get("xbr"), child.get("ybr"))
             if None in box:
                 raise InterchangeError(f"{where} needs xtl, ytl, xbr and ybr")
-            rects.append(_rect(label, *box, size, where, fields=("xtl", "ytl", "xbr", "ybr")))
+            rects.append(rect(label, *box, size, where, fields=("xtl", "ytl", "xbr", "ybr")))
         elif child.tag == "polygon":
             xs, ys = _points(child.get("points"), f"{where}.points")
             notes.add("polygons read as their bounding boxes", where)
-            rects.append(_rect(label, min(xs), min(ys), max(xs), max(ys), size, where))
+            rects.append(rect(label, min(xs), min(ys), max(xs), max(ys), size, where))
         else:
             raise InterchangeError(f"{where}: a <{child.tag}> is not a box or a polygon")
-        _count(rects, "boxes")
+        check_count(rects, "boxes")
     return Segmentation(*size, tuple(rects)), names[k]
 
 
@@ -451,7 +329,7 @@ def _points(text: str | None, where: str) -> tuple[list[float], list[float]]:
     pairs = [p.split(",") for p in (text or "").split(";") if p.strip()]
     if len(pairs) < 3 or any(len(p) != 2 for p in pairs):
         raise InterchangeError(f"{where} must be at least 3 points 'x0,y0;x1,y1;…', got {(text or '')[:40]!r}")
-    return [_number(x, where) for x, _ in pairs], [_number(y, where) for _, y in pairs]
+    return [number(x, where) for x, _ in pairs], [number(y, where) for _, y in pairs]
 
 
 def _write_coco(seg: Segmentation, image: str) -> bytes:

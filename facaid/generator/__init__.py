@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from facaid.generator.heuristics import build_procedure
+from facaid.generator.image import build_procedure
 from facaid.generator.styles import PRESETS, STYLE_NAMES, Style, sample_style
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure, validate

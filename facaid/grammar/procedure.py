@@ -1,27 +1,27 @@
 """Procedures: derivation trees of the FaçAID split grammar, their JSON form and their validation.
 
-A procedure holds the image size and a tree of nodes. Inner nodes split their region along one axis into
-children whose sizes are given by size specs; leaves paint their region with one of the 12 CMP labels.
+A procedure holds the image size and a tree of nodes. Inner nodes split their region along one axis into children
+whose sizes are given by size specs; leaves paint their region with one of the 12 CMP labels.
 
 Rules (see docs/grammar.md for pictures):
 
 - ``leaf``: a terminal; ``label`` is one of `facaid.labels.LABELS`.
 - ``split``: ``axis`` ``x`` (left to right) or ``y`` (top to bottom); ``sizes[i]`` sizes ``children[i]``.
-- ``repeat``: the pattern ``children`` (sized by ``sizes``) is laid out ``count`` times (an integer, or
-  ``"fill"``: as many times as the nominal sizes fit), followed by the first ``tail`` pattern items again,
-  so ``[pillar, tile]`` with ``tail=1`` gives pillar tile pillar tile ... pillar.
-- ``mirror``: ``children`` then the same children in reverse order, each copy reflected along the axis;
-  with ``center`` the last child is the middle one and is not repeated.
+- ``repeat``: the pattern ``children`` (sized by ``sizes``) is laid out ``count`` times (an integer, or ``"fill"``:
+  as many times as the nominal sizes fit), followed by the first ``tail`` pattern items again, so ``[pillar, tile]``
+  with ``tail=1`` gives pillar tile pillar tile ... pillar.
+- ``mirror``: ``children`` then the same children in reverse order, each copy reflected along the axis; with
+  ``center`` the last child is the middle one and is not repeated.
 
-A repeat may list ``exceptions``: copies that differ from the typical one by a delta, each an `Override` of one
-node of one copy (its size, or the node itself: a closed blind, a missing sill, a taller first floor). The copy
-stays a copy of the repeat, so changing the count adds or removes typical copies.
+A repeat may list ``exceptions``: copies that differ from the typical one by a delta, each an `Override` of one node
+of one copy (its size, or the node itself: a closed blind, a missing sill, a taller first floor). The copy stays a
+copy of the repeat, so changing the count adds or removes typical copies.
 
-A size spec is ``[mode, value]``: ``abs`` is a length in pixels, ``rel`` a fraction of the parent's length,
-``flt`` a floating length: floating children share what the others leave, in proportion to their values
-(their nominal pixel lengths). When fixed sizes overflow the parent they are scaled down to fit and the
-floating ones get nothing; when a node has no floating child its fixed sizes are scaled to fill the parent
-exactly. Every node may carry a ``role`` (what it stands for: floor, tile, ...); it never changes execution.
+A size spec is ``[mode, value]``: ``abs`` is a length in pixels, ``rel`` a fraction of the parent's length, ``flt`` a
+floating length: floating children share what the others leave, in proportion to their values (their nominal pixel
+lengths). When fixed sizes overflow the parent they are scaled down to fit and the floating ones get nothing; when a
+node has no floating child its fixed sizes are scaled to fill the parent exactly. Every node may carry a ``role``
+(what it stands for: floor, tile, ...); it never changes execution.
 """
 
 from __future__ import annotations
@@ -31,8 +31,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from facaid.grammar.budget import charge
-from facaid.grammar.layout import count_expansion
+from facaid.grammar.checks import MODES, check_expansion, check_meta, check_size, is_number
+from facaid.grammar.errors import ProcedureError
 from facaid.grammar.limits import (
     MAX_CHILDREN,
     MAX_COUNT,
@@ -44,6 +44,7 @@ from facaid.grammar.limits import (
     MAX_META_CHARS,
     MAX_NODES,
 )
+from facaid.grammar.repeats import along_path, expanded_count, recount
 from facaid.labels import LABEL_ID, LABELS
 from facaid.numbers import finite
 
@@ -53,7 +54,6 @@ GRAMMAR_VERSION = "facaid-split-1"
 
 RULES = ("leaf", "split", "repeat", "mirror")
 AXES = ("x", "y")
-MODES = ("abs", "rel", "flt")
 ROLES = (
     "image",  # the whole picture: building and background around it
     "facade",  # one building or wing
@@ -75,14 +75,6 @@ __all__ = [
     "MAX_EXTENT", "MAX_INSTANCES", "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES", "Node",
     "Override", "Procedure", "ProcedureError", "Size", "parse_procedure", "recount", "validate",
 ]
-
-
-class ProcedureError(ValueError):
-    """An invalid procedure; the message names the node by its path, e.g. ``root/2/0``."""
-
-    def __init__(self, path: str, message: str):
-        super().__init__(f"node {path}: {message}")
-        self.path = path
 
 
 class Override(NamedTuple):
@@ -275,55 +267,6 @@ class Procedure:
 
 # --- parsing and validation ---------------------------------------------------------------------------------
 
-def _is_number(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool)
-
-
-def _check_size(path: str, i: int, mode: str, value: Any, what: str | None = None) -> None:
-    what = what or f"sizes[{i}]"
-    if mode not in MODES:
-        raise ProcedureError(path, f"{what} has unknown mode {mode!r}; expected one of {', '.join(MODES)}")
-    if not _is_number(value):
-        raise ProcedureError(path, f"{what} value must be a number, got {value!r}")
-    if not finite(value):
-        raise ProcedureError(path, f"{what} value must be finite, got {value!r}")
-    if value < 0:
-        raise ProcedureError(path, f"{what} is negative ({value!r})")
-    if mode == "rel" and value > 1:
-        raise ProcedureError(path, f"{what} is a relative size above 1 ({value!r})")
-    if value > MAX_EXTENT:
-        raise ProcedureError(path, f"{what} is too large ({value!r} > {MAX_EXTENT:g})")
-
-
-def _texts(value: Any) -> Iterator[str]:
-    """Every key and string in a JSON value."""
-    stack = [value]
-    while stack:
-        value = stack.pop()
-        if isinstance(value, str):
-            yield value
-        elif isinstance(value, dict):
-            yield from (k for k in value if isinstance(k, str))
-            stack.extend(value.values())
-        elif isinstance(value, list):
-            stack.extend(value)
-
-
-def _check_meta(meta: dict) -> None:
-    """Free-form notes, but plain JSON that every database stores and every encoder writes back: finite numbers,
-    text without NUL or unpaired surrogates, at most `MAX_META_CHARS` written out."""
-    try:
-        text = json.dumps(meta, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
-        text.encode("utf-8")
-    except (ValueError, TypeError, UnicodeEncodeError, RecursionError) as exc:
-        raise ProcedureError("(document)", f"meta must be plain JSON text and finite numbers ({exc})") from None
-    if any("\x00" in text for text in _texts(meta)):
-        raise ProcedureError("(document)", "meta must not hold NUL characters")
-    if len(text) > MAX_META_CHARS:
-        raise ProcedureError("(document)", f"meta is too long ({len(text)} characters written out; at most "
-                                           f"{MAX_META_CHARS})")
-
-
 def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
     if depth > MAX_DEPTH:
         raise ProcedureError(path, f"tree too deep (more than {MAX_DEPTH} levels)")
@@ -366,7 +309,7 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
     for i, s in enumerate(sizes_in):
         if not (isinstance(s, list) and len(s) == 2):
             raise ProcedureError(path, f"sizes[{i}] must be a [mode, value] pair, got {s!r}")
-        _check_size(path, i, s[0], s[1])
+        check_size(path, i, s[0], s[1])
         sizes.append(Size(s[0], s[1]))
     node = Node(rule, axis=axis, sizes=sizes, role=role)
     if rule == "repeat":
@@ -389,77 +332,6 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
     if rule == "repeat" and "exceptions" in obj:
         node.exceptions = _parse_exceptions(obj["exceptions"], node, path, depth, counter)
     return node
-
-
-def _expanded_count(node: Node) -> int:
-    """How many children a node lays out (a ``"fill"`` repeat: as many as it may)."""
-    k = len(node.children)
-    if node.rule == "repeat":
-        return k * (MAX_COUNT if node.count == "fill" else node.count) + node.tail
-    if node.rule == "mirror":
-        return 2 * k - node.center
-    return k
-
-
-def _pattern_child(node: Node, i: int) -> Node:
-    """The node expanded child ``i`` of ``node`` is (`layout.expand`'s order), or the node an exception of ``node``
-    puts in its place (an exception of a whole copy's item: a path through it goes on in that node)."""
-    k = len(node.children)
-    if node.rule == "mirror" and i >= k:
-        return node.children[k - (2 if node.center else 1) - (i - k)]
-    if node.exceptions:
-        copy, item = divmod(i, k)
-        for o in node.exceptions:
-            if o.node is not None and o.copy == copy and o.path == (item,):
-                return o.node
-    return node.children[i % k]
-
-
-def copies_moved(node: Node, count: int) -> dict[int, int]:
-    """Where each copy of the repeat ``node`` goes when its count becomes ``count`` (a copy absent: removed; the
-    tail, ``node.count``, goes to ``count``): new copies are typical and go after the last typical copy (one that no
-    exception of ``node`` changes), between its like; removed copies are typical ones from the end first, then the
-    last."""
-    old = node.count
-    changed = {o.copy for o in node.exceptions}
-    typical = [c for c in range(old) if c not in changed]
-    if count >= old:
-        at = typical[-1] + 1 if typical else old
-        new = {c: c if c < at else c + count - old for c in range(old)}
-    else:
-        gone = set((typical[::-1] + [c for c in range(old - 1, -1, -1) if c in changed])[: old - count])
-        new = {c: c - sum(1 for g in gone if g < c) for c in range(old) if c not in gone}
-    new[old] = count  # the tail
-    return new
-
-
-def recount(root: Node, node: Node, count: int, new: dict[int, int] | None = None) -> None:
-    """Set the count of the repeat ``node`` (in the tree under ``root``) to ``count``, in place, keeping every
-    exception on its copy as `copies_moved` places the copies (or as ``new`` says, a mapping of the same kind:
-    rows of tiles that must stay in step). The tail keeps its exceptions, and the paths of repeats above that run
-    through ``node`` follow their copies."""
-    k = len(node.children)
-    moved = (copies_moved(node, count) if new is None else new).get  # a copy's new index, None when it goes
-    paths = {}  # the repeats above first: their paths run through node's copies as they are now
-    for _, above in root.walk():
-        if not above.exceptions or above is node:
-            continue
-        kept = []
-        for o in above.exceptions:
-            steps = list(o.path)
-            for s, target in _along_path(above, o, above.exceptions):
-                if target is node and s + 1 < len(steps):
-                    c = moved(steps[s + 1] // k)
-                    if c is None:
-                        break
-                    steps[s + 1] = c * k + steps[s + 1] % k
-            else:
-                kept.append(o._replace(path=tuple(steps)))
-        paths[id(above)] = (above, kept)
-    for above, kept in paths.values():
-        above.exceptions = kept
-    node.exceptions = [o._replace(copy=moved(o.copy)) for o in node.exceptions if moved(o.copy) is not None]
-    node.count = count
 
 
 def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: list[int]) -> list[Override]:
@@ -500,7 +372,7 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
             s = item["size"]
             if not (isinstance(s, list) and len(s) == 2):
                 raise ProcedureError(path, f"{where}.size must be a [mode, value] pair, got {s!r}")
-            _check_size(path, e, s[0], s[1], what=f"{where}.size")
+            check_size(path, e, s[0], s[1], what=f"{where}.size")
             size = Size(s[0], s[1])
         sub = None
         if "node" in item:
@@ -517,32 +389,18 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
     return out
 
 
-def _along_path(node: Node, o: Override, exceptions: list[Override]) -> Iterator[tuple[int, Node]]:
-    """The nodes an exception's path runs through, (step, node reached) each: the copy's item, then each child as
-    laid out, where an exception of the same copy puts a node at a shorter path or a repeat below puts one in
-    place of a whole item (`_pattern_child`), that node."""
-    own = {e.path: e.node for e in exceptions if e.copy == o.copy and e.node is not None and e is not o}
-    target = own.get(o.path[:1], node.children[o.path[0]])
-    yield 0, target
-    for k in range(1, len(o.path)):
-        if target.rule == "leaf" or o.path[k] >= _expanded_count(target):
-            return
-        target = own.get(o.path[: k + 1]) or _pattern_child(target, o.path[k])
-        yield k, target
-
-
 def _path_problem(node: Node, o: Override, exceptions: list[Override]) -> str | None:
     """What is wrong with an exception's path (None if nothing): a step below a leaf or past the children."""
     reached = 0
     parent = None
-    for k, target in _along_path(node, o, exceptions):
+    for k, target in along_path(node, o, exceptions):
         reached, parent = k, target
     if reached == len(o.path) - 1:
         return None
     k = reached + 1
     if parent.rule == "leaf":
         return f"path[{k}] goes below a leaf"
-    return f"path[{k}] is {o.path[k]}, but that node lays out {_expanded_count(parent)} children"
+    return f"path[{k}] is {o.path[k]}, but that node lays out {expanded_count(parent)} children"
 
 
 def parse_procedure(obj: Any) -> Procedure:
@@ -558,12 +416,12 @@ def parse_procedure(obj: Any) -> Procedure:
                              f"made for grammar {obj.get('grammar')!r}; this build runs {GRAMMAR_VERSION!r}")
     for key in ("width", "height"):
         v = obj.get(key)
-        if not _is_number(v) or not finite(v) or not 1 <= v <= MAX_EXTENT:
+        if not is_number(v) or not finite(v) or not 1 <= v <= MAX_EXTENT:
             raise ProcedureError("(document)", f"{key} must be a number from 1 to {MAX_EXTENT:g}, got {v!r}")
     meta = obj.get("meta", {})
     if not isinstance(meta, dict):
         raise ProcedureError("(document)", f"meta must be an object, got {type(meta).__name__}")
-    _check_meta(meta)
+    check_meta(meta)
     extra = sorted(set(obj) - {"format", "version", "grammar", "width", "height", "root", "meta"})
     if extra:
         raise ProcedureError("(document)", f"unexpected key(s): {', '.join(extra)}")
@@ -571,21 +429,10 @@ def parse_procedure(obj: Any) -> Procedure:
         raise ProcedureError("(document)", "missing 'root'")
     root = _parse_node(obj["root"], "root", 0, [0])
     proc = Procedure(obj["width"], obj["height"], root, meta)
-    _check_expansion(proc)
+    check_expansion(proc)
     return proc
 
 
 def validate(proc: Procedure) -> None:
     """Validate a procedure built in code (the generator, variations) exactly as JSON input is validated."""
     parse_procedure(proc.to_dict())
-
-
-def _check_expansion(proc: Procedure) -> None:
-    """The cost model: what executing the tree would cost, bounded before any of it is paid (`count_expansion`,
-    from the distinct nodes only, so a crafted tree is refused in microseconds), and charged to the work budget of
-    the request it is part of (`facaid.grammar.budget`). Each leaf is an instance, so `MAX_LEAVES` holds too."""
-    cost = count_expansion(proc.root, proc.width, proc.height)
-    if cost.instances > MAX_INSTANCES or cost.leaves > MAX_LEAVES:
-        raise ProcedureError("root", f"expands to more than {MAX_INSTANCES} node instances (each node once per copy "
-                                     f"of it, repeats and splits included): the limit of what one tree may cost")
-    charge(cost.instances)

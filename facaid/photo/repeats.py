@@ -13,7 +13,7 @@ that make up its lattice are found by voting (after Pauly et al. 2008, "Discover
 4. Every drawn element is carried by every repeat to where the photo looks most like it (`JITTER` around), and
    is as alike as the lower of its NCC with its wall and without: what a window's wall shares with the wall
    between two windows does not make that wall a window. `facaid.completion` proposes the carried elements that
-   stand in a drawn row or column of their class; `facaid.photo.copies` carries one unit a person selected.
+   stand in a drawn row or column of their class; `facaid.completion.copies` carries one unit a person selected.
 
 Pillars and moldings are not carried (`CARRIED`): along their length they look like themselves anywhere. The work
 of a call is bounded: the photo at `SIDE`, `MAX_VOTERS` voters, `MAX_CARRIES` elements carried by a repeat.

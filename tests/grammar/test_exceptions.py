@@ -22,11 +22,9 @@ from facaid.grammar.procedure import (
     Procedure,
     ProcedureError,
     Size,
-    _expanded_count,
-    _pattern_child,
-    recount,
     validate,
 )
+from facaid.grammar.repeats import expanded_count, pattern_child, recount
 from facaid.labels import LABEL_ID
 from facaid.native import rects
 from facaid.parameters import named_parameters, normalised, set_parameter
@@ -158,9 +156,9 @@ def random_exceptions(proc: Procedure, rng: np.random.Generator, n: int = 6) -> 
         path = [int(rng.integers(len(node.children)))]
         target = node.children[path[0]]
         while target.rule != "leaf" and rng.random() < 0.6:
-            i = int(rng.integers(min(_expanded_count(target), 40)))
+            i = int(rng.integers(min(expanded_count(target), 40)))
             path.append(i)
-            target = _pattern_child(target, i)
+            target = pattern_child(target, i)
         size = Size("flt" if rng.random() < 0.5 else "abs", float(rng.uniform(2, 60))) if rng.random() < 0.6 else None
         new = leaf(labels[rng.integers(len(labels))]) if size is None or rng.random() < 0.5 else None
         override = Override(int(rng.integers(copies)), tuple(path), size, new)

@@ -1,4 +1,4 @@
-"""The photo's repeats (`photo.repeats`): find copies of a drawn unit (`photo.copies`) and completion's repeats, on
+"""The photo's repeats (`photo.repeats`): find copies of a drawn unit (`completion.copies`) and completion's repeats, on
 pictures made here: a wall with a lattice of windows under a lighting gradient, with noise and closed blinds."""
 
 import json
@@ -8,8 +8,8 @@ from photo_helpers import CLOSED, GRID, lattice_photo, sill_of
 from PIL import Image
 
 from facaid.completion import complete
+from facaid.completion.copies import UnitError, find_copies
 from facaid.labels import FACADE, LABEL_ID
-from facaid.photo.copies import UnitError, find_copies
 from facaid.segmentation import Rect, Segmentation
 
 WINDOW, SILL = LABEL_ID["window"], LABEL_ID["sill"]

@@ -265,8 +265,8 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
 
 
 def test_completion_with_a_unit_proposes_its_copies_in_the_photo(as_alice):
-    """``unit`` in the body: the copies of a window with its sill, found in the photo (`photo.copies`), each with its
-    score and the copy it belongs to; a bad unit is a 400 naming it."""
+    """``unit`` in the body: the copies of a window with its sill, found in the photo (`completion.copies`), each
+    with its score and the copy it belongs to; a bad unit is a 400 naming it."""
     from photo_helpers import CLOSED, GRID, lattice_photo, sill_of
 
     out = io.BytesIO()

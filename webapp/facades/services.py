@@ -22,10 +22,10 @@ from PIL import Image
 from rest_framework.exceptions import APIException, ValidationError
 
 from facaid.completion import RejectedError, complete
+from facaid.completion.copies import UnitError, find_copies
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE
 from facaid.formats import interchange
 from facaid.photo import appearance
-from facaid.photo.copies import UnitError, find_copies
 from facaid.photo.rectify import propose_corners_file, rectify_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
@@ -195,7 +195,7 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
     segmentation JSON, optionally with ``rejected`` (rectangles not to propose again), ``min_score`` and
     ``use_photo`` (default true: the photo the segmentation is drawn on confirms or rejects each proposal). With
     ``unit`` (indices of its rectangles: a window and what is drawn around it), the copies of that unit the photo
-    shows instead (`facaid.photo.copies.find_copies`)."""
+    shows instead (`facaid.completion.copies.find_copies`)."""
     seg = _segmentation_of(photo, data, "segmentation").segmentation
     rejected = data.get("rejected") or []
     unit = data.get("unit")

@@ -1,0 +1,79 @@
+"""The checks of a procedure that need no parsing: a size spec, the free-form notes (``meta``) and what executing
+the tree would cost."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any
+
+from facaid.grammar.budget import charge
+from facaid.grammar.errors import ProcedureError
+from facaid.grammar.layout import count_expansion
+from facaid.grammar.limits import MAX_EXTENT, MAX_INSTANCES, MAX_LEAVES, MAX_META_CHARS
+from facaid.numbers import finite
+
+if TYPE_CHECKING:
+    from facaid.grammar.procedure import Procedure
+
+MODES = ("abs", "rel", "flt")
+
+
+def is_number(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+def check_size(path: str, i: int, mode: str, value: Any, what: str | None = None) -> None:
+    what = what or f"sizes[{i}]"
+    if mode not in MODES:
+        raise ProcedureError(path, f"{what} has unknown mode {mode!r}; expected one of {', '.join(MODES)}")
+    if not is_number(value):
+        raise ProcedureError(path, f"{what} value must be a number, got {value!r}")
+    if not finite(value):
+        raise ProcedureError(path, f"{what} value must be finite, got {value!r}")
+    if value < 0:
+        raise ProcedureError(path, f"{what} is negative ({value!r})")
+    if mode == "rel" and value > 1:
+        raise ProcedureError(path, f"{what} is a relative size above 1 ({value!r})")
+    if value > MAX_EXTENT:
+        raise ProcedureError(path, f"{what} is too large ({value!r} > {MAX_EXTENT:g})")
+
+
+def _texts(value: Any) -> Iterator[str]:
+    """Every key and string in a JSON value."""
+    stack = [value]
+    while stack:
+        value = stack.pop()
+        if isinstance(value, str):
+            yield value
+        elif isinstance(value, dict):
+            yield from (k for k in value if isinstance(k, str))
+            stack.extend(value.values())
+        elif isinstance(value, list):
+            stack.extend(value)
+
+
+def check_meta(meta: dict) -> None:
+    """Free-form notes, but plain JSON that every database stores and every encoder writes back: finite numbers,
+    text without NUL or unpaired surrogates, at most `MAX_META_CHARS` written out."""
+    try:
+        text = json.dumps(meta, ensure_ascii=False, allow_nan=False, separators=(",", ":"))
+        text.encode("utf-8")
+    except (ValueError, TypeError, UnicodeEncodeError, RecursionError) as exc:
+        raise ProcedureError("(document)", f"meta must be plain JSON text and finite numbers ({exc})") from None
+    if any("\x00" in text for text in _texts(meta)):
+        raise ProcedureError("(document)", "meta must not hold NUL characters")
+    if len(text) > MAX_META_CHARS:
+        raise ProcedureError("(document)", f"meta is too long ({len(text)} characters written out; at most "
+                                           f"{MAX_META_CHARS})")
+
+
+def check_expansion(proc: Procedure) -> None:
+    """The cost model: what executing the tree would cost, bounded before any of it is paid (`count_expansion`,
+    from the distinct nodes only, so a crafted tree is refused in microseconds), and charged to the work budget of
+    the request it is part of (`facaid.grammar.budget`). Each leaf is an instance, so `MAX_LEAVES` holds too."""
+    cost = count_expansion(proc.root, proc.width, proc.height)
+    if cost.instances > MAX_INSTANCES or cost.leaves > MAX_LEAVES:
+        raise ProcedureError("root", f"expands to more than {MAX_INSTANCES} node instances (each node once per copy "
+                                     f"of it, repeats and splits included): the limit of what one tree may cost")
+    charge(cost.instances)
