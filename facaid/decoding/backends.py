@@ -2,8 +2,8 @@
 
 - the C step (`facaid.native`), where it builds: K rows in shards on torch's threads;
 - `facaid.decoder.DecoderState`: the model's own decoder blocks stepped with their key/value cache.
-Both give the logits of the teacher-forced `FacaidModel.decode` (to about 1e-5; tests/model/test_native.py,
-tests/model/test_decoding.py).
+Both give the logits of the teacher-forced `FacaidModel.decode` (to about 1e-5; tests/decoding/test_native_step.py,
+tests/decoding/test_decoding.py).
 """
 
 from __future__ import annotations
