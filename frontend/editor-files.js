@@ -80,7 +80,7 @@ export function mountFiles(ed) {
     ed.status("Drag the four corners onto the facade's corners; the preview shows the result.");
   }
 
-  /** The real size typed in the rectification panel, as the ed.photo's fields ({real_width_m: 12.5}: the other side
+  /** The real size typed in the rectification panel, as the photo's fields ({real_width_m: 12.5}: the other side
    * cleared; both null when the field is empty); throws a message for what is not a size. */
   function typedRealSize() {
     const input = $("#real-metres"), side = $("#real-side").value;

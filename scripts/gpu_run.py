@@ -1,7 +1,8 @@
 """What a session lent a GPU machine runs, as it is: `scripts/gpu-run OUT [--limit SECONDS]`.
 
-1. Installs what the machine lacks (transformers of the version pyproject.toml asks for, orjson) from the wheels it
-   carries (`--wheels`, default var/gpu-wheels, made here by `scripts/gpu-wheels`): nothing is downloaded there.
+1. Installs what the machine lacks (transformers, orjson, safetensors, tqdm at the versions pyproject.toml asks
+   for) from the wheels it carries (`--wheels`, default var/gpu-wheels, made here by `scripts/gpu-wheels`): nothing
+   is downloaded there; then starts again, so that nothing imported before the install lingers.
 2. Checks CUDA and prints the device.
 3. Reconstructs generated facades with `facaid.reconstruct` on CUDA and on the CPU, and runs one worker job
    (`worker.compute.reconstruct`, the Celery task's work) on CUDA: each must give the CPU's procedure (the same tree,
@@ -18,7 +19,6 @@ all of it on the CPU with tiny figures and a few training steps of configs/small
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import os
 import shutil
@@ -31,33 +31,47 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # the working tree as it is: the machine has the project's files, not it installed
 
-REQUIRED = {"transformers": (5, 24), "orjson": None, "safetensors": None, "tqdm": None}
+REQUIRED = ("transformers", "orjson", "safetensors", "tqdm")  # at pyproject's versions (scripts/gpu-wheels)
 SIZE_TOLERANCE = 0.5  # pixels: a size of the CUDA tree may differ from the CPU's by this much (float sums)
 ACCURACY_TOLERANCE = 0.002
 TRAIN_MARGIN = 45  # seconds kept back from training to save, evaluate nothing more and write the report
 
 
-def _version(name: str) -> tuple[int, ...] | None:
-    try:
-        module = importlib.import_module(name)
-    except ImportError:
-        return None
-    parts = str(getattr(module, "__version__", "0")).split(".")
-    return tuple(int(p) for p in parts[:2] if p.isdigit())
+def _pins() -> dict[str, str]:
+    """pyproject.toml's requirement of each of `REQUIRED` ("transformers>=5.24,<6"), or the bare name."""
+    import re
+    import tomllib
+
+    deps = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["dependencies"]
+    named = {re.split(r"[\[<>=!~ ]", d, maxsplit=1)[0]: d.split(";")[0].strip() for d in deps}
+    return {name: named.get(name, name) for name in REQUIRED}
 
 
 def missing() -> list[str]:
-    """The packages of `REQUIRED` this Python lacks, or has older than asked."""
+    """The requirements of `REQUIRED` this Python does not meet, read from the installed metadata with nothing
+    imported (an old version's modules must not linger into the new one's)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        from packaging.requirements import Requirement
+    except ImportError:  # pip's own copy, where the machine has no packaging of its own
+        from pip._vendor.packaging.requirements import Requirement
+
     out = []
-    for name, least in REQUIRED.items():
-        have = _version(name)
-        if have is None or (least is not None and have < least):
-            out.append(name)
+    for pin in _pins().values():
+        requirement = Requirement(pin)
+        try:
+            have = version(requirement.name)
+        except PackageNotFoundError:
+            out.append(pin)
+            continue
+        if not requirement.specifier.contains(have, prereleases=True):
+            out.append(pin)
     return out
 
 
 def install(wheels: Path, log) -> list[str]:
-    """Install what is missing from the wheels carried here; the names it could not install."""
+    """Install what is missing from the wheels carried here; what is still missing after."""
     needed = missing()
     if not needed:
         return []
@@ -66,11 +80,7 @@ def install(wheels: Path, log) -> list[str]:
         return needed
     log(f"installing {', '.join(needed)} from {wheels}")
     subprocess.run([sys.executable, "-m", "pip", "install", "--no-index", "--find-links", str(wheels), "--quiet",
-                    *[f"{n}>={'.'.join(map(str, REQUIRED[n]))}" if REQUIRED[n] else n for n in needed]],
-                   check=False)
-    importlib.invalidate_caches()
-    for name in needed:
-        sys.modules.pop(name, None)
+                    *needed], check=False)
     return missing()
 
 
@@ -182,7 +192,13 @@ def main(argv: list[str] | None = None) -> int:
         log_file.flush()
 
     report: dict = {"limit_s": args.limit, "dry_run": args.dry_run}
+    before = missing()
     left_over = install(Path(args.wheels), log)
+    if before and not left_over and not os.environ.get("FACAID_GPU_RUN_REEXEC"):
+        # installed now: started again, so that nothing imported before the install lingers
+        log_file.close()
+        os.execve(sys.executable, [sys.executable, __file__, *(argv if argv is not None else sys.argv[1:])],
+                  {**os.environ, "FACAID_GPU_RUN_REEXEC": "1"})
     if left_over:
         report["error"] = f"missing {', '.join(left_over)}"
         (out / "report.json").write_text(json.dumps(report, indent=1))

@@ -1,5 +1,7 @@
 """Permissions with three users: alice owns, bob is another user, charlie is anonymous."""
 
+import json
+
 import pytest
 
 from webapp.facades.models import Job, Procedure
@@ -162,6 +164,13 @@ def test_a_fork_of_a_procedure_whose_photo_is_private_shows_it_once_shared(objec
     assert r.status_code == 400 and "is not shared with you" in r.json()["procedure"]
     mine = as_bob.get(f"/api/v1/procedures/{fork.code}/").json()
     assert (mine["photo_shared"], mine["viewers_see"]) == (False, "Only you see this procedure.")
+    # an edited tree is not measured against the segmentation bob may not see: no figure tells him about it
+    edited = json.loads(json.dumps(mine["data"]))
+    edited["meta"] = {"probe": 1}
+    edited["root"]["sizes"][0][1] += 3
+    r = as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"data": edited}, format="json").json()
+    assert r["accuracy"] is None and "iou" not in r["metrics"]
+    assert r["metrics"]["unmeasured"] == "the photo it was made from is not shared with its owner"
     as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"visibility": "public"}, format="json")
     assert not shown(as_charlie, fork.code)
     assert "No photo to overlay" in as_charlie.get(f"/procedures/{fork.code}").content.decode()
@@ -173,6 +182,9 @@ def test_a_fork_of_a_procedure_whose_photo_is_private_shows_it_once_shared(objec
     assert shown(as_bob, fork.code) and shown(as_charlie, fork.code)
     assert "Re-run inference" in as_bob.get(f"/procedures/{fork.code}").content.decode()
     assert as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2}, format="json").status_code == 202
+    edited["root"]["sizes"][0][1] -= 3
+    r = as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"data": edited}, format="json").json()
+    assert r["accuracy"] is not None and "unmeasured" not in r["metrics"]  # shared now: measured
     # and hides it again: never shown while private
     photo.visibility = "private"
     photo.save()
@@ -196,8 +208,11 @@ def test_sharing_a_procedure_asks_about_its_photo_and_says_what_viewers_see(obje
     photo.refresh_from_db()
     assert (photo.visibility, r["photo_shared"]) == ("unlisted", True)
     assert r["viewers_see"] == "Anyone with its link sees the procedure with its photo and the overlay."
-    r = as_alice.patch(url, {"visibility": "public"}, format="json").json()  # the photo stays unlisted
-    assert r["photo_shared"] is False and "the photo is unlisted, so only those with its link" in r["viewers_see"]
+    r = as_alice.patch(url, {"visibility": "public"}, format="json").json()  # the photo stays unlisted: it shows
+    assert r["photo_shared"] is True and r["viewers_see"] == (
+        "Anyone sees the procedure with its photo and the overlay (the photo is unlisted: its page is not in the "
+        "gallery).")
+    assert as_charlie.get(url).json()["photo"] == str(photo.code)
     # the page's form: public, and the photo with it
     r = as_alice.post(f"/procedures/{proc.code}/visibility", {"visibility": "public", "share_photo": "on"},
                       follow=True)

@@ -22,7 +22,7 @@ from facaid.formats.mesh import MeshTooLarge, procedure_mesh
 from facaid.formats.render import segmentation_svg
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
-from webapp.facades import rendering
+from webapp.facades import access, rendering
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
 
@@ -48,9 +48,12 @@ def drawn_on_original(proc: Procedure) -> bool:
 
 def photo_scale(proc: Procedure) -> tuple[float, str] | None:
     """The scale the procedure's photo gives (its real width or height over the pixels of the image the procedure
-    was drawn on) and a line saying so; None without a photo or a real size."""
+    was drawn on) and a line saying so; None without a photo or a real size, or where its owner may not see the
+    photo (a fork of one not shared)."""
     photo = proc.photo
     if photo is None or (photo.real_width_m is None and photo.real_height_m is None):
+        return None
+    if not access.photo_visible_to(proc.owner, photo):  # a fork of a photo not shared with its owner
         return None
     scale = photo.metres_per_pixel((photo.width, photo.height) if drawn_on_original(proc) else None)
     if scale is None:

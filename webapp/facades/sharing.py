@@ -11,20 +11,25 @@ import copy
 from django.db import transaction
 from rest_framework.exceptions import ValidationError
 
-from webapp.facades.access import READABLE
+from webapp.facades import access
 from webapp.facades.models import Procedure, Visibility
 
 REACH = {Visibility.PRIVATE: 0, Visibility.UNLISTED: 1, Visibility.PUBLIC: 2}
 
 
+def _shared_as(photo_visibility: str, visibility: str) -> str:
+    """The photo's visibility once shared with a procedure of ``visibility``: at least as wide, never narrower."""
+    return visibility if REACH[photo_visibility] < REACH[visibility] else photo_visibility
+
+
 def photo_shared(proc: Procedure) -> bool | None:
     """Whether all who may see the procedure, its owner included, see its photo and overlay too; None without a
-    photo."""
+    photo. An unlisted photo is seen by anyone with a link to it, and the procedure's page gives that link."""
     photo = proc.photo
     if photo is None:
         return None
-    owner_sees = photo.owner_id == proc.owner_id or photo.visibility in READABLE
-    return owner_sees and REACH[photo.visibility] >= REACH[proc.visibility]
+    return access.photo_visible_to(proc.owner, photo) and (
+        proc.visibility == Visibility.PRIVATE or photo.visibility in access.READABLE)
 
 
 def may_share_photo(user, proc: Procedure) -> bool:
@@ -42,10 +47,9 @@ def viewers_see(proc: Procedure) -> str:
     if photo is None:
         return f"{who} sees the procedure, its pictures and 3D models; it has no photo."
     if photo_shared(proc):
-        return f"{who} sees the procedure with its photo and the overlay."
-    if photo.visibility in READABLE:
-        return (f"{who} sees the procedure, its pictures and 3D models; the photo is unlisted, so only those with "
-                "its link see it and the overlay.")
+        listed = " (the photo is unlisted: its page is not in the gallery)" if (
+            photo.visibility == Visibility.UNLISTED and proc.visibility == Visibility.PUBLIC) else ""
+        return f"{who} sees the procedure with its photo and the overlay{listed}."
     whose = "" if photo.owner_id == proc.owner_id else f" (it is {photo.owner.username}'s: only they can share it)"
     return (f"{who} sees the procedure, its pictures and 3D models, but not the photo or the overlay: the photo is "
             f"private{whose}.")
@@ -59,9 +63,9 @@ def previews(user, proc: Procedure) -> dict[str, str]:
         for share in (False, True) if may_share_photo(user, proc) else (False,):
             would = copy.copy(proc)
             would.visibility = visibility
-            if share and REACH[proc.photo.visibility] < REACH[visibility]:
+            if share:
                 would.photo = copy.copy(proc.photo)
-                would.photo.visibility = visibility
+                would.photo.visibility = _shared_as(proc.photo.visibility, visibility)
             out[visibility + ("+photo" if share else "")] = viewers_see(would)
     return out
 
@@ -78,7 +82,7 @@ def set_visibility(user, proc: Procedure, visibility: str, share_photo: bool = F
     with transaction.atomic():
         proc.visibility = visibility
         proc.save(update_fields=["visibility", "updated"])
-        if share_photo and REACH[proc.photo.visibility] < REACH[visibility]:
-            proc.photo.visibility = visibility
+        if share_photo and _shared_as(proc.photo.visibility, visibility) != proc.photo.visibility:
+            proc.photo.visibility = _shared_as(proc.photo.visibility, visibility)
             proc.photo.save(update_fields=["visibility"])
     return viewers_see(proc)

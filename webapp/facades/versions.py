@@ -13,7 +13,7 @@ from rest_framework.exceptions import ValidationError
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
-from webapp.facades import rendering, services, sharing
+from webapp.facades import access, rendering, services, sharing
 from webapp.facades.models import Change, Procedure, ProcedureVersion
 from webapp.facades.parsing import parse_procedure
 
@@ -26,10 +26,14 @@ MAX_VERSION_DIGITS = 9
 def remeasure(proc: Procedure) -> None:
     """Pixel accuracy and per-class IoU of the procedure's tree against the segmentation it was made from, into
     ``accuracy`` and ``metrics`` (nothing is saved). A tree of another size than the segmentation (a resized
-    variant) is not comparable: no accuracy, and ``metrics["unmeasured"]`` says why."""
+    variant) is not comparable: no accuracy, and ``metrics["unmeasured"]`` says why; neither is a fork's whose photo
+    is not shared with its owner (the figures would tell them about the segmentation)."""
     metrics = {k: v for k, v in (proc.metrics or {}).items() if k not in (*JOB_FIGURES, "iou", "unmeasured")}
     proc.accuracy = None
-    if proc.segmentation_id is not None:
+    if proc.segmentation_id is not None and not access.segmentation_visible_to(proc.owner, proc):
+        # a fork whose photo is not shared with its owner: no figure may tell them about the segmentation
+        metrics["unmeasured"] = "the photo it was made from is not shared with its owner"
+    elif proc.segmentation_id is not None:
         target = flatten(SegmentationData.from_dict(proc.segmentation.data))
         tree = parse_procedure(proc.data)
         size = (round(tree.width), round(tree.height))

@@ -18,7 +18,7 @@ from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
 from webapp.facades import access, example, jsonbody, services, sharing, throttling
-from webapp.facades.downloads import DOWNLOADS, download_scale
+from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
     PhotoForm,
     ProcedureVisibilityForm,
@@ -210,17 +210,18 @@ def procedure(request, code):
         "viewers_see": sharing.viewers_see(proc) if owner else "",
         "sharing_previews": sharing.previews(request.user, proc) if owner else {},
         "photo_hidden": proc.photo is not None and not photo_visible,
-        "photo_size": _drawn_on_size(proc) if photo_visible else None,
+        "drawn_on": _drawn_on(proc) if photo_visible else None,
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
         "max_scale": MAX_SCALE, "scale": _download_scale(proc)})
 
 
-def _drawn_on_size(proc) -> tuple[int, int]:
-    """The size of the photo's image the procedure was drawn on: the original's where the tree has its size, else
-    the working (rectified) image's, which the overlay needs the tree to have."""
-    original = (proc.photo.width, proc.photo.height)
-    size = (round(proc.data.get("width", 0)), round(proc.data.get("height", 0)))
-    return original if size == original else proc.photo.working_size()
+def _drawn_on(proc) -> dict:
+    """The photo's image the procedure was drawn on (the original, drawn before rectifying, or the working image),
+    its URL and size: the overlay lays the tree over that one."""
+    photo = proc.photo
+    if drawn_on_original(proc) or not photo.rectified:
+        return {"url": f"/api/v1/photos/{photo.code}/image", "size": (photo.width, photo.height)}
+    return {"url": f"/api/v1/photos/{photo.code}/image?rectified=1", "size": photo.working_size()}
 
 
 def _other_structure(proc):
@@ -257,6 +258,8 @@ def procedure_visibility(request, code):
             messages.error(request, _error_text(exc))
         else:
             messages.success(request, f"The procedure is now {proc.get_visibility_display().lower()}. {said}")
+    else:
+        messages.error(request, f"Not changed: {'; '.join(e for errors in form.errors.values() for e in errors)}")
     return redirect(proc)
 
 
