@@ -7,7 +7,7 @@ import {patientFetch, patientImage} from "./server.js";
 const KINDS = {created: "created", edit: "edited", revert: "reverted", rerun: "re-run"};
 
 export function accuracyText(accuracy) {
-  return accuracy === null || accuracy === undefined ? "not measured" : accuracy.toFixed(4);
+  return accuracy === null || accuracy === undefined ? "not measured" : `${(100 * accuracy).toFixed(2)} %`;
 }
 
 function cell(...content) {
@@ -82,8 +82,8 @@ export function mountHistory({code, owner, csrf}) {
     const [sa, sb] = [body.a, body.b].map((v) => `${Math.round(v.width)}×${Math.round(v.height)}`);
     document.getElementById("compare-diff-caption").textContent =
       `in magenta, ${(100 * body.differing).toFixed(2)} % of the pixels: their label differs` + (sa === sb ? ""
-        : ` (the two are of different sizes, ${sa} and ${sb} px: laid over each other from the top left, what ` +
-          "one has beyond the other counts as differing)");
+        : ` (the two are of different sizes, ${sa} and ${sb} px: laid over each other from the top left, where ` +
+          "one reaches beyond the other the other counts as background)");
     document.getElementById("comparison").hidden = false;
     status.textContent = "";
   }

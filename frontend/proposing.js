@@ -41,7 +41,8 @@ export function mountProposing(ed) {
     }
     const drawn = ed.seg.toJSON(), unit = unitIndices(ed.seg, ed.ui.selection);
     await propose({...drawn, unit}, drawn, "find copies", (n, copies) => n
-      ? `${copies} copies of the unit (${n} proposals), scored by how alike they look: click one to reject its copy, ` +
+      ? `${copies} ${copies === 1 ? "copy" : "copies"} of the unit (${n} proposal${n === 1 ? "" : "s"}), scored by ` +
+        "how alike they look: click one to reject its copy, " +
         "a row's or column's chip to reject all of it (Shift: add it alone), Enter or \"Accept\" to add the rest."
       : `No copies of the unit found in the photo${rejectedNote()}.`);
   }

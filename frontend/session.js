@@ -120,7 +120,18 @@ export async function submit(api, photoCode, seg, history, {saved, k = 4, onSave
 /** {rects, warnings}: the rectangles of a segmentation file for an image of the given size, and what was read other
  * than as it stands. Our JSON is read here; COCO, LabelMe and CVAT files by the site (`POST /api/v1/convert`: of a
  * file of several images, the only one of the photo's size); throws a message otherwise. */
+// the pictures a person picks instead of their annotations, by their first bytes
+const PICTURES = [["ffd8ff", "a JPEG image"], ["89504e47", "a PNG image"], ["47494638", "a GIF image"],
+  ["52494646", "a WebP image"], ["25504446", "a PDF document"]];
+
 export async function readSegmentationFile(file, width, height, api, original = null) {
+  const head = [...new Uint8Array(await file.slice(0, 4).arrayBuffer())]
+    .map((b) => b.toString(16).padStart(2, "0")).join("");
+  const picture = PICTURES.find(([magic]) => head.startsWith(magic));
+  if (picture) {
+    throw new Error(`this is ${picture[1]}, not annotations: import takes our segmentation JSON, COCO or ` +
+      "LabelMe JSON, or CVAT XML (the photo itself is already here)");
+  }
   const text = await file.text();
   let data = null, warnings = [];
   try {

@@ -150,4 +150,11 @@ def test_an_annotation_of_the_photo_as_taken_is_carried_through_the_rectificatio
     import_file(page, path)
     page.wait_for_function("document.querySelector('#status').textContent.startsWith('Not imported')")
     assert "the photo is 400x300 (as taken, before rectifying, 480x360)" in page.text_content("#status")
+    # the photo picked instead of its annotations is named as such (a newcomer read "binary file")
+    picture = tmp_path / "rue-12.png"
+    picture.write_bytes(windows_photo())
+    import_file(page, picture)
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Not imported')")
+    assert page.text_content("#status").startswith("Not imported: this is a PNG image, not annotations")
+    assert page.evaluate(f"{E}.seg.size") == 2
     assert page.errors == []

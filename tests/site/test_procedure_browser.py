@@ -177,15 +177,15 @@ def test_history_lists_versions_compares_two_and_reverts(live_server, alice, fac
     page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 2")
     saved = Procedure.objects.get(pk=proc.pk)
     assert saved.accuracy < 1.0 and page.text_content("#version") == "2"
-    assert page.text_content("#figure").strip() == f"· pixel accuracy {saved.accuracy:.4f}"
-    assert page.text_content("#history tbody tr.current").count(f"{saved.accuracy:.4f}") == 1
+    assert page.text_content("#figure").strip() == f"· pixel accuracy {100 * saved.accuracy:.2f} %"
+    assert page.text_content("#history tbody tr.current").count(f"{100 * saved.accuracy:.2f} %") == 1
 
     # compare: by default the current version (B) against the one before (A)
     page.click("#compare")
     page.wait_for_selector("#comparison:not([hidden])")
     _pictures_loaded(page)
-    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 1.0000"
-    assert page.text_content("#compare-b-caption") == f"B: version 2 · pixel accuracy {saved.accuracy:.4f}"
+    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 100.00 %"
+    assert page.text_content("#compare-b-caption") == f"B: version 2 · pixel accuracy {100 * saved.accuracy:.2f} %"
     assert "% of the pixels: their label differs" in page.text_content("#compare-diff-caption")
     page.locator("#history-panel").scroll_into_view_if_needed()
     path = os.environ.get("FACAID_HISTORY_SCREENSHOT") or str(tmp_path / "procedure-history.png")
@@ -194,7 +194,7 @@ def test_history_lists_versions_compares_two_and_reverts(live_server, alice, fac
     # revert to version 1: a third version equal to it, the page shows its figures
     page.click("#history button[data-revert='1']")
     page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
-    assert page.text_content("#version") == "3" and "1.0000" in page.text_content("#figure")
+    assert page.text_content("#version") == "3" and "100.00 %" in page.text_content("#figure")
     assert "reverted to version 1" in page.text_content("#history tbody tr.current")
     assert Procedure.objects.get(pk=proc.pk).data == proc.data
     assert errors == []
@@ -216,11 +216,11 @@ def test_a_re_run_that_fits_worse_is_shown_beside_the_version_it_continued(live_
         tree.width, tree.height)).to_dict()
     versions.add_rerun(proc, worse, 0.75, {"source": "model"}, based_on=1, nodes=3)  # as the worker stores one
     page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 1100})
-    assert "fits worse than version 1: pixel accuracy 0.7500 against 1.0000" in page.text_content("#rerun-warning")
+    assert "fits worse than version 1: pixel accuracy 75.00 % against 100.00 %" in page.text_content("#rerun-warning")
     page.wait_for_selector("#comparison:not([hidden])")  # opened by itself
     _pictures_loaded(page)
-    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 1.0000"
-    assert page.text_content("#compare-b-caption") == "B: version 2 · pixel accuracy 0.7500"
+    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 100.00 %"
+    assert page.text_content("#compare-b-caption") == "B: version 2 · pixel accuracy 75.00 %"
     assert "worse" in page.get_attribute("#history tbody tr.current td:nth-child(5)", "class")
     path = os.environ.get("FACAID_RERUN_SCREENSHOT") or str(tmp_path / "procedure-rerun-warning.png")
     page.screenshot(path=path, full_page=True)

@@ -98,14 +98,14 @@ def test_figures_are_measured_again_on_every_save_and_never_left_stale(facade_ph
     assert as_alice.get(_url(proc)).json()["accuracy"] == accuracy  # stored, not only answered
     assert _history(as_alice, proc)[0]["accuracy"] == accuracy
     page = as_alice.get(f"/procedures/{proc.code}").content.decode()
-    assert f"{accuracy:.4f}" in page and "0.5000" not in page
+    assert f"{100 * accuracy:.2f} %" in page and "50.00 %" not in page
     # a resized tree is not comparable with the segmentation: no figure, and a reason in its place
     resized = next(v.to_dict() for v in vary(Tree.from_dict(proc.data), 8, 0) if v.meta["variation"] == "resize")
     body = as_alice.patch(_url(proc), {"data": resized}, format="json").json()
     assert body["accuracy"] is None and "iou" not in body["metrics"]
     assert body["metrics"]["unmeasured"].startswith(f"the tree is {round(resized['width'])}x")
     page = as_alice.get(f"/procedures/{proc.code}").content.decode()
-    assert "not measured" in page and f"{accuracy:.4f}" not in page.split('id="history"')[0]
+    assert "not measured" in page and f"{100 * accuracy:.2f} %" not in page.split('id="history"')[0]
 
 
 def test_revert_makes_a_new_version_equal_to_the_old_one(facade_photo, as_alice, alice):

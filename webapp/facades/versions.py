@@ -123,8 +123,8 @@ def rerun_warning(accuracy: float | None, base: float | None, based_on: int) -> 
     it continued; empty when it fits as well or better, or when either was not measured."""
     if accuracy is None or base is None or round(accuracy, 4) >= round(base, 4):
         return ""
-    return (f"This re-run fits worse than version {based_on}: pixel accuracy {accuracy:.4f} against "
-            f"{base:.4f}. Revert to version {based_on} to keep that one.")
+    return (f"This re-run fits worse than version {based_on}: pixel accuracy {100 * accuracy:.2f} % against "
+            f"{100 * base:.2f} %. Revert to version {based_on} to keep that one.")
 
 
 def add_rerun(proc: Procedure, data: dict, accuracy: float | None, metrics: dict, based_on: int,

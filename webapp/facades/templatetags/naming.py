@@ -24,3 +24,11 @@ def percent(share) -> str:
     if share is None:
         return ""
     return f"{100 * float(share):.1f} %"
+
+
+@register.filter
+def percent2(share) -> str:
+    """A share in [0, 1] as a percentage with two decimals ("99.89 %"): a procedure's versions told apart."""
+    if share is None:
+        return ""
+    return f"{100 * float(share):.2f} %"
