@@ -73,7 +73,10 @@ export function mountFiles(ed) {
   async function openRectify() {
     ed.rectifying = await openRectifyMode(ed.canvas, $("#rectify-preview"), ed.info);
     $("#rectify-panel").hidden = false;
-    $("#rectify-panel").scrollIntoView({block: "nearest"});  // its step in view in the side panel
+    // its step in view in the side panel, which scrolls on its own: the page stays put, the save bar in view
+    const panel = $("#rectify-panel"), aside = panel.closest("aside");
+    if (aside) aside.scrollTop += panel.getBoundingClientRect().top - aside.getBoundingClientRect().top;
+    window.scrollTo(0, 0);
     const side = ed.info.real_height_m != null ? "height" : "width";
     $("#real-side").value = side;
     $("#real-metres").value = ed.info[`real_${side}_m`] ?? "";

@@ -87,10 +87,18 @@ def test_at_1280x800_the_rectification_step_keeps_its_size_field_and_apply_in_vi
                                    f"{box['y'] + box['height'] / 2})?.closest('{selector}') !== null")
             assert on_top, selector
     screenshot(page, "rectify-1280x800.png", tmp_path)
+    page.click("#rectify-propose")  # its note, several lines, moves nothing under the controls
+    page.wait_for_function("document.querySelector('#rectify-note').textContent.startsWith('Corners proposed')")
+    preview, actions = (page.locator(s).bounding_box() for s in ("#rectify-preview", ".rectify-actions"))
+    screenshot(page, "rectify-proposed-1280x800.png", tmp_path)
+    assert preview["y"] + preview["height"] <= actions["y"], (preview, actions)  # all of it above them
     # the photo page's link opens the editor on this step
     page.goto(f"{live_server.url}/photos/{photo['code']}")
     page.click("text=Rectify it in the editor")
     page.wait_for_function(f"{E}?.rectifying && !document.querySelector('#rectify-panel').hidden")
+    save = page.locator("#save").bounding_box()  # the page is not scrolled away from the save bar
+    assert page.evaluate("window.scrollY") == 0 and save["y"] >= 0 and save["y"] + save["height"] <= 800
+    assert page.locator("#rectify-apply").bounding_box()["y"] + 10 <= 800
     # Apply leaves the step and says what happened (a newcomer saw the step open again, as if nothing had)
     page.click("#rectify-apply")
     page.wait_for_function("document.querySelector('#status').textContent.startsWith('Rectified:')")
