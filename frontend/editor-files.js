@@ -2,6 +2,7 @@
 // submitting a reconstruction and following its job, and the rectification step (rectify-mode.js) with the
 // facade's real size. `ed` is what the editor's parts share (editor.js); session.js talks to the API.
 import {AddRects, ReplaceAll} from "./commands.js";
+import {noFacadeNote} from "./objects.js";
 import {openRectifyMode} from "./rectify-mode.js";
 import {readSegmentationFile, rectify, save, submit} from "./session.js";
 
@@ -64,6 +65,8 @@ export function mountFiles(ed) {
       await ed.ui.overlay.decode();
       $("#result-link").href = `/procedures/${job.result}`;
       $("#result").hidden = false;
+      const note = noFacadeNote(ed.seg);  // the elements alone, with no wall around them
+      if (note) ed.status(`Reconstructed. ${note}`);
       ed.draw();
     } catch (err) {
       ed.status(`Not submitted: ${err.message}`, "error");

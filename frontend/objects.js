@@ -41,3 +41,11 @@ export function layersNote(layers) {
   const part = (name, set) => (set.size ? `${name}: ${LABELS.filter((l) => set.has(l)).join(", ")}` : "");
   return [part("hidden", layers.hidden), part("locked", layers.locked)].filter(Boolean).join("; ");
 }
+
+/** What a reconstruction of `seg` lacks when no facade rectangle is drawn: its procedure, pictures and 3D models hold
+ * the elements alone, with no wall around them ("" when one is drawn). */
+export function noFacadeNote(seg) {
+  if ([...seg.rects.values()].some((r) => r.label === "facade")) return "";
+  return "No facade is drawn: the procedure and its 3D models hold the elements alone, with no wall around them. " +
+    "Draw the facade's outline (class facade) and reconstruct again to have it.";
+}

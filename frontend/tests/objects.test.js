@@ -4,7 +4,8 @@ import {test} from "node:test";
 
 import {AddRects} from "../commands.js";
 import {History} from "../history.js";
-import {freeView, layersNote, objectGroups, pickable, pickableSelection, shown, toggleLayer} from "../objects.js";
+import {freeView, layersNote, noFacadeNote, objectGroups, pickable, pickableSelection, shown, toggleLayer}
+  from "../objects.js";
 import {Segmentation} from "../state.js";
 import {press} from "../tools/select.js";
 
@@ -75,4 +76,12 @@ test("hide and lock: the selection keeps only what can still be picked", () => {
   const {seg} = scene();
   const layers = toggleLayer(freeView(), "locked", "window");
   assert.deepEqual([...pickableSelection(seg, new Set([2, 3, 4]), layers)], [4]);
+});
+
+test("a reconstruction without the facade's rectangle is told it holds the elements alone", () => {
+  const seg = new Segmentation(200, 100);
+  seg.insert({label: "window", x0: 10, y0: 10, x1: 30, y1: 40});
+  assert.match(noFacadeNote(seg), /^No facade is drawn: .* Draw the facade's outline \(class facade\)/);
+  seg.insert({label: "facade", x0: 0, y0: 0, x1: 200, y1: 100});
+  assert.equal(noFacadeNote(seg), "");
 });

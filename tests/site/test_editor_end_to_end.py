@@ -105,6 +105,7 @@ def test_editor_from_upload_to_downloads(live_server, alice, worker, page, tmp_p
     page.click("#submit")
     page.wait_for_selector("#result:not([hidden])", timeout=240_000)
     assert page.text_content("#job-status") == "done"
+    assert "No facade is drawn" not in page.text_content("#status")  # it is: no hint to draw it
     page.click("#result-link")
     page.wait_for_url(f"{base}/procedures/*")
     # the procedure and its overlay on the photo at the same scale, side by side
