@@ -38,18 +38,20 @@ def _caption(tree) -> str:
     return ", ".join(parts) or f"{tree.width:g} x {tree.height:g} px"
 
 
-def _variations(tree) -> list:
-    """Variations that show what the numbers do: the floors and the tiles a floor drawn around the procedure's
-    own (seed 0), each one unlike the others and the procedure; any variation where it has neither."""
+def _variations(tree, caption: str) -> list[tuple]:
+    """Variations that show what the numbers do, each with its caption: the floors and the tiles a floor drawn around
+    the procedure's own (seed 0; ``caption`` is the procedure's), each one unlike the others and the procedure; any
+    variation where it has neither."""
     ranges = {p.name: (max(p.min, p.value - 2), min(p.max, p.value + 3)) for p in named_parameters(tree)
               if p.name in ("floors", "bays") and p.min < p.max}
     if not ranges:
-        return vary(tree, VARIANTS, seed=0)
-    out, seen = [], {_caption(tree)}
+        return [(v, _caption(v)) for v in vary(tree, VARIANTS, seed=0)]
+    out, seen = [], {caption}
     for variant in vary(tree, 4 * VARIANTS, seed=0, ranges=ranges):
-        if _caption(variant) not in seen and len(out) < VARIANTS:
-            seen.add(_caption(variant))
-            out.append(variant)
+        said = _caption(variant)
+        if said not in seen and len(out) < VARIANTS:
+            seen.add(said)
+            out.append((variant, said))
     return out
 
 
@@ -62,12 +64,13 @@ def _pictures(proc: Procedure) -> dict:
     if found is None:
         try:
             tree = parse_procedure(proc.data)
-            trees = _variations(tree)
+            caption = _caption(tree)
+            variations = _variations(tree, caption)
         except (ProcedureError, ValueError, ValidationError):
             return {"caption": "", "variations": []}
-        found = {"caption": _caption(tree), "variations": [
+        found = {"caption": caption, "variations": [
             {"picture": "data:image/png;base64," + base64.b64encode(label_map_png(to_segmentation(t), SIDE)).decode(),
-             "caption": _caption(t)} for t in trees]}
+             "caption": said} for t, said in variations]}
         cache.set(key, found, None)
     return found
 

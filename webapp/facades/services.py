@@ -94,10 +94,6 @@ def _readable(field):
         raise ValidationError({"image": f"the photo cannot be read: {exc}"}) from None
 
 
-def _working_size(photo: Photo) -> tuple[int, int]:
-    return (photo.rectified.width, photo.rectified.height) if photo.rectified else (photo.width, photo.height)
-
-
 def _foreign(data) -> bool:
     """Is ``data`` another tool's file (COCO, LabelMe, CVAT) rather than the segmentation contract's JSON?"""
     if isinstance(data, bytes | str):  # a file's content: facaid.formats.interchange reads it, or says why not
@@ -128,7 +124,7 @@ def read_annotations(data, format: str | None = None, image: str | None = None,
 def _segmentation_of(photo: Photo, data, format: str | None = None, image: str | None = None) -> interchange.Loaded:
     """The segmentation, validated, of the photo's size (the rectified image's once there is one): the contract's
     JSON, or another tool's file read by `read_annotations`."""
-    w, h = _working_size(photo)
+    w, h = photo.working_size()
     loaded = read_annotations(data, format, image, size=(w, h))
     seg = loaded.segmentation
     if (seg.width, seg.height) != (w, h):
