@@ -1,6 +1,7 @@
 """How well the proposed corners find the facade in a photo (issue 57's corners target).
 
     .venv/bin/python bench/bench_corners.py --photos var/cmp_photos [--limit N] [--warp SEED] [--json F]
+    .venv/bin/python bench/bench_corners.py --photos var/cmp_photos_test --half test   # once, for a closing note
 
 For each CMP dev-half photo in ``--photos`` (``cmp_bNNNN.jpg``, the git-ignored cache of the public copy of CMP's
 base set; CMP's photos are rectified facades), `facaid.photo.rectify.propose_corners_file` proposes the facade's four
@@ -66,11 +67,15 @@ def main() -> None:
     ap.add_argument("--photos", required=True)
     ap.add_argument("--data", default=str(DEFAULT_CMP))
     ap.add_argument("--limit", type=int, default=DEV_FACADES)
+    ap.add_argument("--half", choices=("dev", "test"), default="dev",
+                    help="the dev half (1-189, for tuning) or the test half (190-378, reported once)")
     ap.add_argument("--warp", type=int, default=None, help="warp each photo by a seeded random perspective first")
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
     rows = []
-    for k, (rid, seg) in enumerate(load_records(args.data, DEV_FACADES)[: args.limit]):
+    records = load_records(args.data)
+    half = records[:DEV_FACADES] if args.half == "dev" else records[DEV_FACADES:]
+    for k, (rid, seg) in enumerate(half[: args.limit]):
         path = Path(args.photos) / f"{rid}.jpg"
         box = facade_box(seg)
         if not path.exists() or box is None:

@@ -13,8 +13,16 @@ from facaid.evaluation.real import load_records
 from facaid.paths import DEFAULT_CMP
 from facaid.photo import appearance, repeats
 
+sys.path.insert(0, "experiments/2026-12-06-copies")
+if any(a.startswith("FLOORS=") for a in sys.argv[2:]):
+    import floors_proto
 for kv in sys.argv[2:]:
     k, v = kv.split("=")
+    if k == "FLOORS":
+        continue
+    if "floors_proto" in sys.modules and hasattr(sys.modules["floors_proto"], k):
+        setattr(sys.modules["floors_proto"], k, __import__("ast").literal_eval(v))
+        continue
     mod = repeats if hasattr(repeats, k) else (copies if hasattr(copies, k) else completion)
     import ast; setattr(mod, k, ast.literal_eval(v))
 recs = load_records(DEFAULT_CMP, 189)[::int(sys.argv[1])]
