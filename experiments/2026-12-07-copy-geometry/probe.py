@@ -59,29 +59,17 @@ if args.mode == "typical":
 def settle(proc, tol):
     """After sizing: each size that copies override takes the median of their values as its shared one; the
     overrides within ``tol`` pixels of it go (jitter, restored by the shared size)."""
-    from facaid.grammar.procedure import Override, Size
+    from facaid.grammar.procedure import Size
+    from facaid.grammar.repeats import along_path
     for _, rep in list(proc.root.walk()):
         if rep.rule != "repeat" or not rep.exceptions:
             continue
-        nodes = {(o.copy, o.path): o.node for o in rep.exceptions if o.node is not None}
         groups = {}
         for o in rep.exceptions:
             if o.node is not None or o.size is None or len(o.path) < 2:
                 continue
-            node = nodes.get((o.copy, o.path[:1]), rep.children[o.path[0]])
-            ok = True
-            for k, step in enumerate(o.path[1:-1], start=2):
-                if node.rule == "leaf":
-                    ok = False
-                    break
-                if node.rule == "repeat":
-                    kk = len(node.children)
-                    sub = {(e.copy, e.path): e.node for e in node.exceptions if e.node is not None}
-                    node = sub.get((step // kk, (step % kk,)), node.children[step % kk])
-                else:
-                    node = node.children[step]
-                node = nodes.get((o.copy, o.path[:k]), node)
-            if not ok or node.rule != "split":
+            node = next((t for k, t in along_path(rep, o, rep.exceptions) if k == len(o.path) - 2), None)
+            if node is None or node.rule != "split":
                 continue
             groups.setdefault((id(node), o.path[-1]), (node, []))[1].append(o)
         drop = set()
