@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.grammar.procedure import Node, Override, Procedure, ProcedureError, Size
+from facaid.grammar.repeats import expanded_count, pattern_child
 from facaid.labels import LABEL_ID
 from facaid.segmentation import Segmentation
 
@@ -84,3 +85,32 @@ def real_like(seed: int = 0, floors: int = 5, bays: int = 6) -> Segmentation:
     rows = np.array([(LABEL_ID[label], max(0, x0), max(0, y0), min(width, max(x1, x0 + 2)),
                       min(height, max(y1, y0 + 2))) for label, x0, y0, x1, y1 in rects], dtype=np.int64)
     return Segmentation.from_array(width, height, rows)
+
+
+def random_exceptions(proc: Procedure, rng: np.random.Generator, n: int = 6) -> Procedure:
+    """``proc`` with up to ``n`` random exceptions on its repeats: a size, a leaf of another label or both, at a
+    random depth of a random copy."""
+    proc = Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
+    repeats = [node for _, node in proc.nodes() if node.rule == "repeat"]
+    if not repeats:
+        return proc
+    labels = ["window", "blind", "facade", "door", "balcony", "deco"]
+    for _ in range(n):
+        node = repeats[rng.integers(len(repeats))]
+        copies = 8 if node.count == "fill" else node.count
+        path = [int(rng.integers(len(node.children)))]
+        target = node.children[path[0]]
+        while target.rule != "leaf" and rng.random() < 0.6:
+            i = int(rng.integers(min(expanded_count(target), 40)))
+            path.append(i)
+            target = pattern_child(target, i)
+        size = Size("flt" if rng.random() < 0.5 else "abs", float(rng.uniform(2, 60))) if rng.random() < 0.6 else None
+        new = leaf(labels[rng.integers(len(labels))]) if size is None or rng.random() < 0.5 else None
+        override = Override(int(rng.integers(copies)), tuple(path), size, new)
+        if all((o.copy, o.path) != (override.copy, override.path) for o in node.exceptions):
+            node.exceptions.append(override)
+            try:  # a new whole item can leave an exception from further up without its node
+                Procedure.from_dict(proc.to_dict())
+            except ProcedureError:
+                node.exceptions.pop()
+    return Procedure.from_dict(proc.to_dict())

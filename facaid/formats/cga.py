@@ -171,7 +171,8 @@ class _Writer:
         calls first."""
         if node.is_leaf:
             return LEAF_RULES[node.label]
-        variant = tuple((steps, id(o)) for steps, o, _ in pending) if pending else ()
+        # an exception's steps still to go are the last ones of its path: their count names them
+        variant = tuple((len(steps), id(o)) for steps, o, _ in pending) if pending else ()
         key = (id(node), *flips, variant)
         if key in self.rules:
             return self.rules[key]

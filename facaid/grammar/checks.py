@@ -11,6 +11,7 @@ from facaid.grammar.budget import charge
 from facaid.grammar.errors import ProcedureError
 from facaid.grammar.layout import count_expansion
 from facaid.grammar.limits import MAX_EXTENT, MAX_INSTANCES, MAX_LEAVES, MAX_META_CHARS
+from facaid.grammar.repeats import path_problem
 from facaid.numbers import finite
 
 if TYPE_CHECKING:
@@ -71,9 +72,19 @@ def check_meta(meta: dict) -> None:
 def check_expansion(proc: Procedure) -> None:
     """The cost model: what executing the tree would cost, bounded before any of it is paid (`count_expansion`,
     from the distinct nodes only, so a crafted tree is refused in microseconds), and charged to the work budget of
-    the request it is part of (`facaid.grammar.budget`). Each leaf is an instance, so `MAX_LEAVES` holds too."""
-    cost = count_expansion(proc.root, proc.width, proc.height)
+    the request it is part of (`facaid.grammar.budget`). Each leaf is an instance, so `MAX_LEAVES` holds too. An
+    exception must reach a node that is laid out, in some copy: one that names a copy or a child that the tree
+    never lays out (past what a ``"fill"`` repeat lays out at its length, say) would be carried for nothing."""
+    applied: set[int] = set()
+    cost = count_expansion(proc.root, proc.width, proc.height, applied=applied)
     if cost.instances > MAX_INSTANCES or cost.leaves > MAX_LEAVES:
         raise ProcedureError("root", f"expands to more than {MAX_INSTANCES} node instances (each node once per copy "
-                                     f"of it, repeats and splits included): the limit of what one tree may cost")
+                                     f"of it, repeats and splits included, and each exception once at every level "
+                                     f"its path runs through): the limit of what one tree may cost")
+    for path, node in proc.root.walk():
+        for e, o in enumerate(node.exceptions):
+            if id(o) not in applied:  # the paths are walked only here: a tree refused for its cost never is
+                problem = path_problem(node, o) or (f"names copy {o.copy} at path {list(o.path)}, which is never "
+                                                    "laid out at this size")
+                raise ProcedureError(path, f"exceptions[{e}].{problem}")
     charge(cost.instances)

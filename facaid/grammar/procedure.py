@@ -44,7 +44,7 @@ from facaid.grammar.limits import (
     MAX_META_CHARS,
     MAX_NODES,
 )
-from facaid.grammar.repeats import along_path, expanded_count, recount
+from facaid.grammar.repeats import recount
 from facaid.labels import LABEL_ID, LABELS
 from facaid.numbers import finite
 
@@ -334,6 +334,9 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
     return node
 
 
+_EXCEPTION_KEYS = frozenset(("copy", "path", "size", "node"))
+
+
 def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: list[int]) -> list[Override]:
     if not isinstance(items, list):
         raise ProcedureError(path, f"exceptions must be a list, got {type(items).__name__}")
@@ -349,14 +352,14 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
             raise ProcedureError(path, f"too many nodes and exceptions (more than {MAX_NODES})")
         if not isinstance(item, dict):
             raise ProcedureError(path, f"{where} must be an object, got {type(item).__name__}")
-        extra = sorted(set(item) - {"copy", "path", "size", "node"})
-        if extra:
+        if not item.keys() <= _EXCEPTION_KEYS:
+            extra = sorted(map(str, item.keys() - _EXCEPTION_KEYS))
             raise ProcedureError(path, f"{where} has unexpected key(s): {', '.join(extra)}")
         copy, steps = item.get("copy"), item.get("path")
         if not (isinstance(copy, int) and not isinstance(copy, bool)) or not 0 <= copy <= last:
             raise ProcedureError(path, f"{where}.copy must be a copy of the repeat, 0 to {last}, got {copy!r}")
         if (not isinstance(steps, list) or not 1 <= len(steps) <= MAX_DEPTH
-                or not all(isinstance(i, int) and not isinstance(i, bool) and i >= 0 for i in steps)):
+                or not all(type(i) is int for i in steps) or min(steps) < 0):
             raise ProcedureError(path, f"{where}.path must be a list of 1 to {MAX_DEPTH} indices, got {steps!r}")
         if steps[0] >= len(node.children):
             raise ProcedureError(path, f"{where}.path[0] must be a pattern item, 0 to {len(node.children) - 1}, "
@@ -364,9 +367,10 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
         if copy == node.count and steps[0] >= node.tail:
             raise ProcedureError(path, f"{where}.copy {copy} is the tail, which lays out "
                                        + (f"items 0 to {node.tail - 1}" if node.tail else "nothing"))
-        if (copy, tuple(steps)) in seen:
+        key = (copy, tuple(steps))
+        if key in seen:
             raise ProcedureError(path, f"{where} names copy {copy} at path {steps} twice")
-        seen.add((copy, tuple(steps)))
+        seen.add(key)
         size = None
         if "size" in item:
             s = item["size"]
@@ -381,26 +385,8 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
             sub = _parse_node(item["node"], f"{path}/!{e}", depth + len(steps), counter)
         if size is None and sub is None:
             raise ProcedureError(path, f"{where} changes nothing: give it a size, a node or both")
-        out.append(Override(copy, tuple(steps), size, sub))
-    for e, o in enumerate(out):  # the paths, once every exception's node is known
-        problem = _path_problem(node, o, out)
-        if problem:
-            raise ProcedureError(path, f"exceptions[{e}].{problem}")
+        out.append(Override(copy, key[1], size, sub))
     return out
-
-
-def _path_problem(node: Node, o: Override, exceptions: list[Override]) -> str | None:
-    """What is wrong with an exception's path (None if nothing): a step below a leaf or past the children."""
-    reached = 0
-    parent = None
-    for k, target in along_path(node, o, exceptions):
-        reached, parent = k, target
-    if reached == len(o.path) - 1:
-        return None
-    k = reached + 1
-    if parent.rule == "leaf":
-        return f"path[{k}] goes below a leaf"
-    return f"path[{k}] is {o.path[k]}, but that node lays out {expanded_count(parent)} children"
 
 
 def parse_procedure(obj: Any) -> Procedure:

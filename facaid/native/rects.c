@@ -309,10 +309,20 @@ static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, 
     }
     int flip = along_x ? flip_x : flip_y;
     double pos = flip ? hi : lo;
+    /* the exceptions that go on into each child, in order, bucketed by child (a counting sort: linear in the
+     * children and the exceptions, as `layout.count_expansion` charges): child i's are below[end[i - 1] .. end[i]) */
     Pending *below = NULL;
+    int64_t *end = NULL;
     if (over && ov.n_entries) {
         below = malloc((size_t)ov.n_entries * sizeof(Pending));
-        if (!below) { over_free(&ov); e->error = -1; return; }
+        end = calloc((size_t)n + 1, sizeof(int64_t));
+        if (!below || !end) { free(below); free(end); over_free(&ov); e->error = -1; return; }
+        for (int64_t j = 0; j < ov.n_entries; j++)
+            if (ov.at[j] < n && ov.entry[j].pos + 1 < e->overs[OVER * ov.entry[j].id + 2]) end[ov.at[j] + 1]++;
+        for (int64_t i = 0; i < n; i++) end[i + 1] += end[i];
+        for (int64_t j = 0; j < ov.n_entries; j++)
+            if (ov.at[j] < n && ov.entry[j].pos + 1 < e->overs[OVER * ov.entry[j].id + 2])
+                below[end[ov.at[j]]++] = (Pending){ov.entry[j].id, ov.entry[j].pos + 1};
     }
     for (int64_t i = 0; i < n; i++) {
         int reflected = nd[0] == MIRROR && i >= nk;
@@ -323,15 +333,13 @@ static void run(Exec *e, int64_t k, double x0, double y0, double x1, double y1, 
         else { a = pos; b = i == n - 1 ? hi : pos + size; pos = b; }
         int fx = flip_x, fy = flip_y;
         if (reflected) { if (along_x) fx = !fx; else fy = !fy; }
-        int64_t n_below = 0;
-        for (int64_t j = 0; below && j < ov.n_entries; j++) /* the exceptions that go on into this child */
-            if (ov.at[j] == i && ov.entry[j].pos + 1 < e->overs[OVER * ov.entry[j].id + 2])
-                below[n_below++] = (Pending){ov.entry[j].id, ov.entry[j].pos + 1};
-        if (along_x) run(e, c, a, y0, b, y1, fx, fy, below, n_below);
-        else run(e, c, x0, a, x1, b, fx, fy, below, n_below);
+        int64_t from = !end || i == 0 ? 0 : end[i - 1], n_below = end ? end[i] - from : 0;
+        if (along_x) run(e, c, a, y0, b, y1, fx, fy, below ? below + from : NULL, n_below);
+        else run(e, c, x0, a, x1, b, fx, fy, below ? below + from : NULL, n_below);
         if (e->error) break;
     }
     free(below);
+    free(end);
     if (over) over_free(&ov);
 }
 

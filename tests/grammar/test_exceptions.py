@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from grammar_helpers import example, facade, leaf, plain_facade, tile
+from grammar_helpers import example, facade, leaf, plain_facade, random_exceptions, tile
 
 import facaid.grammar as grammar_pkg
 from facaid.generator import generate_procedure
@@ -24,7 +24,7 @@ from facaid.grammar.procedure import (
     Size,
     validate,
 )
-from facaid.grammar.repeats import expanded_count, pattern_child, recount
+from facaid.grammar.repeats import recount
 from facaid.labels import LABEL_ID
 from facaid.native import rects
 from facaid.parameters import named_parameters, normalised, set_parameter
@@ -140,35 +140,6 @@ def test_first_boxes_reach_the_exceptions_nodes():
     boxes = first_boxes(proc)
     blind = proc.root.children[1].exceptions[0].node
     assert boxes[id(blind)][1] > 100  # the blind's box is on floor 1, not where the typical copy was first seen
-
-
-def random_exceptions(proc: Procedure, rng: np.random.Generator, n: int = 6) -> Procedure:
-    """``proc`` with up to ``n`` random exceptions on its repeats: a size, a leaf of another label or both, at a
-    random depth of a random copy."""
-    proc = Procedure(proc.width, proc.height, proc.root.copy(), dict(proc.meta))
-    repeats = [node for _, node in proc.nodes() if node.rule == "repeat"]
-    if not repeats:
-        return proc
-    labels = ["window", "blind", "facade", "door", "balcony", "deco"]
-    for _ in range(n):
-        node = repeats[rng.integers(len(repeats))]
-        copies = 8 if node.count == "fill" else node.count
-        path = [int(rng.integers(len(node.children)))]
-        target = node.children[path[0]]
-        while target.rule != "leaf" and rng.random() < 0.6:
-            i = int(rng.integers(min(expanded_count(target), 40)))
-            path.append(i)
-            target = pattern_child(target, i)
-        size = Size("flt" if rng.random() < 0.5 else "abs", float(rng.uniform(2, 60))) if rng.random() < 0.6 else None
-        new = leaf(labels[rng.integers(len(labels))]) if size is None or rng.random() < 0.5 else None
-        override = Override(int(rng.integers(copies)), tuple(path), size, new)
-        if all((o.copy, o.path) != (override.copy, override.path) for o in node.exceptions):
-            node.exceptions.append(override)
-            try:  # a new whole item can leave an exception from further up without its node
-                Procedure.from_dict(proc.to_dict())
-            except ProcedureError:
-                node.exceptions.pop()
-    return Procedure.from_dict(proc.to_dict())
 
 
 def reference_rows(proc: Procedure, wall: str = "pieces") -> np.ndarray:
