@@ -17,7 +17,7 @@ from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
-from webapp.facades import access, example, jsonbody, services, sharing, throttling
+from webapp.facades import access, example, jobs, jsonbody, services, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
     PhotoForm,
@@ -193,7 +193,8 @@ def photo_editor(request, code):
 def job(request, code):
     job = access.get_job_for_user(request.user, code)
     return render(request, "facades/job.html", {
-        "job": job, "photo_visible": access.photo_visible_to(request.user, job.segmentation.photo)})
+        "job": job, "photo_visible": access.photo_visible_to(request.user, job.segmentation.photo),
+        "note": jobs.state(job)[1]})
 
 
 def procedure(request, code):
