@@ -56,7 +56,8 @@ export function mountFiles(ed) {
         onSaved: (code) => { ed.root.dataset.segmentation = code; },
         progress: (j) => {
           $("#job").hidden = false;
-          $("#job-status").textContent = `${j.status}${j.status === "running" && j.stage ? ` (${j.stage})` : ""}`;
+          $("#job-status").textContent = `${j.status}${j.status === "running" && j.stage ? ` (${j.stage})` : ""}` +
+            (j.note ? `: ${j.note}` : "");
           $("#job-progress").value = j.progress;
         }});
       if (job.status === "failed") return ed.status(`The reconstruction failed: ${job.message}`, "error");

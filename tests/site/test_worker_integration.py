@@ -1,6 +1,6 @@
 """End to end with a real Redis server and real Celery worker processes: a job runs; a worker killed mid-job,
 a Redis restart and a submission while Redis is down lose no job; a job past its time limit fails with a
-message."""
+message; a late job's status says what is happening."""
 
 from __future__ import annotations
 
@@ -50,17 +50,88 @@ def test_a_job_runs_end_to_end(alice, worker):
     assert "pixel accuracy" in page and 'id="structure"' in page
 
 
-def test_a_worker_killed_mid_job_loses_no_job(alice, worker):
-    worker.start()
+def status(user, job: Job) -> dict:
+    r = client_for(user).get(f"/api/v1/jobs/{job.code}/")
+    assert r.status_code == 200
+    return r.json()
+
+
+def test_a_worker_killed_mid_job_loses_no_job_and_its_status_says_so(alice, worker, monkeypatch):
+    monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "1")  # the site's side: silent for 3 beats is late
+    worker.start(FACAID_JOB_STALE_SECONDS="10")
     job = submit(alice)
     wait_for(job, {"running", "done"}, poll=0.02)
     assert job.status == "running", "the job finished before the worker could be killed"
+    assert status(alice, job)["note"] == ""
     worker.kill()
     time.sleep(1)
     job.refresh_from_db()
     assert job.status == "running"  # its worker is gone; recovery notices the missing heartbeat
-    worker.start()
+    deadline = time.time() + 8  # no worker runs: nothing recovers it meanwhile
+    while "has not reported" not in (now := status(alice, job))["note"] and time.time() < deadline:
+        time.sleep(0.2)
+    assert now["status"] == "running" and "the worker has not reported for" in now["note"], now
+    assert "it may have stopped" in client_for(alice).get(f"/jobs/{job.code}").content.decode()
+    worker.start(FACAID_JOB_STALE_SECONDS="10")
     check_done(wait_for(job, {"done", "failed"}), attempts=2)
+    assert status(alice, job)["note"] == ""
+
+
+def test_a_late_queued_job_says_why(alice, bob, redis, worker):
+    from datetime import timedelta
+
+    from django.utils import timezone
+
+    from webapp.facades import jobs
+
+    redis.stop()
+    job = submit(alice)  # not sent: Redis is down
+    Job.objects.filter(id=job.id).update(created=timezone.now() - timedelta(seconds=40))
+    said = status(alice, job)
+    assert said["status"] == "queued" and said["state_seconds"] >= 40 and "could not be reached" in said["note"]
+    redis.start()
+    assert jobs.recover()["resent"] == 1
+    said = status(alice, job)
+    assert said["note"].startswith("no worker has taken this job for 4") and "may be down" in said["note"], said
+    assert "the worker may be down" in client_for(alice).get(f"/jobs/{job.code}").content.decode()
+    other = submit(bob)  # a job a worker is on
+    Job.objects.filter(id=other.id).update(status="running", heartbeat=timezone.now())
+    said = status(alice, job)["note"]
+    assert said.startswith("waiting 4") and said.endswith("for a worker: 1 job running before it"), said
+    worker.start()  # recovers the other (its 'worker' never beats) and does both
+    check_done(wait_for(job, {"done", "failed"}), attempts=1)
+    assert wait_for(other, {"done", "failed"}).status == "done"
+    assert status(alice, job)["note"] == ""
+
+
+def test_the_broker_epoch_tells_a_redis_that_lost_its_data(redis):
+    from webapp.facades import jobs
+
+    assert jobs.broker_lost_messages()  # the first look: nothing to tell it from a lost one
+    assert not jobs.broker_lost_messages()
+    redis.stop()
+    redis.start()  # without persistence: empty
+    assert jobs.broker_lost_messages() and not jobs.broker_lost_messages()
+
+
+def test_jobs_a_redis_restarted_empty_lost_are_sent_again_at_once(alice, redis, worker):
+    """Issue 66: a job stayed 'queued' 310 s after Redis restarted empty (the resend delay, 300 s)."""
+    import redis as redis_client
+
+    from webapp.facades import jobs
+
+    worker.start()
+    assert redis_client.Redis.from_url(redis.url).exists(jobs.EPOCH_KEY)  # its first recovery round marked it
+    worker.kill()
+    job = submit(alice)  # sent to Redis; no worker takes it
+    job.refresh_from_db()
+    assert job.status == "queued" and job.sent is not None
+    redis.stop()
+    redis.start()  # the message died with it
+    worker.start(FACAID_JOB_RESEND_SECONDS="300", FACAID_RECOVER_SECONDS="10")  # the real delays
+    back = time.time()
+    check_done(wait_for(job, {"done", "failed"}, timeout=150), attempts=1)
+    assert time.time() - back < 60
 
 
 def test_a_redis_restart_loses_no_job(alice, redis, worker):

@@ -13,6 +13,10 @@ READABLE = (Visibility.PUBLIC, Visibility.UNLISTED)  # by link; only public ones
 # large JSON columns that lists and job statuses never show: not read at all (they were most of a gallery page's time)
 LISTED_WITHOUT = ("data", "metrics", "parent__data", "parent__metrics")
 JOB_WITHOUT = ("segmentation__data", "result__data", "result__metrics")
+# the demo account (`manage.py demo`): its password is public, so what the front page shows of it is read-only
+DEMO_USERNAME = "demo"
+DEMO_READ_ONLY = ("the demo cannot be changed, by the demo account either (its password is public and the front "
+                  "page shows it): fork the procedure to edit a copy of your own")
 
 
 def _readable(qs: QuerySet, user, owner_field: str = "owner", visibility_field: str = "visibility") -> QuerySet:
@@ -32,7 +36,24 @@ def _get(qs: QuerySet, code):
 def _owned(obj, user, owner):
     if not (user.is_authenticated and owner == user):
         raise PermissionDenied("only the owner may change this")
+    if is_demo(obj):
+        raise PermissionDenied(DEMO_READ_ONLY)
     return obj
+
+
+def is_demo(obj: Photo | Procedure) -> bool:
+    """Is ``obj`` the demo's: a photo of the demo account's, or a procedure of its with no parent (what the worker
+    made of its photo)? Nobody changes those, the demo account included; its forks and saved copies are its own."""
+    if isinstance(obj, Procedure) and obj.parent_id is not None:
+        return False
+    return obj.owner.username == DEMO_USERNAME
+
+
+def refuse_demo_account(user, what: str) -> None:
+    """A 403 for the demo account (anyone may log in as it), which may not make ``what``."""
+    if user.is_authenticated and user.get_username() == DEMO_USERNAME:
+        raise PermissionDenied(f"the demo account cannot {what} (its password is public): sign up to do it as "
+                               "yourself, or fork the demo procedure to edit a copy")
 
 
 def get_photo_for_user(user, code) -> Photo:

@@ -4,21 +4,25 @@ procedure the worker reconstructed from it, and three variations of that procedu
 from __future__ import annotations
 
 import base64
+import logging
 
 from django.core.cache import caches
 from rest_framework.exceptions import ValidationError
 
 from facaid.grammar import to_segmentation
+from facaid.grammar.budget import WorkLimitError, work_budget
 from facaid.grammar.procedure import ProcedureError
 from facaid.parameters import named_parameters
 from facaid.variation import vary
+from webapp.facades.access import DEMO_USERNAME
 from webapp.facades.models import Procedure, Visibility
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.rendering import label_map_png
 
-DEMO_USERNAME, DEMO_PASSWORD = "demo", "demo-facade"
+DEMO_PASSWORD = "demo-facade"
 VARIANTS = 3
 SIDE = 240  # the variations' pictures, at most this many pixels a side
+log = logging.getLogger(__name__)
 
 
 def demo_procedure() -> Procedure | None:
@@ -55,23 +59,37 @@ def _variations(tree, caption: str) -> list[tuple]:
     return out
 
 
+# what the front page's pictures may cost: a fraction of a request's budget (the demo's tree, 12 variations of it and 3
+# pictures: 0.03-0.15 s and 1,200-21,000 instances for generator seeds 0-5), so no tree the demo holds makes it slow
+EXAMPLE_WORK, EXAMPLE_SECONDS = 400_000, 0.5
+RETRY_SECONDS = 600  # a tree whose pictures could not be drawn is tried again after this long, not on every visit
+
+
+def _draw(proc: Procedure) -> dict:
+    tree = parse_procedure(proc.data)
+    caption = _caption(tree)
+    return {"caption": caption, "variations": [
+        {"picture": "data:image/png;base64," + base64.b64encode(label_map_png(to_segmentation(t), SIDE)).decode(),
+         "caption": said} for t, said in _variations(tree, caption)]}
+
+
 def _pictures(proc: Procedure) -> dict:
     """The procedure's caption and three variations of it (`_variations`), each a PNG data URI with its caption, kept in
-    the cache by the tree's digest: the front page pays for them once per tree."""
+    the cache by the tree's digest: the front page pays for them once per tree. Drawn within a budget of their own
+    (`EXAMPLE_WORK`, `EXAMPLE_SECONDS`); a tree that is past it, or cannot be drawn, shows no pictures, and that too
+    is kept (for `RETRY_SECONDS`), so that the front page never fails, nor pays again on the next visit."""
     key = f"front-example:{proc.code}:{proc.digest}"
     cache = caches["pages"]
     found = cache.get(key)
     if found is None:
         try:
-            tree = parse_procedure(proc.data)
-            caption = _caption(tree)
-            variations = _variations(tree, caption)
-        except (ProcedureError, ValueError, ValidationError):
-            return {"caption": "", "variations": []}
-        found = {"caption": caption, "variations": [
-            {"picture": "data:image/png;base64," + base64.b64encode(label_map_png(to_segmentation(t), SIDE)).decode(),
-             "caption": said} for t, said in variations]}
-        cache.set(key, found, None)
+            with work_budget(EXAMPLE_WORK, EXAMPLE_SECONDS):
+                found = _draw(proc)
+            cache.set(key, found, None)
+        except (ProcedureError, ValueError, ValidationError, WorkLimitError) as exc:
+            log.warning("the front page's example %s is shown without its pictures: %s", proc.code, exc)
+            found = {"caption": "", "variations": []}
+            cache.set(key, found, RETRY_SECONDS)
     return found
 
 

@@ -5,7 +5,7 @@ message delivered twice runs once), heartbeat, finish, and recovery of jobs whos
 from __future__ import annotations
 
 import logging
-from datetime import timedelta
+from datetime import datetime, timedelta
 
 from django.db import transaction
 from django.db.models import F, Q
@@ -22,12 +22,53 @@ MAX_ATTEMPTS = 3
 
 def stale_after() -> timedelta:
     """A running job whose heartbeat is older than this has lost its worker."""
-    return timedelta(seconds=env_int("FACAID_JOB_STALE_SECONDS", 60))
+    return timedelta(seconds=env_int("FACAID_JOB_STALE_SECONDS", 30))
+
+
+def heartbeat_every() -> int:
+    return env_int("FACAID_HEARTBEAT_SECONDS", 5) or 5
 
 
 def resend_after() -> timedelta:
     """A queued job not claimed this long after its message was sent is sent again (the message may be lost)."""
     return timedelta(seconds=env_int("FACAID_JOB_RESEND_SECONDS", 300))
+
+
+# a queued job waiting longer than this, or a running one whose worker has been silent for this many heartbeats,
+# says what may be happening
+WAITING_SECONDS, SILENT_BEATS = 30, 3
+
+
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def state(job: Job, now=None) -> tuple[datetime, str]:
+    """When the job entered its status (a queued job put back after a failure or a lost worker: when it was put
+    back), and, for one that is late, a sentence saying what is happening, else ""."""
+    now = now or timezone.now()
+    if job.status in (Job.Status.DONE, Job.Status.FAILED):
+        return job.finished or job.created, ""
+    if job.status == Job.Status.RUNNING:
+        silent = int((now - (job.heartbeat or job.started or now)).total_seconds())
+        if silent < SILENT_BEATS * heartbeat_every():
+            return job.started or job.created, ""
+        return job.started or job.created, (
+            f"the worker has not reported for {silent} s: it may have stopped; the job is queued again once it has "
+            f"been silent for {int(stale_after().total_seconds())} s")
+    since = job.heartbeat or job.created  # release and recover touch it as they queue the job again
+    waited = int((now - since).total_seconds())
+    if waited < WAITING_SECONDS:
+        return since, ""
+    if job.sent is None:
+        return since, (f"not in the queue for {waited} s: the queue (Redis) could not be reached; the job is sent "
+                       "again as soon as it answers")
+    ahead = Job.objects.filter(status=Job.Status.RUNNING, heartbeat__gte=now - stale_after()).exclude(
+        id=job.id).count()
+    if ahead:
+        return since, f"waiting {waited} s for a worker: {_plural(ahead, 'job')} running before it"
+    return since, (f"no worker has taken this job for {waited} s: the worker may be down; it runs once one is "
+                   "back (a job lost from the queue is sent again)")
 
 
 def send(job_id: int) -> None:
@@ -77,24 +118,49 @@ def fail(job_id: int, message: str) -> None:
 
 def release(job_id: int) -> None:
     """Give a running job back to the queue (a transient error; it will be retried)."""
-    Job.objects.filter(id=job_id, status=Job.Status.RUNNING).update(status=Job.Status.QUEUED, stage="retrying")
+    Job.objects.filter(id=job_id, status=Job.Status.RUNNING).update(status=Job.Status.QUEUED, stage="retrying",
+                                                                    heartbeat=timezone.now())
+
+
+# A key the workers keep in the broker's Redis. A Redis that restarted without its data (no append-only file) lost
+# it, and with it every message it held: then every queued job is sent again at once, not after the resend delay.
+EPOCH_KEY = "facaid:broker-epoch"
+
+
+def broker_lost_messages() -> bool:
+    """Has the broker's Redis lost its data since the last look (or is this the first look)? Sets the key again."""
+    import redis
+
+    client = redis.Redis.from_url(app.conf.broker_url, socket_timeout=5, socket_connect_timeout=5)
+    try:
+        return bool(client.set(EPOCH_KEY, timezone.now().isoformat(), nx=True))
+    finally:
+        client.close()
 
 
 def recover() -> dict[str, int]:
     """Re-queue running jobs whose worker stopped beating (failing those out of attempts) and re-send queued
-    jobs whose message seems lost. Safe to run anywhere, any number of times."""
+    jobs whose message seems lost: not sent, sent long ago, or sent to a Redis that has lost its data since.
+    Safe to run anywhere, any number of times (a message delivered twice runs once)."""
     now = timezone.now()
     requeued = failed = resent = 0
+    try:
+        lost = broker_lost_messages()
+    except Exception:  # Redis is down: the resends below fail too, and are tried at the next round
+        log.warning("job recovery: the broker cannot be reached")
+        lost = False
     for job in Job.objects.filter(status=Job.Status.RUNNING, heartbeat__lt=now - stale_after()):
         if job.attempts >= MAX_ATTEMPTS:
             failed += Job.objects.filter(id=job.id, status=Job.Status.RUNNING, heartbeat=job.heartbeat).update(
                 status=Job.Status.FAILED, finished=now,
                 message=f"the worker stopped responding {job.attempts} times; giving up")
         elif Job.objects.filter(id=job.id, status=Job.Status.RUNNING, heartbeat=job.heartbeat).update(
-                status=Job.Status.QUEUED, stage="worker lost; queued again", sent=None):
+                status=Job.Status.QUEUED, stage="worker lost; queued again", sent=None, heartbeat=now):
             requeued += 1
-    for job_id in Job.objects.filter(status=Job.Status.QUEUED).filter(
-            Q(sent__isnull=True) | Q(sent__lt=now - resend_after())).values_list("id", flat=True):
+    queued = Job.objects.filter(status=Job.Status.QUEUED)
+    if not lost:
+        queued = queued.filter(Q(sent__isnull=True) | Q(sent__lt=now - resend_after()))
+    for job_id in queued.values_list("id", flat=True):
         try:
             send(job_id)
             resent += 1

@@ -3,9 +3,12 @@ name the offending field or grammar node."""
 
 from __future__ import annotations
 
+from datetime import datetime
+
 from django.contrib.auth.models import AnonymousUser
 from django.core.validators import ProhibitNullCharactersValidator
 from django.http import QueryDict
+from django.utils import timezone
 from rest_framework import serializers
 
 from facaid.defaults import DEFAULT_K, MAX_K, STRUCTURES
@@ -13,7 +16,7 @@ from facaid.formats import interchange
 from facaid.grammar.procedure import MAX_NODES
 from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
-from webapp.facades import access, sharing
+from webapp.facades import access, jobs, sharing
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, ProcedureVersion, Segmentation, Visibility
 from webapp.facades.parsing import parse_procedure
 
@@ -261,15 +264,36 @@ class ProcedureEditSerializer(ProcedureWriteSerializer):
 class JobSerializer(serializers.ModelSerializer):
     segmentation = serializers.UUIDField(source="segmentation.code", read_only=True)
     result = serializers.SerializerMethodField()
+    state_since = serializers.SerializerMethodField(help_text="when the job entered its status")
+    state_seconds = serializers.SerializerMethodField(help_text="how long it has been in its status, in seconds")
+    note = serializers.SerializerMethodField(help_text="what is happening to a job that is late: waiting for a "
+                                                       "worker, or a worker that stopped reporting; else empty")
 
     class Meta:
         model = Job
         fields = ["code", "kind", "status", "progress", "stage", "message", "attempts", "params", "segmentation",
-                  "result", "result_version", "created", "started", "finished"]
+                  "result", "result_version", "created", "started", "finished", "state_since", "state_seconds",
+                  "note"]
         read_only_fields = fields
 
     def get_result(self, job: Job) -> str | None:
         return str(job.result.code) if job.result_id else None
+
+    def _state(self, job: Job) -> tuple:
+        if getattr(job, "_state_now", None) is None:
+            job._state_now = timezone.now()
+            job._state = jobs.state(job, job._state_now)
+        return job._state
+
+    def get_state_since(self, job: Job) -> datetime:
+        return self._state(job)[0]
+
+    def get_state_seconds(self, job: Job) -> int:
+        since = self._state(job)[0]
+        return max(0, int((job._state_now - since).total_seconds()))
+
+    def get_note(self, job: Job) -> str:
+        return self._state(job)[1]
 
 
 def k_field() -> WholeNumberField:

@@ -35,6 +35,7 @@ from webapp.facades.uploads import UploadError, normalize_photo
 
 
 def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PRIVATE) -> Photo:
+    access.refuse_demo_account(owner, "upload photos")  # they would be the demo's, which nobody changes
     try:
         content, _, _ = normalize_photo(upload)
     except UploadError as exc:

@@ -56,7 +56,7 @@ class JobTask(app.Task):
 def run_job(self, job_id: int) -> None:
     if not jobs.claim(job_id):
         return  # done, failed, or another worker has it: a duplicate delivery
-    heart = _Heartbeat(job_id, env_int("FACAID_HEARTBEAT_SECONDS", 5) or 5)
+    heart = _Heartbeat(job_id, jobs.heartbeat_every())
     heart.start()
     try:
         job = Job.objects.select_related("segmentation__photo").get(id=job_id)
@@ -158,6 +158,6 @@ def _recover_forever(every: int) -> None:
 
 @worker_ready.connect
 def _start_recovery(**_) -> None:
-    every = env_int("FACAID_RECOVER_SECONDS", 30)
+    every = env_int("FACAID_RECOVER_SECONDS", 10)
     if every > 0:
         threading.Thread(target=_recover_forever, args=(every,), daemon=True, name="job-recovery").start()

@@ -17,7 +17,7 @@ from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
-from webapp.facades import access, example, jsonbody, services, sharing, throttling
+from webapp.facades import access, example, jobs, jsonbody, services, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
     PhotoForm,
@@ -83,7 +83,7 @@ def photo_new(request):
 
 def photo(request, code):
     photo = access.get_photo_for_user(request.user, code)
-    owner = request.user == photo.owner
+    owner = request.user == photo.owner and not access.is_demo(photo)  # nobody changes the demo's
     segmentation = photo.latest_segmentation()
     context = {"photo": photo, "owner": owner, "segmentation": segmentation,
                "procedures": access.listed(photo.procedures.filter(owner=photo.owner) if owner else
@@ -193,15 +193,17 @@ def photo_editor(request, code):
 def job(request, code):
     job = access.get_job_for_user(request.user, code)
     return render(request, "facades/job.html", {
-        "job": job, "photo_visible": access.photo_visible_to(request.user, job.segmentation.photo)})
+        "job": job, "photo_visible": access.photo_visible_to(request.user, job.segmentation.photo),
+        "note": jobs.state(job)[1]})
 
 
 def procedure(request, code):
     proc = access.get_procedure_for_user(request.user, code)
-    owner = request.user == proc.owner
+    demo = access.is_demo(proc)
+    owner = request.user == proc.owner and not demo  # the demo account sees the demo as anyone does: fork to edit
     photo_visible = access.photo_visible_to(request.user, proc.photo)
     return render(request, "facades/procedure.html", {
-        "proc": proc, "owner": owner, "photo_visible": photo_visible, "current": proc.current_version(),
+        "proc": proc, "owner": owner, "demo": demo, "photo_visible": photo_visible, "current": proc.current_version(),
         "other_structure": _other_structure(proc),
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
         "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),

@@ -9,7 +9,7 @@ from rest_framework.decorators import (
     parser_classes,
     permission_classes,
 )
-from rest_framework.exceptions import ValidationError
+from rest_framework.exceptions import PermissionDenied, ValidationError
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
@@ -45,6 +45,8 @@ def job_list(request):
     if seg.photo.owner != request.user:
         raise ValidationError({"segmentation": "fork the photo's procedure or upload your own photo to "
                                                "reconstruct it"})
+    if access.is_demo(seg.photo):
+        raise PermissionDenied(access.DEMO_READ_ONLY)
     prefix = access.get_procedure_for_user(request.user, v["prefix_procedure"]) if v["prefix_procedure"] else None
     job = services.submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"], v["structure"])
     return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)

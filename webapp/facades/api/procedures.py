@@ -159,6 +159,8 @@ def procedure_parameters(request, code):
         return Response({"parameters": [p.to_dict() for p in named_parameters(tree)], "leaves": _leaves(tree)})
     form = ParametersSerializer(data=request.data)
     form.is_valid(raise_exception=True)
+    if form.validated_data["save"]:  # refused before the work, not after it
+        proc = access.get_rw_procedure_for_user(request.user, code)
     try:
         tree = form.validated_data.get("data") or proc.data
         edited = set_parameters(parse_procedure(tree), form.validated_data["values"])
@@ -167,7 +169,6 @@ def procedure_parameters(request, code):
     answer = {"data": edited.to_dict(), "parameters": [p.to_dict() for p in named_parameters(edited)],
               "leaves": _leaves(edited), "accuracy": None, "metrics": None, "version": None}
     if form.validated_data["save"]:
-        proc = access.get_rw_procedure_for_user(request.user, code)
         versions.save_parameters(proc, answer["data"], form.validated_data["values"])
         answer.update(accuracy=proc.accuracy, metrics=proc.metrics, version=proc.current_version().version)
     return Response(answer)
