@@ -1,15 +1,21 @@
-"""The light pages under a burst of the heaviest requests the site accepts (issue 56).
+"""The light pages under a burst of the heaviest requests the site accepts (issues 56 and 66).
 
-    .venv/bin/python bench/bench_heavy_load.py [--seconds 20] [--heavy 8] [--slots 2 8]
+    .venv/bin/python bench/bench_heavy_load.py [--seconds 20] [--heavy 8] [--slots 2 8] [--mix api pages uploads]
 
 Starts gunicorn as `scripts/run` does (2 workers x 4 threads) on a scratch SQLite database in a temporary directory,
-loopback only, with a public procedure of the largest accepted size (157 x 157 tiles, 98,755 node instances) and
-60 small public ones for the gallery. Then for ``--seconds``: ``--heavy`` anonymous clients each send, one after
-another, the heaviest accepted requests (a render of that tree, two variations of it in a range of floors, its
-windows made wider), while one client reads the gallery (`GET /api/v1/gallery/`) and measures it. The API's rate
-throttles are off (every client shares one address: this measures the process's heavy slots, not the throttle).
-Run once per ``--slots`` value (`FACAID_HEAVY_SLOTS`: heavy requests one process serves at once; 8 is no cap with
-4 threads a worker). Target: the gallery's p95 ≤ 500 ms at the default slots.
+loopback only, with a public procedure of the largest accepted size (157 x 157 tiles, 98,755 node instances, in two
+versions) and 60 small public ones for the gallery. Then for ``--seconds``: ``--heavy`` clients each send, one after
+another, the heaviest requests of one mix, while one client reads the gallery (`GET /api/v1/gallery/`) and
+measures it. The mixes:
+
+- ``api``, anonymous: a render of that tree, two variations of it in a range of floors, its windows made wider;
+- ``pages``, anonymous: that procedure's page, the difference picture of its two versions, the label map of its
+  first version (drawn on each request);
+- ``uploads``, one account (an API token): a 40-megapixel WebP photo of 16,000 x 2,490 px (issue 66's probe).
+
+The API's rate throttles are off (every client shares one address: this measures the process's heavy slots, not
+the throttle). Run once per mix and ``--slots`` value (`FACAID_HEAVY_SLOTS`: heavy requests one process serves at
+once; 8 is no cap with 4 threads a worker). Target: the gallery's p95 ≤ 500 ms at the default slots.
 """
 
 from __future__ import annotations
@@ -51,11 +57,50 @@ tree = {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR_VERSION, 
         "root": {"rule": "repeat", "axis": "y", "count": 157, "role": "floors", "sizes": [["flt", 1]],
                  "children": [row]}}
 big = Procedure.objects.create(owner=user, title="big", data=tree, visibility="public")
-print(json.dumps({"big": str(big.code), "tree": tree}))
+tree["root"]["count"] = 156
+big.data = tree
+big.save()  # its version 2
+from rest_framework.authtoken.models import Token
+print(json.dumps({"big": str(big.code), "tree": tree, "token": Token.objects.create(user=user).key}))
 """
 
+BOUNDARY = "facaid-bench-boundary"
 
-def run(env: dict, slots: int, seconds: float, heavy: int, seeded: dict) -> dict:
+
+def upload_body() -> bytes:
+    """A multipart body of the probe's photo: a 16,000 x 2,490 WebP (40 MP), a few tens of KB."""
+    import io
+
+    from PIL import Image
+
+    img = Image.new("RGB", (16000, 2490), (150, 140, 130))
+    img.paste((90, 100, 120), (4000, 600, 8000, 1800))
+    buf = io.BytesIO()
+    img.save(buf, "WEBP", quality=50)
+    head = (f"--{BOUNDARY}\r\nContent-Disposition: form-data; name=\"image\"; filename=\"big.webp\"\r\n"
+            "Content-Type: image/webp\r\n\r\n").encode()
+    return head + buf.getvalue() + f"\r\n--{BOUNDARY}--\r\n".encode()
+
+
+def mix_requests(mix: str, seeded: dict) -> list[tuple[str, str, object, dict]]:
+    """(method, path, body, headers) of each heavy request of a mix, sent in turn."""
+    code, tree = seeded["big"], seeded["tree"]
+    json_body = {"Content-Type": "application/json"}
+    if mix == "api":
+        return [("POST", "/api/v1/render", tree, json_body),
+                ("POST", f"/api/v1/procedures/{code}/variations", {"n": 2, "ranges": {"floors": [150, 157]}},
+                 json_body),
+                ("POST", f"/api/v1/procedures/{code}/parameters", {"values": {"window_width": 12}}, json_body)]
+    if mix == "pages":
+        return [("GET", f"/procedures/{code}", None, {}),
+                ("GET", f"/api/v1/procedures/{code}/versions/compare.png?a=1&b=2", None, {}),
+                ("GET", f"/api/v1/procedures/{code}/versions/1/labels.png", None, {})]
+    form = {"Content-Type": f"multipart/form-data; boundary={BOUNDARY}", "Authorization": f"Token {seeded['token']}"}
+    return [("POST", "/api/v1/photos/", seeded["upload"], form)]
+
+
+
+def run(env: dict, slots: int, seconds: float, heavy: int, seeded: dict, mix: str) -> dict:
     port = free_port()
     env = {**env, "FACAID_HEAVY_SLOTS": str(slots)}
     server = subprocess.Popen([sys.executable, "-m", "gunicorn", "webapp.wsgi", "--bind", f"127.0.0.1:{port}",
@@ -63,19 +108,16 @@ def run(env: dict, slots: int, seconds: float, heavy: int, seeded: dict) -> dict
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         wait_port(port)
-        code, tree = seeded["big"], seeded["tree"]
-        requests = [("POST", "/api/v1/render", tree),
-                    ("POST", f"/api/v1/procedures/{code}/variations", {"n": 2, "ranges": {"floors": [150, 157]}}),
-                    ("POST", f"/api/v1/procedures/{code}/parameters", {"values": {"window_width": 12}})]
+        requests = mix_requests(mix, seeded)
         stop = time.time() + seconds
         statuses: Counter = Counter()
         heavy_times: list[float] = []
         gallery: list[float] = []
         lock = threading.Lock()
 
-        def send(conn, method, path, body=None):
-            data = None if body is None else json.dumps(body)
-            conn.request(method, path, body=data, headers={"Content-Type": "application/json"})
+        def send(conn, method, path, body=None, headers=None):
+            data = body if body is None or isinstance(body, bytes) else json.dumps(body)
+            conn.request(method, path, body=data, headers=headers or {})
             r = conn.getresponse()
             r.read()
             return r.status, r.getheader("Retry-After")
@@ -84,11 +126,11 @@ def run(env: dict, slots: int, seconds: float, heavy: int, seeded: dict) -> dict
             conn = http.client.HTTPConnection("127.0.0.1", port, timeout=60)
             n = i
             while time.time() < stop:
-                method, path, body = requests[n % len(requests)]
+                method, path, body, headers = requests[n % len(requests)]
                 n += 1
                 t0 = time.perf_counter()
                 try:
-                    status, retry = send(conn, method, path, body)
+                    status, retry = send(conn, method, path, body, headers)
                 except (OSError, http.client.HTTPException):
                     status, retry = "error", None
                     conn.close()
@@ -129,6 +171,7 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=20)
     ap.add_argument("--heavy", type=int, default=8)
     ap.add_argument("--slots", type=int, nargs="+", default=[2, 8])
+    ap.add_argument("--mix", nargs="+", choices=("api", "pages", "uploads"), default=["api", "pages", "uploads"])
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="facaid-heavy-"))
     env = {**os.environ, "DATABASE_URL": f"sqlite:///{tmp / 'db.sqlite3'}", "MEDIA_ROOT": str(tmp / "media"),
@@ -138,14 +181,16 @@ def main() -> None:
     try:
         manage(env, "migrate", "--noinput")
         seeded = json.loads(manage(env, "shell", "-c", SEED_SCRIPT).strip().splitlines()[-1])
+        seeded["upload"] = upload_body()
         print(f"{args.heavy} clients sending the heaviest accepted requests, one reading the gallery, "
               f"{args.seconds:.0f} s, gunicorn 2 workers x 4 threads")
-        for slots in args.slots:
-            r = run(env, slots, args.seconds, args.heavy, seeded)
+        for mix, slots in [(mix, slots) for mix in args.mix for slots in args.slots]:
+            r = run(env, slots, args.seconds, args.heavy, seeded, mix)
             g = r["gallery"]
-            print(f"heavy slots {slots}: gallery {len(g)} reads, median {1000 * statistics.median(g):.0f} ms, "
-                  f"p95 {1000 * pct(g, 0.95):.0f} ms, max {1000 * max(g):.0f} ms; heavy answers {r['statuses']}, "
-                  f"served in median {statistics.median(r['heavy']):.2f} s" if r["heavy"] else "")
+            served = f", served in median {statistics.median(r['heavy']):.2f} s" if r["heavy"] else ""
+            print(f"{mix}, heavy slots {slots}: gallery {len(g)} reads, median {1000 * statistics.median(g):.0f} ms, "
+                  f"p95 {1000 * pct(g, 0.95):.0f} ms, max {1000 * max(g):.0f} ms; heavy answers {r['statuses']}"
+                  f"{served}")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

@@ -8,15 +8,15 @@ trees it reads and makes may lay out at most ``FACAID_REQUEST_WORK`` node instan
 from __future__ import annotations
 
 import logging
-import threading
 
 from django.conf import settings
 from django.db import OperationalError
 
 from facaid.grammar.budget import WorkLimitError, work_budget
 from webapp.errors import error_response
-from webapp.facades.models import VersionQuotaError
-from webapp.facades.throttling import HeavySlots, is_heavy
+from webapp.facades import throttling
+from webapp.facades.models import QuotaError
+from webapp.facades.throttling import is_heavy
 
 log = logging.getLogger(__name__)
 
@@ -79,7 +79,7 @@ class WorkBudgetMiddleware:
             return self.get_response(request)
 
     def process_exception(self, request, exception):
-        if not isinstance(exception, WorkLimitError | VersionQuotaError):  # (the quota: a save past it, models.py)
+        if not isinstance(exception, WorkLimitError | QuotaError):  # (the storage quota: a write past it, models.py)
             return None
         return error_response(request, 400, str(exception))
 
@@ -92,8 +92,6 @@ class HeavySlotsMiddleware:
 
     def __init__(self, get_response):
         self.get_response = get_response
-        self.slots = HeavySlots(settings.FACAID_HEAVY_SLOTS)
-        self.lock = threading.Lock()
 
     def __call__(self, request):
         try:
@@ -107,10 +105,7 @@ class HeavySlotsMiddleware:
     def process_view(self, request, view_func, view_args, view_kwargs):
         if not is_heavy(request, view_func, view_kwargs):
             return None
-        with self.lock:  # the setting changed (a test): new slots; requests give back the ones they took
-            if self.slots.slots != settings.FACAID_HEAVY_SLOTS:
-                self.slots = HeavySlots(settings.FACAID_HEAVY_SLOTS)
-            slots = self.slots
+        slots = throttling.slots()
         if not slots.take():
             return error_response(request, 503, f"the site is busy with {slots.slots} heavy requests (rendering, "
                                                 "variations, downloads) in this process; try again in a moment",

@@ -59,8 +59,9 @@ FACAID_REQUEST_SECONDS = env_float("FACAID_REQUEST_SECONDS", 2.0)
 # heavy API requests (rendering, variations, rectifying, downloads: webapp/facades/throttling.py) one process serves
 # at once; gunicorn's 4 threads a worker (scripts/run) keep 2 for the gallery, job status and pages
 FACAID_HEAVY_SLOTS = env_int("FACAID_HEAVY_SLOTS", 2, minimum=1)
-# megabytes an account's saved procedure versions may take, compressed (a real facade's tree: 2-20 KB a version)
-FACAID_VERSIONS_QUOTA_MB = env_int("FACAID_VERSIONS_QUOTA_MB", 200, minimum=1)
+# megabytes an account may store: its photos' files, its segmentations (versions and drafts, as JSON) and its
+# procedures (current trees as JSON, versions compressed); a phone's photo is 2-8 MB, a real facade's tree 2-20 KB
+FACAID_STORAGE_QUOTA_MB = env_int("FACAID_STORAGE_QUOTA_MB", 1000, minimum=1)
 
 INSTALLED_APPS = [
     "django.contrib.admin",

@@ -19,7 +19,7 @@ from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
 from facaid.variation import vary
-from webapp.facades.models import Job, Procedure, ProcedureVersion, Segmentation
+from webapp.facades.models import Job, Procedure, ProcedureVersion, Segmentation, stored_bytes
 from webapp.facades.rendering import DIFFERENT
 
 pytestmark = pytest.mark.django_db
@@ -414,7 +414,8 @@ def test_versions_past_the_accounts_quota_are_refused_by_name_and_nothing_is_los
                                                                                    settings):
     _, seg = facade_photo
     proc = _faithful(alice, seg)
-    settings.FACAID_VERSIONS_QUOTA_MB = (ProcedureVersion.objects.get(procedure=proc).size * 3.5) / 2**20
+    used = sum(stored_bytes(alice.pk).values())  # the photo, its segmentation, the tree and its version
+    settings.FACAID_STORAGE_QUOTA_MB = (used + ProcedureVersion.objects.get(procedure=proc).size * 2.5) / 2**20
     kept = []
     for seed in range(10, 20):
         tree = _same_size_variant(generate(seed).procedure.to_dict()) if seed % 2 else None
@@ -423,13 +424,13 @@ def test_versions_past_the_accounts_quota_are_refused_by_name_and_nothing_is_los
         if r.status_code != 200:
             break
         kept.append(r.json()["version"])
-    assert r.status_code == 400 and "your saved versions take" in r.json()["detail"], r.content[:300]
+    assert r.status_code == 400 and "your account stores" in r.json()["detail"], r.content[:300]
     assert "nothing was saved" in r.json()["detail"]
     assert [v["version"] for v in _history(as_alice, proc)] == [*reversed(kept), 1]  # all kept, none added
     assert as_alice.get(_url(proc)).json()["version"] == (kept or [1])[-1]
     jobs = Job.objects.count()  # a job would fail on its result: it is refused when asked for
     r = as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"]}, format="json")
-    assert r.status_code == 400 and "your saved versions take" in r.json()["detail"] and Job.objects.count() == jobs
+    assert r.status_code == 400 and "your account stores" in r.json()["detail"] and Job.objects.count() == jobs
 
 
 def test_a_compressed_tree_reads_back_from_the_database_from_a_dump_and_as_given():

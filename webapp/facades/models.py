@@ -1,6 +1,6 @@
 """Photos, their segmentations (versioned), reconstruction jobs and procedures (versioned: every save of a tree
-is a new `ProcedureVersion`, stored compressed within its owner's quota, and none is ever changed or deleted but
-with its procedure). Every object is addressed
+is a new `ProcedureVersion`, stored compressed, and none is ever changed or deleted but with its procedure). What an
+account stores, photos, segmentations and procedures, is within its quota (`check_quota`). Every object is addressed
 by a UUID ``code``; photos and procedures carry a visibility (private, unlisted, public)."""
 
 from __future__ import annotations
@@ -51,12 +51,17 @@ class Photo(models.Model):
     real_height_m = models.FloatField(null=True, blank=True)
     visibility = models.CharField(max_length=10, choices=Visibility.choices, default=Visibility.PRIVATE)
     created = models.DateTimeField(default=timezone.now)
+    stored_bytes = models.PositiveBigIntegerField(default=0)  # its files' bytes, the original's and the rectified's
 
     class Meta:
         ordering = ["-created"]
 
     def __str__(self) -> str:
         return self.title or f"photo {self.code}"
+
+    def file_bytes(self) -> int:
+        """Bytes its files take in storage (what `stored_bytes` keeps, for the quota)."""
+        return sum(field.size for field in (self.image, self.rectified) if field)
 
     def get_absolute_url(self) -> str:
         return reverse("photo", args=[self.code])
@@ -90,6 +95,7 @@ class Segmentation(models.Model):
     version = models.PositiveIntegerField()
     data = models.JSONField()
     rect_count = models.PositiveIntegerField(default=0)
+    size = models.PositiveIntegerField(default=0)  # bytes of its JSON (`json_size`), for the quota
     created = models.DateTimeField(default=timezone.now)
 
     class Meta:
@@ -107,32 +113,49 @@ class Draft(models.Model):
     photo = models.OneToOneField(Photo, on_delete=models.CASCADE, related_name="draft")
     data = models.JSONField()
     rect_count = models.PositiveIntegerField(default=0)
+    size = models.PositiveIntegerField(default=0)  # bytes of its JSON (`json_size`), for the quota
     updated = models.DateTimeField(default=timezone.now)
 
     def __str__(self) -> str:
         return f"{self.photo} draft"
 
 
-class VersionQuotaError(Exception):
-    """A save past its owner's quota of stored versions; the message says how much is used and what to do."""
+class QuotaError(Exception):
+    """A write past its owner's storage quota; the message says how much is used, by what, and what to do."""
 
 
-def versions_stored(owner_id) -> int:
-    """Bytes the owner's versions take (compressed), all procedures."""
-    return ProcedureVersion.objects.filter(procedure__owner_id=owner_id).aggregate(
-        total=models.Sum("size"))["total"] or 0
+def json_size(data) -> int:
+    """Bytes a JSON value takes written out compactly: what a JSON column holds of it, uncompressed."""
+    return len(json.dumps(data, separators=(",", ":"), allow_nan=False, ensure_ascii=False).encode())
 
 
-def check_quota(owner_id, size: int) -> None:
-    """Refuse a version of ``size`` bytes that would take its owner past ``FACAID_VERSIONS_QUOTA_MB``; nothing
-    stored is touched."""
-    quota = settings.FACAID_VERSIONS_QUOTA_MB * 2**20
-    used = versions_stored(owner_id)
-    if used + size > quota:
-        raise VersionQuotaError(
-            f"your saved versions take {used / 2**20:.1f} MB of your {quota / 2**20:g} MB, and this one needs "
-            f"{size / 2**10:.0f} KB more: delete procedures you no longer need (their versions go with them); "
-            "nothing was saved")
+def stored_bytes(owner_id) -> dict[str, int]:
+    """Bytes an account stores, by kind: its photos' files (the original and the rectified image), its
+    segmentations (every version and the drafts, as JSON), and its procedures (each current tree as JSON, and every
+    version, compressed)."""
+    def total(rows, field: str) -> int:
+        return rows.aggregate(total=models.Sum(field))["total"] or 0
+
+    return {"photos": total(Photo.objects.filter(owner_id=owner_id), "stored_bytes"),
+            "segmentations": total(Segmentation.objects.filter(photo__owner_id=owner_id), "size")
+            + total(Draft.objects.filter(photo__owner_id=owner_id), "size"),
+            "procedures": total(Procedure.objects.filter(owner_id=owner_id), "data_size")
+            + total(ProcedureVersion.objects.filter(procedure__owner_id=owner_id), "size")}
+
+
+def check_quota(owner_id, size: int, replaced: int = 0) -> None:
+    """Refuse a write of ``size`` bytes (in place of ``replaced`` bytes stored now) that would take its owner past
+    ``FACAID_STORAGE_QUOTA_MB``; nothing stored is touched. Called before the write, or inside its transaction
+    after it (where the rows written count already: ``size`` is then what is still to come)."""
+    quota = settings.FACAID_STORAGE_QUOTA_MB * 2**20
+    used = stored_bytes(owner_id)
+    total = sum(used.values())
+    if size > 0 and total - replaced + size > quota:
+        kinds = ", ".join(f"{kind} {n / 2**20:.1f} MB" for kind, n in used.items())
+        raise QuotaError(
+            f"your account stores {total / 2**20:.1f} MB of its {quota / 2**20:g} MB ({kinds}), and this needs "
+            f"{size / 2**10:.0f} KB more: delete photos or procedures you no longer need (a procedure's versions "
+            "go with it); nothing was saved")
 
 
 def tree_digest(data: dict) -> str:
@@ -154,6 +177,7 @@ class Procedure(models.Model):
     metrics = models.JSONField(default=dict, blank=True)
     # names the tree in `data` (tree_digest): its kept pictures' names and ETags, read without `data`
     digest = models.CharField(max_length=16, blank=True, editable=False)
+    data_size = models.PositiveIntegerField(default=0, editable=False)  # bytes of `data` (`json_size`): the quota's
     visibility = models.CharField(max_length=10, choices=Visibility.choices, default=Visibility.PRIVATE)
     created = models.DateTimeField(default=timezone.now)
     updated = models.DateTimeField(auto_now=True)
@@ -174,9 +198,9 @@ class Procedure(models.Model):
         fields = kwargs.get("update_fields")
         writes_tree = "data" in fields if fields is not None else "data" not in self.get_deferred_fields()
         if writes_tree:
-            self.digest = tree_digest(self.data)
+            self.digest, self.data_size = tree_digest(self.data), json_size(self.data)
             if fields is not None:
-                kwargs["update_fields"] = {*fields, "digest"}
+                kwargs["update_fields"] = {*fields, "digest", "data_size"}
         with transaction.atomic(using=kwargs.get("using")):
             super().save(*args, **kwargs)  # first: the row's write lock orders racing saves' version numbers
             if writes_tree:
@@ -192,7 +216,7 @@ class Procedure(models.Model):
                 return
             change = change or Change(ProcedureVersion.Kind.EDIT if latest else ProcedureVersion.Kind.CREATED)
         packed = pack(self.data)  # stored as it is: the field compresses only what is not compressed yet
-        check_quota(self.owner_id, len(packed))
+        check_quota(self.owner_id, len(packed))  # with the tree just written: a refusal rolls both back
         ProcedureVersion.objects.create(
             procedure=self, version=(latest["version"] if latest else 0) + 1, data=packed, size=len(packed),
             digest=self.digest,

@@ -68,14 +68,17 @@ def render(data: dict, kind: str) -> bytes:
     return rendering.label_map_png(to_segmentation(Tree.from_dict(data)), SIDES[kind])
 
 
-def stored(proc, kind: str, redraw: bool = False) -> tuple[str, str, bytes | None]:
+def stored(proc, kind: str, redraw: bool = False, draw: bool = True) -> tuple[str, str, bytes | None] | None:
     """(storage name, digest, the PNG when this call had to draw it) of the procedure's picture ``kind``; with
-    ``redraw``, drawn even if kept (the kept file just went). Its tree is read only to draw it, together with the
-    digest it is filed under (an edit may have committed since ``proc`` was read); `LookupError` when the
-    procedure is gone meanwhile. A picture that cannot be kept (a full disk) is logged and still returned."""
+    ``redraw``, drawn even if kept (the kept file just went); without ``draw``, None where it would have to be
+    drawn (the caller takes a heavy slot first). Its tree is read only to draw it, together with the digest it is
+    filed under (an edit may have committed since ``proc`` was read); `LookupError` when the procedure is gone
+    meanwhile. A picture that cannot be kept (a full disk) is logged and still returned."""
     name = _name(proc.code, proc.digest, kind)
     if not redraw and proc.digest and default_storage.exists(name):
         return name, proc.digest, None
+    if not draw:
+        return None
     row = Procedure.objects.filter(id=proc.id).values_list("digest", "data").first()
     if row is None:
         raise LookupError(f"procedure {proc.code} is gone")

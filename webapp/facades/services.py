@@ -29,7 +29,16 @@ from facaid.photo import appearance
 from facaid.photo.rectify import propose_corners_file, rectify_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
-from webapp.facades.models import Draft, Job, Photo, Procedure, Segmentation, Visibility, check_quota
+from webapp.facades.models import (
+    Draft,
+    Job,
+    Photo,
+    Procedure,
+    Segmentation,
+    Visibility,
+    check_quota,
+    json_size,
+)
 from webapp.facades.parsing import parse_segmentation
 from webapp.facades.uploads import UploadError, normalize_photo
 
@@ -40,8 +49,10 @@ def create_photo(owner, upload, title: str = "", visibility: str = Visibility.PR
         content, _, _ = normalize_photo(upload)
     except UploadError as exc:
         raise ValidationError({"image": str(exc)}) from None
+    check_quota(owner.pk, content.size)
     photo = Photo(owner=owner, title=title, visibility=visibility)
     photo.image.save(content.name, content, save=False)
+    photo.stored_bytes = photo.file_bytes()
     photo.save()
     return photo
 
@@ -69,10 +80,12 @@ def rectify_photo(photo: Photo, corners) -> Photo:
             raise ValidationError({"corners": str(exc)}) from None
     buf = io.BytesIO()
     out.save(buf, "PNG")
+    check_quota(photo.owner_id, buf.tell(), replaced=photo.rectified.size if photo.rectified else 0)
     if photo.rectified:
         photo.rectified.delete(save=False)
     photo.rectified.save("rectified.png", ContentFile(buf.getvalue()), save=False)
     photo.corners = corners
+    photo.stored_bytes = photo.file_bytes()
     photo.save()
     drop_draft(photo)  # drawn on the image before: it no longer fits
     return photo
@@ -139,10 +152,13 @@ def add_segmentation(photo: Photo, data, format: str | None = None,
     """A new version from the body of an upload (see `_segmentation_of`), and the warnings of reading it."""
     loaded = _segmentation_of(photo, data, format, image)
     seg = loaded.segmentation
+    data = seg.to_dict()
     with transaction.atomic():
         last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
-        version = Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=seg.to_dict(),
-                                              rect_count=len(seg.rects))
+        draft = Draft.objects.filter(photo=photo).values_list("size", flat=True).first() or 0
+        check_quota(photo.owner_id, json_size(data), replaced=draft)
+        version = Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=data,
+                                              rect_count=len(seg.rects), size=json_size(data))
         drop_draft(photo)  # saved: the draft it was is the version now
     return version, loaded.warnings
 
@@ -159,8 +175,13 @@ def save_draft(photo: Photo, data) -> Draft:
     """Keep (replace) the photo's draft: the segmentation contract's JSON of the photo's size (the rectified
     image's once there is one), validated as a version would be."""
     seg = _segmentation_of(photo, data).segmentation
-    draft, _ = Draft.objects.update_or_create(photo=photo, defaults={
-        "data": seg.to_dict(), "rect_count": len(seg.rects), "updated": timezone.now()})
+    data = seg.to_dict()
+    size = json_size(data)
+    with transaction.atomic():
+        kept = Draft.objects.select_for_update().filter(photo=photo).values_list("size", flat=True).first() or 0
+        check_quota(photo.owner_id, size, replaced=kept)
+        draft, _ = Draft.objects.update_or_create(photo=photo, defaults={
+            "data": data, "rect_count": len(seg.rects), "size": size, "updated": timezone.now()})
     return draft
 
 

@@ -1,12 +1,17 @@
 """The API's throttle for requests that cost real CPU: rendering a procedure (a preview, or its pictures as a save
-commits), variations, rectifying a photo, building a download. A rate of its own (FACAID_API_HEAVY_RATE) on top of
-the general ones, per account for users and per address for everyone else; reads of what is already kept
-(a procedure's JSON, its `labels.png` file) do not count. And a cap on how many such requests one process serves
-at once (`HeavySlots`), so that a burst of them leaves threads for the light pages."""
+commits), variations, rectifying a photo, uploading one, building a download. A rate of its own
+(FACAID_API_HEAVY_RATE) on top of the general ones, per account for users and per address for everyone else; reads
+of what is already kept (a procedure's JSON, its `labels.png` file) do not count. And a cap on how many such
+requests one process serves at once (`HeavySlots`, `slots`), so that a burst of them leaves threads for the light
+pages: the API's heavy views take a slot before they run (`webapp.middleware.HeavySlotsMiddleware`), and the pages
+and pictures that must draw take one where they draw (`heavy_slot`)."""
 
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from types import SimpleNamespace
 
+from django.conf import settings
 from rest_framework.permissions import SAFE_METHODS
 from rest_framework.settings import api_settings
 from rest_framework.throttling import UserRateThrottle
@@ -27,7 +32,7 @@ def _light(request, view) -> bool:
     if "name" in kwargs:  # a download
         return kwargs["name"] == "labels.png"
     return request.method in SAFE_METHODS and request.resolver_match is not None and \
-        request.resolver_match.url_name in ("api-procedures", "api-procedure")
+        request.resolver_match.url_name in ("api-procedures", "api-procedure", "api-photos")
 
 
 HEAVY = [*api_settings.DEFAULT_THROTTLE_CLASSES, HeavyRateThrottle]  # the site's throttles, and this one
@@ -63,3 +68,34 @@ class HeavySlots:
 
     def give_back(self) -> None:
         self._free.release()
+
+
+_slots: HeavySlots | None = None
+_slots_lock = threading.Lock()
+
+
+def slots() -> HeavySlots:
+    """This process's heavy slots, ``settings.FACAID_HEAVY_SLOTS`` of them (new ones when the setting changes, in a
+    test; requests give back the ones they took)."""
+    global _slots
+    with _slots_lock:
+        if _slots is None or _slots.slots != settings.FACAID_HEAVY_SLOTS:
+            _slots = HeavySlots(settings.FACAID_HEAVY_SLOTS)
+        return _slots
+
+
+@contextmanager
+def heavy_slot(request) -> Iterator[bool]:
+    """Hold a heavy slot for the block, where a page or a picture must draw: yields True with one (or where the
+    request holds one already, a heavy API view's), False when none is free, at once."""
+    if getattr(request, "_heavy_slots", None) is not None:
+        yield True
+        return
+    held = slots()
+    if not held.take():
+        yield False
+        return
+    try:
+        yield True
+    finally:
+        held.give_back()

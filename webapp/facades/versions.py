@@ -173,8 +173,10 @@ def save_as_new(user, proc: Procedure, data: dict | None = None, title: str = ""
 def compare(proc: Procedure, a, b, max_side: int = rendering.COMPARE_SIDE) -> tuple[ProcedureVersion,
                                                                                      ProcedureVersion, dict]:
     """Versions ``a`` and ``b`` (from the query: a 400 names the bad one) and their difference picture:
-    {"png", "differing", "pixels"} (pixels whose label differs, of the picture's, at most ``max_side`` a side)."""
+    {"png", "differing", "pixels", "sizes"} (pixels whose label differs, of the picture's, at most ``max_side`` a
+    side; each tree's width and height). Each tree is read once, before any is drawn."""
     first, second = get_version(proc, a, "a"), get_version(proc, b, "b")
-    png, differing, pixels = rendering.difference_png(parse_procedure(first.data), parse_procedure(second.data),
-                                                      max_side)
-    return first, second, {"png": png, "differing": differing, "pixels": pixels}
+    trees = parse_procedure(first.data), parse_procedure(second.data)  # both charged to the budget, then drawn
+    png, differing, pixels = rendering.difference_png(*trees, max_side)
+    return first, second, {"png": png, "differing": differing, "pixels": pixels,
+                           "sizes": [(tree.width, tree.height) for tree in trees]}

@@ -17,6 +17,7 @@ from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
+from facaid.grammar.budget import WorkLimitError
 from webapp.facades import access, example, jobs, jsonbody, services, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
@@ -28,7 +29,7 @@ from webapp.facades.forms import (
     SegmentationForm,
     VisibilityForm,
 )
-from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure
+from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, QuotaError
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers import PhotoSerializer
 
@@ -69,16 +70,27 @@ def home(request):
 @login_required
 def photo_new(request):
     form = PhotoForm(request.POST or None, request.FILES or None)
+    status = 200
     if request.method == "POST" and form.is_valid():
-        try:
-            photo = services.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
-                                          form.cleaned_data["visibility"])
-        except ValidationError as exc:
-            form.add_error("image", _error_text(exc).removeprefix("image: "))
-        else:
-            messages.success(request, "Photo uploaded. Rectify it if needed, then add a segmentation.")
-            return redirect(photo)
-    return render(request, "facades/photo_new.html", {"form": form}, status=400 if form.errors else 200)
+        with throttling.heavy_slot(request) as held:  # decoding a photo is a heavy request, as the API's upload
+            allowed, wait = throttling.allow_heavy(request) if held else (False, 2)
+            if not allowed:
+                form.add_error("image", f"the site is busy with other uploads and drawings; send it again in "
+                                        f"{math.ceil(wait or 2)} s")
+                status = 503
+            else:
+                try:
+                    photo = services.create_photo(request.user, form.cleaned_data["image"],
+                                                  form.cleaned_data["title"], form.cleaned_data["visibility"])
+                except ValidationError as exc:
+                    form.add_error("image", _error_text(exc).removeprefix("image: "))
+                except QuotaError as exc:
+                    form.add_error("image", str(exc))
+                else:
+                    messages.success(request, "Photo uploaded. Rectify it if needed, then add a segmentation.")
+                    return redirect(photo)
+    return render(request, "facades/photo_new.html", {"form": form}, status=400 if status == 200 and form.errors
+                  else status)
 
 
 def photo(request, code):
@@ -202,7 +214,11 @@ def procedure(request, code):
     demo = access.is_demo(proc)
     owner = request.user == proc.owner and not demo  # the demo account sees the demo as anyone does: fork to edit
     photo_visible = access.photo_visible_to(request.user, proc.photo)
+    with throttling.heavy_slot(request) as held:  # a page that draws is a heavy request: a slot and the rate
+        heavy = held and throttling.allow_heavy(request)[0]
+        scale, drawable, note = _drawing(proc) if heavy else (None, True, BUSY_NOTE)
     return render(request, "facades/procedure.html", {
+        "drawable": drawable, "picture_note": note, "scale_pending": not heavy,
         "proc": proc, "owner": owner, "demo": demo, "photo_visible": photo_visible, "current": proc.current_version(),
         "other_structure": _other_structure(proc),
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
@@ -214,7 +230,23 @@ def procedure(request, code):
         "photo_hidden": proc.photo is not None and not photo_visible,
         "drawn_on": _drawn_on(proc) if photo_visible else None,
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
-        "max_scale": MAX_SCALE, "scale": _download_scale(proc)})
+        "max_scale": MAX_SCALE, "scale": scale})
+
+
+BUSY_NOTE = "The site is busy: this page is shown without working out the downloads' scale; reload in a moment."
+
+
+def _drawing(proc) -> tuple[tuple[float, str] | None, bool, str]:
+    """(the metric downloads' scale, whether the tree can be drawn, what to say if not): the tree is read under the
+    request's work budget, charged before any of it is laid out. A tree stored before a limit it now breaks, or one
+    past the budget, is shown without its picture."""
+    try:
+        return download_scale(proc, parse_procedure(proc.data)), True, ""
+    except (ValidationError, ProcedureError) as exc:
+        why = _error_text(exc) if isinstance(exc, ValidationError) else str(exc)
+        return None, False, f"This procedure cannot be drawn ({why}). Its tree is below, and procedure.json has it."
+    except WorkLimitError as exc:
+        return None, False, f"This procedure is not drawn here: {exc}. Its tree is below, and procedure.json has it."
 
 
 def _drawn_on(proc) -> dict:
@@ -236,15 +268,6 @@ def _other_structure(proc):
         if there in ("editable", "exact") and there != here:
             return version
     return None
-
-
-def _download_scale(proc) -> tuple[float, str] | None:
-    """The scale of the metric downloads, for the page to say; None for a procedure stored before a limit it now
-    breaks."""
-    try:
-        return download_scale(proc, parse_procedure(proc.data))
-    except (ValidationError, ProcedureError):
-        return None
 
 
 @login_required

@@ -14,7 +14,8 @@ from rest_framework.parsers import BaseParser
 
 from facaid.formats import interchange
 from facaid.grammar.procedure import ProcedureError
-from webapp.facades import pictures
+from webapp.errors import error_response
+from webapp.facades import pictures, throttling
 from webapp.facades.models import (
     Procedure,
     Visibility,
@@ -71,13 +72,19 @@ def stored_picture(request, proc: Procedure, kind: str) -> HttpResponse:
         resp = HttpResponse(status=304)
     else:
         try:
-            name, tag, png = pictures.stored(proc, kind)
-            if png is None:
+            kept, resp = pictures.stored(proc, kind, draw=False), None
+            if kept is not None:
+                name, tag, _ = kept
                 try:
                     resp = FileResponse(default_storage.open(name, "rb"), content_type="image/png")
                 except FileNotFoundError:  # an edit's refresh replaced it a moment ago: drawn as it is now
+                    resp = None
+            if resp is None:  # to be drawn: a heavy request, which takes a slot or is told to come back
+                with throttling.heavy_slot(request) as held:
+                    if not held:
+                        return error_response(request, 503, "the site is busy drawing pictures; try again in a "
+                                                             "moment", **{"Retry-After": "2", "X-Facaid-Busy": "slots"})
                     name, tag, png = pictures.stored(proc, kind, redraw=True)
-            if png is not None:
                 resp = HttpResponse(png, content_type="image/png")
         except ProcedureError as exc:  # stored before a limit it now breaks
             raise ValidationError({"data": f"this procedure cannot be drawn: {exc}"}) from None

@@ -39,6 +39,7 @@ from webapp.facades.throttling import HEAVY
 @extend_schema(methods=["POST"], request={"multipart/form-data": PhotoUploadSerializer},
                responses={201: PhotoSerializer}, summary="Upload a photo (JPEG, PNG or WebP)")
 @api_view(["GET", "POST"])
+@throttle_classes(HEAVY)
 @permission_classes([IsAuthenticated])
 @parser_classes([MultiPartParser, FormParser])
 def photos(request):

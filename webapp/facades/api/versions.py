@@ -97,9 +97,8 @@ def procedure_compare(request, code):
     proc = access.get_procedure_for_user(request.user, code)
     a, b, diff = versions.compare(proc, request.query_params.get("a"), request.query_params.get("b"))
     sides = {}
-    for key, version in (("a", a), ("b", b)):
-        tree = parse_procedure(version.data)
-        sides[key] = {**ProcedureVersionSummarySerializer(version).data, "width": tree.width, "height": tree.height}
+    for key, version, (width, height) in zip(("a", "b"), (a, b), diff["sizes"], strict=True):
+        sides[key] = {**ProcedureVersionSummarySerializer(version).data, "width": width, "height": height}
     seg = ProcedureSerializer(proc, context={"request": request}).get_segmentation(proc)
     return Response({**sides, "differing": diff["differing"] / diff["pixels"], "differing_pixels": diff["differing"],
                      "pixels": diff["pixels"], "segmentation": seg,
