@@ -259,7 +259,9 @@ class ProcedureEditSerializer(ProcedureWriteSerializer):
 
 
 class JobSerializer(serializers.ModelSerializer):
-    segmentation = serializers.UUIDField(source="segmentation.code", read_only=True)
+    segmentation = serializers.SerializerMethodField(
+        help_text="the segmentation it reconstructs; null once its photo is not shared with you (a fork's re-run "
+                  "whose photo its owner made private)")
     result = serializers.SerializerMethodField()
 
     class Meta:
@@ -267,6 +269,11 @@ class JobSerializer(serializers.ModelSerializer):
         fields = ["code", "kind", "status", "progress", "stage", "message", "attempts", "params", "segmentation",
                   "result", "result_version", "created", "started", "finished"]
         read_only_fields = fields
+
+    def get_segmentation(self, job: Job) -> str | None:
+        request = self.context.get("request")
+        user = request.user if request is not None else AnonymousUser()
+        return str(job.segmentation.code) if access.photo_visible_to(user, job.segmentation.photo) else None
 
     def get_result(self, job: Job) -> str | None:
         return str(job.result.code) if job.result_id else None

@@ -233,5 +233,5 @@ def procedure_rerun(request, code):
     form = RerunSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     job = services.rerun(request.user, proc, form.validated_data["nodes"], form.validated_data["k"])
-    return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
+    return Response(JobSerializer(job, context={"request": request}).data, status=status.HTTP_202_ACCEPTED)
 
