@@ -170,7 +170,7 @@ def test_a_fork_of_a_procedure_whose_photo_is_private_shows_it_once_shared(objec
     edited["root"]["sizes"][0][1] += 3
     r = as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"data": edited}, format="json").json()
     assert r["accuracy"] is None and "iou" not in r["metrics"]
-    assert r["metrics"]["unmeasured"] == "the photo it was made from is not shared with its owner"
+    assert r["metrics"]["unmeasured"] == "the photo it was made from is not shared with you"
     as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"visibility": "public"}, format="json")
     assert not shown(as_charlie, fork.code)
     assert "No photo to overlay" in as_charlie.get(f"/procedures/{fork.code}").content.decode()

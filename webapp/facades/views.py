@@ -17,7 +17,7 @@ from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
-from webapp.facades import access, example, jsonbody, services, sharing, throttling
+from webapp.facades import access, disclosure, example, jsonbody, services, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
     PhotoForm,
@@ -200,16 +200,21 @@ def procedure(request, code):
     proc = access.get_procedure_for_user(request.user, code)
     owner = request.user == proc.owner
     photo_visible = access.photo_visible_to(request.user, proc.photo)
+    hidden = disclosure.hidden(request.user, proc)  # nothing of the photo or its segmentation is shown
+    current = proc.current_version()
     return render(request, "facades/procedure.html", {
-        "proc": proc, "owner": owner, "photo_visible": photo_visible, "current": proc.current_version(),
+        "proc": proc, "owner": owner, "photo_visible": photo_visible, "current": current,
+        "title": disclosure.title(request.user, proc),
+        "figures": disclosure.figures(request.user, proc, proc.accuracy, proc.metrics, current and current.warning),
         "other_structure": _other_structure(proc),
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
-        "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
+        "lineage": access.visible_lineage(request.user, proc), "rerun_form": RerunForm(),
+        "data_json": disclosure.tree(proc.data) if hidden else proc.data,
         "visibility_form": ProcedureVisibilityForm(initial={"visibility": proc.visibility}),
         "may_share_photo": owner and sharing.may_share_photo(request.user, proc),
         "viewers_see": sharing.viewers_see(proc) if owner else "",
         "sharing_previews": sharing.previews(request.user, proc) if owner else {},
-        "photo_hidden": proc.photo is not None and not photo_visible,
+        "photo_hidden": hidden,
         "drawn_on": _drawn_on(proc) if photo_visible else None,
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
         "max_scale": MAX_SCALE, "scale": _download_scale(proc)})

@@ -22,7 +22,7 @@ from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
 from facaid.parameters import named_parameters, set_parameters
 from facaid.variation import vary
-from webapp.facades import access, downloads, rendering, services, versions
+from webapp.facades import access, disclosure, downloads, rendering, services, versions
 from webapp.facades.api.common import (
     page,
     stored_picture,
@@ -130,7 +130,8 @@ def procedure_variations(request, code):
     except (ProcedureError, ValueError) as exc:
         field = "ranges" if form.validated_data.get("ranges") else "data"
         raise ValidationError({field: f"no variations of this procedure: {exc}"}) from None
-    return Response({"variants": [v.to_dict() for v in variants]})
+    shown = disclosure.tree if disclosure.hidden(request.user, proc) else dict  # no accuracy of a private photo's
+    return Response({"variants": [shown(v.to_dict()) for v in variants]})
 
 
 def _leaves(tree) -> list | None:
@@ -169,7 +170,10 @@ def procedure_parameters(request, code):
     if form.validated_data["save"]:
         proc = access.get_rw_procedure_for_user(request.user, code)
         versions.save_parameters(proc, answer["data"], form.validated_data["values"])
-        answer.update(accuracy=proc.accuracy, metrics=proc.metrics, version=proc.current_version().version)
+        shown = disclosure.figures(request.user, proc, proc.accuracy, proc.metrics)
+        answer.update(accuracy=shown["accuracy"], metrics=shown["metrics"], version=proc.current_version().version)
+    if disclosure.hidden(request.user, proc):  # the tree's meta: no accuracy of a photo not shared with the viewer
+        answer["data"] = disclosure.tree(answer["data"])
     return Response(answer)
 
 
