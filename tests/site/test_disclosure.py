@@ -119,3 +119,44 @@ def test_copies_hide_it_too_and_show_it_once_the_photo_is_shared(shared, as_alic
         assert shown["segmentation"] == seg["code"] and shown["metrics"]["iou"]
         note = client.get(f"/api/v1/procedures/{copy['code']}/versions/").json()["results"][0]["note"]
         assert TITLE in note
+
+
+DOWNLOADS = ("procedure.cga", "facade.gltf", "facade.city.json", "procedure.json", "facade.ifc", "mesh.zip")
+
+
+def _download(client, proc, name: str) -> str:
+    r = client.get(f"/api/v1/procedures/{proc.code}/download/{name}")
+    assert r.status_code == 200, (name, r.content)
+    if name == "mesh.zip":
+        import zipfile
+
+        with zipfile.ZipFile(io.BytesIO(r.content)) as z:
+            return z.read("facade.obj").decode() + z.read("facade.mtl").decode()
+    return r.content.decode()
+
+
+def test_no_real_size_or_title_of_a_private_photo_in_the_downloads_and_the_page(shared, as_alice, as_bob, as_charlie):
+    """The photo's real width (12.3 m) is the photo's: to who may not see it, every file in metres and the page take
+    a storey 3 m tall (the procedure keeps no scale of its own), or the metres_per_pixel they ask for, and no file
+    names the facade by the photo's title. Alice, who owns both, still has the photo's scale."""
+    photo, seg, proc = shared
+    scale = f"{12.3 / photo['width']:.6g}"
+    for name in DOWNLOADS:
+        text = _download(as_alice, proc, name)
+        assert "12.3 m" in text or scale in text, name
+    assert TITLE in _download(as_alice, proc, "procedure.cga")
+    assert "the photo's real width, 12.3 m" in as_alice.get(f"/procedures/{proc.code}").content.decode().replace(
+        "&#x27;", "'")
+    secrets = [*_secrets(photo, seg, proc), "12.3", scale, "real width"]
+    for client in (as_bob, as_charlie):
+        for name in DOWNLOADS:
+            text = _download(client, proc, name)
+            assert not [s for s in secrets if s in text], name
+            assert "storey" in text or name == "procedure.json", name
+        assert "scale" not in json.loads(_download(client, proc, "procedure.json"))["meta"]
+        asked = client.get(f"/api/v1/procedures/{proc.code}/download/procedure.json?metres_per_pixel=0.02")
+        assert json.loads(asked.content)["meta"]["scale"] == {"metres_per_pixel": 0.02, "from": "given"}
+        page = client.get(f"/procedures/{proc.code}").content.decode()
+        assert "(left empty, a storey is 3 m tall: " in page and not [s for s in secrets if s in page]
+        r = client.get(f"/api/v1/procedures/{proc.code}/download/procedure.cga")
+        assert r["Cache-Control"] == "private"  # another viewer is given another file

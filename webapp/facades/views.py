@@ -217,7 +217,7 @@ def procedure(request, code):
         "photo_hidden": hidden,
         "drawn_on": _drawn_on(proc) if photo_visible else None,
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
-        "max_scale": MAX_SCALE, "scale": _download_scale(proc)})
+        "max_scale": MAX_SCALE, "scale": _download_scale(proc, request.user)})
 
 
 def _drawn_on(proc) -> dict:
@@ -241,11 +241,11 @@ def _other_structure(proc):
     return None
 
 
-def _download_scale(proc) -> tuple[float, str] | None:
-    """The scale of the metric downloads, for the page to say; None for a procedure stored before a limit it now
-    breaks."""
+def _download_scale(proc, viewer) -> tuple[float, str] | None:
+    """The scale of the metric downloads for ``viewer``, for the page to say; None for a procedure stored before a
+    limit it now breaks."""
     try:
-        return download_scale(proc, parse_procedure(proc.data))
+        return download_scale(proc, parse_procedure(proc.data), viewer)
     except (ValidationError, ProcedureError):
         return None
 

@@ -214,7 +214,9 @@ def procedure_download(request, code, name):
         if download.needs_photo and not access.photo_visible_to(request.user, proc.photo):
             raise ValidationError({"photo": f"{name} is drawn with the photo, and this procedure has no photo you "
                                             "may see"})
-        resp = HttpResponse(downloads.build(name, proc, request.query_params), content_type=download.content_type)
+        resp = HttpResponse(downloads.build(name, proc, request.query_params, request.user),
+                            content_type=download.content_type)
+        resp["Cache-Control"] = "private"  # what it holds depends on who asks (the photo's real size and title)
     resp["Content-Disposition"] = f'attachment; filename="{downloads.stem(proc)}-{name}"'
     return resp
 
