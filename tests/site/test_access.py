@@ -1,5 +1,6 @@
 """Permissions with three users: alice owns, bob is another user, charlie is anonymous."""
 
+import html
 import json
 
 import pytest
@@ -197,12 +198,21 @@ def test_sharing_a_procedure_asks_about_its_photo_and_says_what_viewers_see(obje
     photo, seg, proc, job = objects  # both alice's and private
     url = f"/api/v1/procedures/{proc.code}/"
     r = as_alice.patch(url, {"visibility": "public"}, format="json").json()
+    # the question and the answer say plainly that the procedure itself redraws the annotation (issue 66)
     assert (r["photo_shared"], r["viewers_see"]) == (False, (
         "Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the photo is "
-        "private."))
+        "private. The procedure itself redraws the annotation (an exact version reproduces it as drawn); the "
+        "photo's title, its real size and the accuracy against it are not shown."))
     assert as_charlie.get(url).json()["photo"] is None
-    page = as_alice.get(f"/procedures/{proc.code}").content.decode()
-    assert 'id="share-photo"' in page and "the photo is private" in page and r["viewers_see"] in page
+    page = html.unescape(as_alice.get(f"/procedures/{proc.code}").content.decode())
+    assert 'id="share-photo"' in page and r["viewers_see"] in page
+    assert "(the photo is private; either way the procedure itself redraws the annotation)" in page
+    previews = json.loads(page.split('id="sharing-previews"', 1)[1].split(">", 1)[1].split("</script>", 1)[0])
+    assert previews["public"] == previews["unlisted"].replace("Anyone with its link", "Anyone") == r["viewers_see"]
+    r = as_alice.post(f"/procedures/{proc.code}/visibility", {"visibility": "unlisted"}, follow=True)
+    assert "The procedure is now unlisted. Anyone with its link sees the procedure, its pictures and 3D models, but " \
+           "not the photo or the overlay: the photo is private. The procedure itself redraws the annotation" in (
+               html.unescape(r.content.decode()))
     # unlisted with its photo: the photo becomes unlisted too
     r = as_alice.patch(url, {"visibility": "unlisted", "share_photo": True}, format="json").json()
     photo.refresh_from_db()
@@ -241,7 +251,8 @@ def test_only_the_photos_owner_shares_it_and_a_refusal_changes_nothing(objects, 
     photo.refresh_from_db()
     assert (fork.visibility, fork.title, photo.visibility) == ("private", "Fork of p", "private")
     r = as_bob.patch(url, {"visibility": "public"}, format="json").json()
-    assert r["viewers_see"].endswith("the photo is private (it is alice's: only they can share it).")
+    assert "the photo is private (it is alice's: only they can share it). The procedure itself redraws the " \
+           "annotation" in r["viewers_see"]
     assert 'id="share-photo"' not in as_bob.get(f"/procedures/{fork.code}").content.decode()
     r = as_bob.post(f"/procedures/{fork.code}/visibility", {"visibility": "public", "share_photo": "on"},
                     follow=True)
