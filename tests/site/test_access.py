@@ -1,10 +1,11 @@
 """Permissions with three users: alice owns, bob is another user, charlie is anonymous."""
 
+import html
 import json
 
 import pytest
 
-from webapp.facades.models import Job, Procedure
+from webapp.facades.models import Job, Photo, Procedure
 
 pytestmark = pytest.mark.django_db
 
@@ -170,7 +171,7 @@ def test_a_fork_of_a_procedure_whose_photo_is_private_shows_it_once_shared(objec
     edited["root"]["sizes"][0][1] += 3
     r = as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"data": edited}, format="json").json()
     assert r["accuracy"] is None and "iou" not in r["metrics"]
-    assert r["metrics"]["unmeasured"] == "the photo it was made from is not shared with its owner"
+    assert r["metrics"]["unmeasured"] == "the photo it was made from is not shared with you"
     as_bob.patch(f"/api/v1/procedures/{fork.code}/", {"visibility": "public"}, format="json")
     assert not shown(as_charlie, fork.code)
     assert "No photo to overlay" in as_charlie.get(f"/procedures/{fork.code}").content.decode()
@@ -197,12 +198,21 @@ def test_sharing_a_procedure_asks_about_its_photo_and_says_what_viewers_see(obje
     photo, seg, proc, job = objects  # both alice's and private
     url = f"/api/v1/procedures/{proc.code}/"
     r = as_alice.patch(url, {"visibility": "public"}, format="json").json()
+    # the question and the answer say plainly that the procedure itself redraws the annotation (issue 66)
     assert (r["photo_shared"], r["viewers_see"]) == (False, (
         "Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the photo is "
-        "private."))
+        "private. The procedure itself redraws the annotation (an exact version reproduces it as drawn); the "
+        "photo's title, its real size and the accuracy against it are not shown."))
     assert as_charlie.get(url).json()["photo"] is None
-    page = as_alice.get(f"/procedures/{proc.code}").content.decode()
-    assert 'id="share-photo"' in page and "the photo is private" in page and r["viewers_see"] in page
+    page = html.unescape(as_alice.get(f"/procedures/{proc.code}").content.decode())
+    assert 'id="share-photo"' in page and r["viewers_see"] in page
+    assert "(the photo is private; either way the procedure itself redraws the annotation)" in page
+    previews = json.loads(page.split('id="sharing-previews"', 1)[1].split(">", 1)[1].split("</script>", 1)[0])
+    assert previews["public"] == previews["unlisted"].replace("Anyone with its link", "Anyone") == r["viewers_see"]
+    r = as_alice.post(f"/procedures/{proc.code}/visibility", {"visibility": "unlisted"}, follow=True)
+    assert "The procedure is now unlisted. Anyone with its link sees the procedure, its pictures and 3D models, but " \
+           "not the photo or the overlay: the photo is private. The procedure itself redraws the annotation" in (
+               html.unescape(r.content.decode()))
     # unlisted with its photo: the photo becomes unlisted too
     r = as_alice.patch(url, {"visibility": "unlisted", "share_photo": True}, format="json").json()
     photo.refresh_from_db()
@@ -241,7 +251,8 @@ def test_only_the_photos_owner_shares_it_and_a_refusal_changes_nothing(objects, 
     photo.refresh_from_db()
     assert (fork.visibility, fork.title, photo.visibility) == ("private", "Fork of p", "private")
     r = as_bob.patch(url, {"visibility": "public"}, format="json").json()
-    assert r["viewers_see"].endswith("the photo is private (it is alice's: only they can share it).")
+    assert "the photo is private (it is alice's: only they can share it). The procedure itself redraws the " \
+           "annotation" in r["viewers_see"]
     assert 'id="share-photo"' not in as_bob.get(f"/procedures/{fork.code}").content.decode()
     r = as_bob.post(f"/procedures/{fork.code}/visibility", {"visibility": "public", "share_photo": "on"},
                     follow=True)
@@ -251,3 +262,57 @@ def test_only_the_photos_owner_shares_it_and_a_refusal_changes_nothing(objects, 
     assert r.status_code == 400 and r.json() == {"share_photo": "this procedure has no photo to share"}
     r = as_alice.patch(f"/api/v1/procedures/{bare.code}/", {"visibility": "public"}, format="json").json()
     assert r["viewers_see"] == "Anyone sees the procedure, its pictures and 3D models; it has no photo."
+
+
+def test_a_forks_rerun_stores_nothing_once_its_photo_is_made_private(objects, as_alice, as_bob, monkeypatch):
+    """Issue 66, 7: bob re-runs his fork while alice's photo is shared, and alice makes it private while the job runs
+    (at its first progress beat, through the API). The worker's task, run in this process as the worker runs it,
+    reads the photo again as it stores: it fails the job and stores nothing, and the job's JSON no longer names the
+    segmentation."""
+    from webapp.facades import jobs, tasks
+
+    monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")  # the progress beats are enough here
+    photo, seg, proc, job = objects
+    for obj in (photo, proc):
+        obj.visibility = "public"
+        obj.save()
+    fork = fork_as_bob(as_bob, proc)
+    photo_url = f"/api/v1/photos/{photo.code}/"
+
+    def rerun() -> Job:
+        r = as_bob.post(f"/api/v1/procedures/{fork.code}/rerun", {"nodes": 2, "k": 1}, format="json")
+        assert r.status_code == 202 and r.json()["segmentation"] == str(seg.code)
+        return Job.objects.get(code=r.json()["code"])
+
+    # shared throughout: the re-run is the fork's next version (the control)
+    done = rerun()
+    tasks.run_job.apply(args=[done.id])
+    done.refresh_from_db()
+    assert (done.status, done.result_id, done.result_version) == ("done", fork.id, 2), done.message
+
+    racing, beat = rerun(), jobs.beat
+
+    def made_private_while_running(job_id, progress=None, stage=None):
+        if progress is not None and Photo.objects.get(id=photo.id).visibility == "public":
+            assert as_alice.patch(photo_url, {"visibility": "private"}, format="json").status_code == 200
+        beat(job_id, progress, stage)
+
+    monkeypatch.setattr(jobs, "beat", made_private_while_running)
+    tasks.run_job.apply(args=[racing.id])
+    racing.refresh_from_db()
+    assert racing.status == "failed" and racing.message == tasks.MADE_PRIVATE
+    assert racing.result_id is None and fork.versions.count() == 2 and Procedure.objects.count() == 2
+    body = as_bob.get(f"/api/v1/jobs/{racing.code}/").json()
+    assert body["status"] == "failed" and body["segmentation"] is None and str(seg.code) not in json.dumps(body)
+    assert all(j["segmentation"] is None for j in as_bob.get("/api/v1/jobs/").json()["results"])
+    assert str(seg.code) not in as_bob.get(f"/jobs/{racing.code}").content.decode()
+
+    # shared again for a re-run that waits in the queue, made private before a worker takes it: not even computed
+    monkeypatch.setattr(jobs, "beat", beat)
+    as_alice.patch(photo_url, {"visibility": "public"}, format="json")
+    queued = rerun()
+    as_alice.patch(photo_url, {"visibility": "private"}, format="json")
+    tasks.run_job.apply(args=[queued.id])
+    queued.refresh_from_db()
+    assert (queued.status, queued.message, queued.progress) == ("failed", tasks.MADE_PRIVATE, 0.0)
+    assert fork.versions.count() == 2

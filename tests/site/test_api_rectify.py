@@ -118,11 +118,12 @@ def test_downloads_take_the_photos_scale_and_say_so(procedure_of_photo, as_alice
     # asked for another scale, the download takes it
     width, header = obj_extent(as_alice.get(base + "mesh.zip?metres_per_pixel=0.01").content)
     assert width == pytest.approx(0.01 * width_px, abs=0.01) and "(given)" in header
-    # the procedure's page says which scale its downloads take
+    # the procedure's page says which scale its downloads take: the photo's to who may see the photo (issue 66)
     proc.visibility = "public"
     proc.save()
-    page = as_charlie.get(f"/procedures/{proc.code}").content.decode()
-    assert "the photo&#x27;s real width, 24 m" in page or "the photo's real width, 24 m" in page
+    for client, sees in ((as_alice, True), (as_charlie, False)):
+        page = client.get(f"/procedures/{proc.code}").content.decode().replace("&#x27;", "'")
+        assert ("the photo's real width, 24 m" in page) == sees and ("a storey is 3 m tall" in page) != sees
 
 
 def test_the_photo_page_sets_the_real_size(facade_photo, as_alice, as_bob):

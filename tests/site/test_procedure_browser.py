@@ -384,10 +384,12 @@ def test_sharing_asks_whether_to_share_the_photo_and_the_overlay_follows(live_se
     assert page.text_content("#viewers-see") == "Only you see this procedure."
     assert not page.is_visible("#share-photo")  # nothing to ask while it stays private
     page.select_option("#visibility-form select", "public")
-    assert page.is_visible("#share-photo") and "the photo is private" in page.text_content("#share-photo")
+    assert page.is_visible("#share-photo") and "the photo is private; either way the procedure itself redraws" in (
+        page.text_content("#share-photo"))
     assert page.text_content("#viewers-will-see") == (
         "Once saved: Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the "
-        "photo is private.")
+        "photo is private. The procedure itself redraws the annotation (an exact version reproduces it as drawn); "
+        "the photo's title, its real size and the accuracy against it are not shown.")
     page.check("#share-photo input")
     assert page.text_content("#viewers-will-see") == (
         "Once saved: Anyone sees the procedure with its photo and the overlay.")
@@ -397,7 +399,7 @@ def test_sharing_asks_whether_to_share_the_photo_and_the_overlay_follows(live_se
     screenshot(form, "share-photo.png", tmp_path)
     page.click("#visibility-form button")  # public, the photo left private: the page says what viewers see
     page.wait_for_selector(".msg")
-    assert "not the photo or the overlay: the photo is private." in page.text_content("#viewers-see")
+    assert "the photo is private. The procedure itself redraws the annotation" in page.text_content("#viewers-see")
     anonymous = browser.new_page()
     anonymous.goto(f"{live_server.url}/procedures/{proc.code}")
     assert anonymous.locator("#overlay").count() == 0 and "No photo to overlay" in anonymous.content()

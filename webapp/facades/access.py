@@ -109,7 +109,7 @@ def segmentation_visible_to(user, proc: Procedure) -> bool:
 
 
 def get_procedure_for_user(user, code) -> Procedure:
-    return _get(_readable(Procedure.objects.select_related("owner", "parent"), user), code)
+    return _get(_readable(Procedure.objects.select_related("owner", "parent", "photo"), user), code)
 
 
 def get_procedure_picture_for_user(user, code) -> Procedure:
@@ -130,8 +130,9 @@ def get_job_for_user(user, code) -> Job:
 
 
 def listed(procedures: QuerySet) -> QuerySet:
-    """Procedures as lists show them: with their owner and parent, without the JSON columns."""
-    return procedures.select_related("owner", "parent").defer(*LISTED_WITHOUT)
+    """Procedures as lists show them: with their owner, parent and photo (whether the viewer may see it decides what
+    they are shown, `disclosure`), without the JSON columns."""
+    return procedures.select_related("owner", "parent", "photo").defer(*LISTED_WITHOUT)
 
 
 def public_procedures() -> QuerySet:

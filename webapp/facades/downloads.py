@@ -22,18 +22,20 @@ from facaid.formats.mesh import MeshTooLarge, procedure_mesh
 from facaid.formats.render import segmentation_svg
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
-from webapp.facades import access, rendering
+from webapp.facades import access, disclosure, rendering
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
 
 Params = Mapping[str, str]
+# (the procedure, its tree, the request's parameters, the viewer) -> the file: what is in it may depend on who asks
+Builder = Callable[[Procedure, Tree, Params, object], bytes | str]
 
 
 @dataclass(frozen=True)
 class Download:
     help: str  # what it is, for the procedure page's buttons
     content_type: str
-    build: Callable[[Procedure, Tree, Params], bytes | str] | None  # None: a picture kept in storage
+    build: Builder | None  # None: a picture kept in storage
     needs_photo: bool = False  # offered only where the procedure's photo is visible to the user
     scaled: bool = False  # in metres: takes ``metres_per_pixel``, else the scale of `download_scale`
 
@@ -46,14 +48,15 @@ def drawn_on_original(proc: Procedure) -> bool:
     return bool(photo.rectified) and (round(size[0]), round(size[1])) == (photo.width, photo.height)
 
 
-def photo_scale(proc: Procedure) -> tuple[float, str] | None:
+def photo_scale(proc: Procedure, viewer) -> tuple[float, str] | None:
     """The scale the procedure's photo gives (its real width or height over the pixels of the image the procedure
-    was drawn on) and a line saying so; None without a photo or a real size, or where its owner may not see the
-    photo (a fork of one not shared)."""
+    was drawn on) and a line saying so; None without a photo or a real size, or where ``viewer`` may not see the
+    photo: its real size is the photo's, not the procedure's, which keeps no scale of its own (a public procedure
+    of a private photo, a fork of one not shared with its owner)."""
     photo = proc.photo
     if photo is None or (photo.real_width_m is None and photo.real_height_m is None):
         return None
-    if not access.photo_visible_to(proc.owner, photo):  # a fork of a photo not shared with its owner
+    if not access.photo_visible_to(viewer, photo):
         return None
     scale = photo.metres_per_pixel((photo.width, photo.height) if drawn_on_original(proc) else None)
     if scale is None:
@@ -63,21 +66,21 @@ def photo_scale(proc: Procedure) -> tuple[float, str] | None:
     return scale, what
 
 
-def download_scale(proc: Procedure, tree: Tree) -> tuple[float, str]:
-    """The scale the metric downloads take without ``metres_per_pixel`` and where it comes from: the photo's real
-    size, else a storey 3 m tall."""
-    scale, source = _scale(proc, tree, {})
+def download_scale(proc: Procedure, tree: Tree, viewer) -> tuple[float, str]:
+    """The scale the metric downloads take for ``viewer`` without ``metres_per_pixel`` and where it comes from: the
+    photo's real size where they may see the photo, else a storey 3 m tall."""
+    scale, source = _scale(proc, tree, {}, viewer)
     if scale is None:
         return default_scale(tree), f"a storey is {STOREY_M:g} m tall"
     return scale, source
 
 
-def _scale(proc: Procedure, tree: Tree, params: Params) -> tuple[float | None, str]:
-    """The scale of a download and where it came from: ``metres_per_pixel`` if asked, else the photo's real size,
-    else None (the writers' default: a storey 3 m tall, which they say)."""
+def _scale(proc: Procedure, tree: Tree, params: Params, viewer) -> tuple[float | None, str]:
+    """The scale of a download and where it came from: ``metres_per_pixel`` if asked, else the photo's real size
+    (`photo_scale`), else None (the writers' default: a storey 3 m tall, which they say)."""
     raw = params.get("metres_per_pixel")
     if raw is None:
-        given = photo_scale(proc)
+        given = photo_scale(proc, viewer)
         if given is not None:
             try:
                 return checked_scale(tree, given[0]), given[1]
@@ -95,35 +98,41 @@ def stem(proc: Procedure) -> str:
     return f"facaid-{str(proc.code)[:8]}"
 
 
-def _cga(proc: Procedure, tree: Tree, params: Params) -> str:
-    scale, source = _scale(proc, tree, params)
-    return procedure_cga(tree, scale, name=proc.title or stem(proc), scale_from=source)
+def _name(proc: Procedure, viewer) -> str:
+    """The name a file gives the facade: the procedure's title as ``viewer`` is shown it (`disclosure.title`)."""
+    return disclosure.title(viewer, proc) or stem(proc)
 
 
-def _metric(write: Callable[[Procedure, Tree, float | None, str], bytes | str]
-            ) -> Callable[[Procedure, Tree, Params], bytes | str]:
-    """A builder of a download in metres: ``write(proc, tree, scale, scale_from)`` at the request's scale; a
+def _cga(proc: Procedure, tree: Tree, params: Params, viewer) -> str:
+    scale, source = _scale(proc, tree, params, viewer)
+    return procedure_cga(tree, scale, name=_name(proc, viewer), scale_from=source)
+
+
+def _metric(write: Callable[[Procedure, Tree, float | None, str, str], bytes | str]) -> Builder:
+    """A builder of a download in metres: ``write(proc, tree, scale, scale_from, name)`` at the request's scale; a
     procedure too large for it is a bad request."""
-    def build(proc: Procedure, tree: Tree, params: Params) -> bytes | str:
-        scale, source = _scale(proc, tree, params)
+    def build(proc: Procedure, tree: Tree, params: Params, viewer) -> bytes | str:
+        scale, source = _scale(proc, tree, params, viewer)
         try:
-            return write(proc, tree, scale, source)
+            return write(proc, tree, scale, source, _name(proc, viewer))
         except MeshTooLarge as exc:
             raise ValidationError({"name": str(exc)}) from None
     return build
 
 
-def _procedure_json(proc: Procedure, tree: Tree, params: Params) -> str:
+def _procedure_json(proc: Procedure, tree: Tree, params: Params, viewer) -> str:
     """The tree in pixels; where a real scale is known (the photo's real size, or ``metres_per_pixel``), its meta
     names it, ``"scale": {"metres_per_pixel": .., "from": ..}``, so that a tool reading it can measure in metres."""
-    scale, source = _scale(proc, tree, params)
+    scale, source = _scale(proc, tree, params, viewer)
     tree.meta = {k: v for k, v in tree.meta.items() if k != "scale"}  # never a scale of another download
+    if disclosure.hidden(viewer, proc):  # nor the accuracy against a segmentation the viewer may not see
+        tree.meta = disclosure.tree({"meta": tree.meta})["meta"]
     if scale is not None:
         tree.meta["scale"] = {"metres_per_pixel": scale, "from": source or "given"}
     return tree.to_json(indent=2)
 
 
-def _mesh_zip(proc: Procedure, tree: Tree, scale: float | None, source: str) -> bytes:
+def _mesh_zip(proc: Procedure, tree: Tree, scale: float | None, source: str, name: str) -> bytes:
     obj, mtl = procedure_mesh(tree, scale, mtl_name="facade.mtl", scale_from=source)
     out = io.BytesIO()
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
@@ -132,26 +141,25 @@ def _mesh_zip(proc: Procedure, tree: Tree, scale: float | None, source: str) -> 
     return out.getvalue()
 
 
-def _gltf(binary: bool, photo: bool = False) -> Callable[[Procedure, Tree, float | None, str], bytes]:
-    def write(proc: Procedure, tree: Tree, scale: float | None, source: str) -> bytes:
+def _gltf(binary: bool, photo: bool = False) -> Callable[[Procedure, Tree, float | None, str, str], bytes]:
+    def write(proc: Procedure, tree: Tree, scale: float | None, source: str, name: str) -> bytes:
         if not photo:
-            return procedure_gltf(tree, scale, binary=binary, scale_from=source, name=proc.title or stem(proc))
+            return procedure_gltf(tree, scale, binary=binary, scale_from=source, name=name)
         drawn = proc.photo.image if drawn_on_original(proc) else proc.photo.working_image()
         with drawn.open("rb") as f:  # read as the texture needs it (`gltf._add_photo`), not at full size first
-            return procedure_gltf(tree, scale, binary=binary, photo=Image.open(f), scale_from=source,
-                                  name=proc.title or stem(proc))
+            return procedure_gltf(tree, scale, binary=binary, photo=Image.open(f), scale_from=source, name=name)
     return write
 
 
-def _ifc(proc: Procedure, tree: Tree, scale: float | None, source: str) -> str:
-    return procedure_ifc(tree, scale, scale_from=source, name=proc.title or stem(proc))
+def _ifc(proc: Procedure, tree: Tree, scale: float | None, source: str, name: str) -> str:
+    return procedure_ifc(tree, scale, scale_from=source, name=name)
 
 
-def _cityjson(proc: Procedure, tree: Tree, scale: float | None, source: str) -> str:
-    return cityjson_text(procedure_cityjson(tree, scale, scale_from=source, name=proc.title or stem(proc)))
+def _cityjson(proc: Procedure, tree: Tree, scale: float | None, source: str, name: str) -> str:
+    return cityjson_text(procedure_cityjson(tree, scale, scale_from=source, name=name))
 
 
-def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
+def _overlay(proc: Procedure, tree: Tree, params: Params, viewer) -> bytes:
     try:
         alpha = float(params.get("alpha", 0.5))
     except ValueError:
@@ -162,10 +170,10 @@ def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
         return rendering.overlay_png(to_segmentation(tree), Image.open(f), alpha)
 
 
-def _annotations(fmt: str) -> Callable[[Procedure, Tree, Params], bytes]:
+def _annotations(fmt: str) -> Builder:
     """The elements it draws as another tool's annotations, one box each (`annotation.written_as`), of the
     label map downloaded beside them."""
-    return lambda proc, tree, params: interchange.write(written_as(to_segmentation(tree), fmt), fmt,
+    return lambda proc, tree, params, viewer: interchange.write(written_as(to_segmentation(tree), fmt), fmt,
                                                         image=f"{stem(proc)}-labels.png")
 
 
@@ -174,7 +182,7 @@ DOWNLOADS: dict[str, Download] = {
                                "meta names the metres per pixel where the photo's real size (or metres_per_pixel) "
                                "gives them", "application/json", _procedure_json),
     "segmentation.json": Download("the labelled rectangles it draws", "application/json",
-                                  lambda proc, tree, params: to_segmentation(tree).to_json()),
+                                  lambda proc, tree, params, viewer: to_segmentation(tree).to_json()),
     "segmentation.coco.json": Download("its elements as COCO object detection annotations, one box each (pieces of "
                                        "one element merged, the wall under them)", "application/json",
                                        _annotations("coco")),
@@ -184,7 +192,7 @@ DOWNLOADS: dict[str, Download] = {
                                       _annotations("cvat")),
     "labels.png": Download("the label map as a picture", "image/png", None),
     "labels.svg": Download("the label map as vector rectangles, one group per class", "image/svg+xml",
-                           lambda proc, tree, params: segmentation_svg(to_segmentation(tree))),
+                           lambda proc, tree, params, viewer: segmentation_svg(to_segmentation(tree))),
     "procedure.cga": Download("CityEngine CGA rules: apply Facade to a facade shape", "text/plain; charset=utf-8",
                               _cga, scaled=True),
     "mesh.zip": Download("a 3D relief mesh (OBJ and MTL) for Blender and other 3D tools", "application/zip",
@@ -204,6 +212,7 @@ DOWNLOADS: dict[str, Download] = {
 }
 
 
-def build(name: str, proc: Procedure, params: Params) -> bytes | str:
-    """The download ``name`` of a procedure (one with a builder); a `ValidationError` names a bad parameter."""
-    return DOWNLOADS[name].build(proc, parse_procedure(proc.data), params)
+def build(name: str, proc: Procedure, params: Params, viewer) -> bytes | str:
+    """The download ``name`` of a procedure (one with a builder) as ``viewer`` may have it (no real size or title of
+    a photo they may not see); a `ValidationError` names a bad parameter."""
+    return DOWNLOADS[name].build(proc, parse_procedure(proc.data), params, viewer)

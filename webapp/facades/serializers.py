@@ -16,7 +16,7 @@ from facaid.formats import interchange
 from facaid.grammar.procedure import MAX_NODES
 from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
-from webapp.facades import access, jobs, sharing
+from webapp.facades import access, disclosure, jobs, sharing
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, ProcedureVersion, Segmentation, Visibility
 from webapp.facades.parsing import parse_procedure
 
@@ -159,6 +159,12 @@ class SegmentationSummarySerializer(SegmentationSerializer):
         read_only_fields = fields
 
 
+def _viewer(serializer: serializers.Serializer):
+    """The user the answer is for: the request's, else anonymous (who is shown the least)."""
+    request = serializer.context.get("request")
+    return request.user if request is not None else AnonymousUser()
+
+
 class ProcedureSerializer(serializers.ModelSerializer):
     owner = serializers.CharField(source="owner.username", read_only=True)
     parent = serializers.SerializerMethodField()
@@ -184,8 +190,21 @@ class ProcedureSerializer(serializers.ModelSerializer):
     # links to other objects are shown only to those who may see them (a fork of a procedure made private later
     # does not reveal its parent; a public procedure does not reveal its private photo)
     def _user(self):
-        request = self.context.get("request")
-        return request.user if request is not None else AnonymousUser()
+        return _viewer(self)
+
+    def to_representation(self, proc: Procedure) -> dict:
+        """As the viewer is shown it: to one who may not see the photo, nothing of it or of its segmentation (no
+        figure, no title taken from the photo's, no accuracy in the tree's meta: `disclosure`)."""
+        out = super().to_representation(proc)
+        user = self._user()
+        if disclosure.hidden(user, proc):
+            out["title"] = disclosure.title(user, proc)
+            out["accuracy"] = None
+            if "metrics" in out:
+                out["metrics"] = disclosure.metrics(proc.metrics)
+            if "data" in out:
+                out["data"] = disclosure.tree(out["data"])
+        return out
 
     def get_parent(self, proc: Procedure) -> str | None:
         visible = proc.parent_id and access.parent_named_to(self._user(), proc, proc.parent)
@@ -221,6 +240,18 @@ class ProcedureVersionSummarySerializer(serializers.ModelSerializer):
         fields = ["version", "kind", "note", "based_on", "warning", "accuracy", "metrics", "digest", "created",
                   "picture", "url"]
         read_only_fields = fields
+
+    def to_representation(self, version: ProcedureVersion) -> dict:
+        """As the viewer is shown it (the version's procedure set): to one who may not see the photo, no figure of
+        its segmentation and no note naming the photo (`disclosure`)."""
+        out = super().to_representation(version)
+        user, proc = _viewer(self), version.procedure
+        if disclosure.hidden(user, proc):
+            out.update(accuracy=None, metrics=disclosure.metrics(version.metrics), warning="",
+                       note=disclosure.note(user, proc, version.note))
+            if "data" in out:
+                out["data"] = disclosure.tree(out["data"])
+        return out
 
     def _base(self, version: ProcedureVersion) -> str:
         return f"/api/v1/procedures/{version.procedure.code}/versions/{version.version}/"
@@ -262,7 +293,9 @@ class ProcedureEditSerializer(ProcedureWriteSerializer):
 
 
 class JobSerializer(serializers.ModelSerializer):
-    segmentation = serializers.UUIDField(source="segmentation.code", read_only=True)
+    segmentation = serializers.SerializerMethodField(
+        help_text="the segmentation it reconstructs; null once its photo is not shared with you (a fork's re-run "
+                  "whose photo its owner made private)")
     result = serializers.SerializerMethodField()
     state_since = serializers.SerializerMethodField(help_text="when the job entered its status")
     state_seconds = serializers.SerializerMethodField(help_text="how long it has been in its status, in seconds")
@@ -275,6 +308,9 @@ class JobSerializer(serializers.ModelSerializer):
                   "result", "result_version", "created", "started", "finished", "state_since", "state_seconds",
                   "note"]
         read_only_fields = fields
+
+    def get_segmentation(self, job: Job) -> str | None:
+        return str(job.segmentation.code) if access.photo_visible_to(_viewer(self), job.segmentation.photo) else None
 
     def get_result(self, job: Job) -> str | None:
         return str(job.result.code) if job.result_id else None

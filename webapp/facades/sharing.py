@@ -2,7 +2,7 @@
 a viewer sees the photo and the overlay only where the photo is shared with them (`access.photo_visible_to`,
 checked every time, so a fork shows the overlay once its photo is shared, and never while it is private). When a
 procedure is shared, its owner may share the photo with it, where the photo is theirs, and is told what viewers
-will see."""
+will see: without the photo, still the procedure, which itself redraws the annotation."""
 
 from __future__ import annotations
 
@@ -15,6 +15,9 @@ from webapp.facades import access
 from webapp.facades.models import Procedure, Visibility
 
 REACH = {Visibility.PRIVATE: 0, Visibility.UNLISTED: 1, Visibility.PUBLIC: 2}
+# what a procedure shared without its photo still tells of it (`disclosure`): the sharing question says so plainly
+REDRAWS = ("The procedure itself redraws the annotation (an exact version reproduces it as drawn); the photo's "
+           "title, its real size and the accuracy against it are not shown.")
 
 
 def _shared_as(photo_visibility: str, visibility: str) -> str:
@@ -52,7 +55,7 @@ def viewers_see(proc: Procedure) -> str:
         return f"{who} sees the procedure with its photo and the overlay{listed}."
     whose = "" if photo.owner_id == proc.owner_id else f" (it is {photo.owner.username}'s: only they can share it)"
     return (f"{who} sees the procedure, its pictures and 3D models, but not the photo or the overlay: the photo is "
-            f"private{whose}.")
+            f"private{whose}. {REDRAWS}")
 
 
 def previews(user, proc: Procedure) -> dict[str, str]:

@@ -14,8 +14,8 @@ from django.utils import timezone
 
 from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
-from webapp.facades import jobs, versions
-from webapp.facades.models import Change, Job, Procedure, ProcedureVersion, Visibility
+from webapp.facades import access, jobs, versions
+from webapp.facades.models import Change, Job, Photo, Procedure, ProcedureVersion, Visibility
 from worker import compute
 from worker.app import RUN_JOB, app
 
@@ -60,6 +60,9 @@ def run_job(self, job_id: int) -> None:
     heart.start()
     try:
         job = Job.objects.select_related("segmentation__photo").get(id=job_id)
+        if not access.photo_visible_to(job.owner, job.segmentation.photo):  # made private while it was queued
+            jobs.fail(job_id, MADE_PRIVATE)
+            return
         result = _compute(job)
         _store(job, result)
     except TRANSIENT as exc:
@@ -79,6 +82,9 @@ def run_job(self, job_id: int) -> None:
     finally:
         heart.stop.set()
 
+
+# a fork's re-run (its owner is not the photo's) whose photo its owner made private before the result was stored
+MADE_PRIVATE = "the photo was made private while this job ran, so nothing of it was stored"
 
 # what a job's result says of its tree, kept in the procedure's metrics beside its accuracy
 JOB_METRICS = ("accuracy_decoded", "iou", "timings", "source", "retried", "shortcut", "structure")
@@ -107,14 +113,26 @@ def _compute(job: Job) -> dict:
                                structure=params.get("structure", "editable"))
 
 
+def _still_shared(job: Job) -> bool:
+    """May the job's owner still see its photo? Read again, its row locked, inside the transaction that stores the
+    result: a photo made private while the job ran (by its owner, of a fork's re-run) either waits for the store to
+    commit, then hides what was stored with the rest, or is seen private here, and nothing is stored."""
+    photo = Photo.objects.select_for_update().filter(id=job.segmentation.photo_id).first()
+    return photo is not None and access.photo_visible_to(job.owner, photo)
+
+
 def _store(job: Job, result: dict) -> None:
     """The result as a new procedure, or, for a re-run of the owner's procedure against its own segmentation, as
-    that procedure's next version (`versions.add_rerun`)."""
+    that procedure's next version (`versions.add_rerun`); nothing, and the job failed, where its owner may no longer
+    see the photo."""
     photo, params = job.segmentation.photo, job.params or {}
     metrics = {k: result[k] for k in JOB_METRICS if k in result}
     with transaction.atomic():
         if Job.objects.select_for_update().filter(id=job.id, status=Job.Status.RUNNING).count() != 1:
             return  # recovered and given to another worker meanwhile
+        if not _still_shared(job):
+            jobs.fail(job.id, MADE_PRIVATE)
+            return
         if params.get("as_version") and params.get("prefix_version"):
             proc = Procedure.objects.select_for_update().filter(id=params["parent_id"]).first()
             if proc is None:

@@ -18,7 +18,7 @@ from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
 from facaid.grammar.budget import WorkLimitError
-from webapp.facades import access, example, jobs, jsonbody, services, sharing, throttling
+from webapp.facades import access, disclosure, example, jobs, jsonbody, services, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
     PhotoForm,
@@ -214,20 +214,25 @@ def procedure(request, code):
     demo = access.is_demo(proc)
     owner = request.user == proc.owner and not demo  # the demo account sees the demo as anyone does: fork to edit
     photo_visible = access.photo_visible_to(request.user, proc.photo)
+    hidden = disclosure.hidden(request.user, proc)  # nothing of the photo or its segmentation is shown
+    current = proc.current_version()
     with throttling.heavy_slot(request) as held:  # a page that draws is a heavy request: a slot and the rate
         heavy = held and throttling.allow_heavy(request)[0]
-        scale, drawable, note = _drawing(proc) if heavy else (None, True, BUSY_NOTE)
+        scale, drawable, note = _drawing(proc, request.user) if heavy else (None, True, BUSY_NOTE)
     return render(request, "facades/procedure.html", {
         "drawable": drawable, "picture_note": note, "scale_pending": not heavy,
-        "proc": proc, "owner": owner, "demo": demo, "photo_visible": photo_visible, "current": proc.current_version(),
+        "proc": proc, "owner": owner, "demo": demo, "photo_visible": photo_visible, "current": current,
+        "title": disclosure.title(request.user, proc),
+        "figures": disclosure.figures(request.user, proc, proc.accuracy, proc.metrics, current and current.warning),
         "other_structure": _other_structure(proc),
         "can_rerun": owner and access.segmentation_visible_to(request.user, proc),
-        "lineage": access.visible_lineage(request.user, proc), "data_json": proc.data, "rerun_form": RerunForm(),
+        "lineage": access.visible_lineage(request.user, proc), "rerun_form": RerunForm(),
+        "data_json": disclosure.tree(proc.data) if hidden else proc.data,
         "visibility_form": ProcedureVisibilityForm(initial={"visibility": proc.visibility}),
         "may_share_photo": owner and sharing.may_share_photo(request.user, proc),
         "viewers_see": sharing.viewers_see(proc) if owner else "",
         "sharing_previews": sharing.previews(request.user, proc) if owner else {},
-        "photo_hidden": proc.photo is not None and not photo_visible,
+        "photo_hidden": hidden,
         "drawn_on": _drawn_on(proc) if photo_visible else None,
         "downloads": [(name, d.help, d.scaled) for name, d in DOWNLOADS.items() if photo_visible or not d.needs_photo],
         "max_scale": MAX_SCALE, "scale": scale})
@@ -236,12 +241,12 @@ def procedure(request, code):
 BUSY_NOTE = "The site is busy: this page is shown without working out the downloads' scale; reload in a moment."
 
 
-def _drawing(proc) -> tuple[tuple[float, str] | None, bool, str]:
-    """(the metric downloads' scale, whether the tree can be drawn, what to say if not): the tree is read under the
-    request's work budget, charged before any of it is laid out. A tree stored before a limit it now breaks, or one
-    past the budget, is shown without its picture."""
+def _drawing(proc, viewer) -> tuple[tuple[float, str] | None, bool, str]:
+    """(the metric downloads' scale for ``viewer``, whether the tree can be drawn, what to say if not): the tree is
+    read under the request's work budget, charged before any of it is laid out. A tree stored before a limit it now
+    breaks, or one past the budget, is shown without its picture."""
     try:
-        return download_scale(proc, parse_procedure(proc.data)), True, ""
+        return download_scale(proc, parse_procedure(proc.data), viewer), True, ""
     except (ValidationError, ProcedureError) as exc:
         why = _error_text(exc) if isinstance(exc, ValidationError) else str(exc)
         return None, False, f"This procedure cannot be drawn ({why}). Its tree is below, and procedure.json has it."

@@ -36,8 +36,8 @@ from webapp.facades.serializers import (
 @parser_classes([JSONParser])
 def job_list(request):
     if request.method == "GET":
-        return page(request, Job.objects.filter(owner=request.user).select_related("segmentation", "result").defer(
-            *access.JOB_WITHOUT), JobSerializer)
+        return page(request, Job.objects.filter(owner=request.user).select_related(
+            "segmentation__photo", "result").defer(*access.JOB_WITHOUT), JobSerializer)
     form = JobCreateSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     v = form.validated_data
@@ -49,12 +49,12 @@ def job_list(request):
         raise PermissionDenied(access.DEMO_READ_ONLY)
     prefix = access.get_procedure_for_user(request.user, v["prefix_procedure"]) if v["prefix_procedure"] else None
     job = services.submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"], v["structure"])
-    return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
+    return Response(JobSerializer(job, context={"request": request}).data, status=status.HTTP_202_ACCEPTED)
 
 
 @extend_schema(responses=JobSerializer, summary="A job's status and progress")
 @api_view(["GET"])
 @permission_classes([AllowAny])
 def job_detail(request, code):
-    return Response(JobSerializer(access.get_job_for_user(request.user, code)).data)
+    return Response(JobSerializer(access.get_job_for_user(request.user, code), context={"request": request}).data)
 

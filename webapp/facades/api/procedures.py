@@ -22,7 +22,7 @@ from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
 from facaid.parameters import named_parameters, set_parameters
 from facaid.variation import vary
-from webapp.facades import access, downloads, rendering, services, versions
+from webapp.facades import access, disclosure, downloads, rendering, services, versions
 from webapp.facades.api.common import (
     page,
     stored_picture,
@@ -130,7 +130,8 @@ def procedure_variations(request, code):
     except (ProcedureError, ValueError) as exc:
         field = "ranges" if form.validated_data.get("ranges") else "data"
         raise ValidationError({field: f"no variations of this procedure: {exc}"}) from None
-    return Response({"variants": [v.to_dict() for v in variants]})
+    shown = disclosure.tree if disclosure.hidden(request.user, proc) else dict  # no accuracy of a private photo's
+    return Response({"variants": [shown(v.to_dict()) for v in variants]})
 
 
 def _leaves(tree) -> list | None:
@@ -170,7 +171,10 @@ def procedure_parameters(request, code):
               "leaves": _leaves(edited), "accuracy": None, "metrics": None, "version": None}
     if form.validated_data["save"]:
         versions.save_parameters(proc, answer["data"], form.validated_data["values"])
-        answer.update(accuracy=proc.accuracy, metrics=proc.metrics, version=proc.current_version().version)
+        shown = disclosure.figures(request.user, proc, proc.accuracy, proc.metrics)
+        answer.update(accuracy=shown["accuracy"], metrics=shown["metrics"], version=proc.current_version().version)
+    if disclosure.hidden(request.user, proc):  # the tree's meta: no accuracy of a photo not shared with the viewer
+        answer["data"] = disclosure.tree(answer["data"])
     return Response(answer)
 
 
@@ -211,7 +215,9 @@ def procedure_download(request, code, name):
         if download.needs_photo and not access.photo_visible_to(request.user, proc.photo):
             raise ValidationError({"photo": f"{name} is drawn with the photo, and this procedure has no photo you "
                                             "may see"})
-        resp = HttpResponse(downloads.build(name, proc, request.query_params), content_type=download.content_type)
+        resp = HttpResponse(downloads.build(name, proc, request.query_params, request.user),
+                            content_type=download.content_type)
+        resp["Cache-Control"] = "private"  # what it holds depends on who asks (the photo's real size and title)
     resp["Content-Disposition"] = f'attachment; filename="{downloads.stem(proc)}-{name}"'
     return resp
 
@@ -234,5 +240,5 @@ def procedure_rerun(request, code):
     form = RerunSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     job = services.rerun(request.user, proc, form.validated_data["nodes"], form.validated_data["k"])
-    return Response(JobSerializer(job).data, status=status.HTTP_202_ACCEPTED)
+    return Response(JobSerializer(job, context={"request": request}).data, status=status.HTTP_202_ACCEPTED)
 

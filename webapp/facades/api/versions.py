@@ -41,7 +41,8 @@ def procedure_versions(request, code):
     page = pager.paginate_queryset(proc.versions.defer("data").order_by("-version"), request)
     for version in page:
         version.procedure = proc
-    return pager.get_paginated_response(ProcedureVersionSummarySerializer(page, many=True).data)
+    return pager.get_paginated_response(ProcedureVersionSummarySerializer(
+        page, many=True, context={"request": request}).data)
 
 
 @extend_schema(responses=ProcedureVersionSerializer, summary="One version of the procedure, with its tree")
@@ -49,7 +50,7 @@ def procedure_versions(request, code):
 @permission_classes([AllowAny])
 def procedure_version(request, code, number):
     proc = access.get_procedure_for_user(request.user, code)
-    return Response(ProcedureVersionSerializer(versions.get_version(proc, number)).data)
+    return Response(ProcedureVersionSerializer(versions.get_version(proc, number), context={"request": request}).data)
 
 
 @extend_schema(responses={(200, "image/png"): bytes, 304: None},
@@ -98,7 +99,8 @@ def procedure_compare(request, code):
     a, b, diff = versions.compare(proc, request.query_params.get("a"), request.query_params.get("b"))
     sides = {}
     for key, version, (width, height) in zip(("a", "b"), (a, b), diff["sizes"], strict=True):
-        sides[key] = {**ProcedureVersionSummarySerializer(version).data, "width": width, "height": height}
+        shown = ProcedureVersionSummarySerializer(version, context={"request": request}).data
+        sides[key] = {**shown, "width": width, "height": height}
     seg = ProcedureSerializer(proc, context={"request": request}).get_segmentation(proc)
     return Response({**sides, "differing": diff["differing"] / diff["pixels"], "differing_pixels": diff["differing"],
                      "pixels": diff["pixels"], "segmentation": seg,

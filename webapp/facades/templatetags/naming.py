@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from django import template
 
-from webapp.facades import access
+from webapp.facades import access, disclosure
 
 register = template.Library()
 
@@ -16,6 +16,19 @@ def photo_name(context, photo) -> str:
     if not access.photo_visible_to(context["user"], photo):
         return "a photo not shared with you"
     return photo.title or f"untitled photo {str(photo.code)[:8]}"
+
+
+@register.simple_tag(takes_context=True)
+def procedure_title(context, proc) -> str:
+    """The procedure's title as the viewer is shown it: not one that repeats a photo they may not see
+    (`disclosure.title`)."""
+    return disclosure.title(context["user"], proc)
+
+
+@register.simple_tag(takes_context=True)
+def procedure_accuracy(context, proc) -> float | None:
+    """The procedure's pixel accuracy, None to a viewer who may not see the photo it was measured against."""
+    return None if disclosure.hidden(context["user"], proc) else proc.accuracy
 
 
 @register.filter
