@@ -12,6 +12,15 @@ allows it (a public procedure). The trees:
   floors, its tiles bays, its windows windows: every named parameter applies.
 - ``photo``: completion (no tree): 2,000 rectangles of 2,000 sizes drawn on a public 16 MP photo (issue 56 measured
   135 s for 1,690 types).
+- ``probe``: issue 66's 137 KB tree, repeat y x 256 -> repeat x x 11 -> R, a repeat of one copy with 1,024
+  size-only exceptions in copy 0 whose paths run down 28 one-child splits into a ``"fill"`` repeat of 4 leaves of
+  abs 5000 (a render took 206 s); refused by the cost model, which charges each exception at every level it is
+  carried through.
+- ``probe-stored``: the same shape with 100 copies of R, stored as the site accepted it before (issue 66: render
+  7.9 s, store 16 s, the page 9 s): every request on it, the page included, reads it and refuses or shows it light.
+- ``probe-max``: the heaviest accepted tree of that shape, 3 copies of R whose exceptions reach a repeat of 256
+  copies (95,474 units): what an accepted tree of exceptions costs.
+- ``nested``: issue 66's 460 KB shape, 8 nested repeats of 1,010 exceptions each (1.06 s to parse and refuse).
 
 Each figure is the median of ``--repeat`` requests, in seconds of wall time on an idle machine (one request at
 a time, so wall time is the CPU the request thread holds). Target: a crafted tree refused in < 0.1 s on every
@@ -45,7 +54,9 @@ CASES = {
     "facade.glb": "GET the download facade.glb",
     "procedure.cga": "GET the download procedure.cga",
     "complete-16MP": "POST complete, 2,000 rectangles of 2,000 sizes on a public 16 MP photo, anonymous",
+    "page": "GET the procedure's page",
 }
+REFUSED = ("crafted", "probe", "nested")  # never stored: only requests that carry a tree can send them
 
 BODY = ("render", "store", "set-floors", "set-window-width", "set-all")  # the requests that carry a tree in their body
 
@@ -89,9 +100,31 @@ def wide(n):
                 "children": [row]})
 
 
-tree = {"crafted": chain(256, 256, 29), "deep": chain(256, 12, 29), "wide": wide(157), "photo": wide(2)}[tree_name]
+def probe(rows, columns, count="fill"):
+    node = {"rule": "repeat", "axis": "x", "count": count, "sizes": [["abs", 5000]] * 4,
+            "children": [{"rule": "leaf", "label": "window"}] * 4}
+    for _ in range(28):
+        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
+    r = {"rule": "repeat", "axis": "y", "count": 1, "sizes": [["flt", 1]], "children": [node],
+         "exceptions": [{"copy": 0, "path": [0] + [0] * 28 + [x], "size": ["abs", 3]} for x in range(1024)]}
+    inner = {"rule": "repeat", "axis": "x", "count": columns, "sizes": [["flt", 1]], "children": [r]}
+    return doc({"rule": "repeat", "axis": "y", "count": rows, "sizes": [["flt", 1]], "children": [inner]})
+
+
+def nested():
+    node = {"rule": "leaf", "label": "window"}
+    for level in range(8):
+        node = {"rule": "repeat", "axis": "xy"[level % 2], "count": 4, "sizes": [["flt", 1]], "children": [node]}
+        node["exceptions"] = [{"copy": e % 4, "path": [0] + [(e >> (2 * k + 2)) % 4 for k in range(level)],
+                               "size": ["flt", 2]} for e in range(4 * 4 ** level)][:1010]
+    return doc(node)
+
+
+tree = {"crafted": chain(256, 256, 29), "deep": chain(256, 12, 29), "wide": wide(157), "photo": wide(2),
+        "probe": probe(256, 11), "probe-stored": probe(100, 1), "probe-max": probe(3, 1, 256),
+        "nested": nested()}[tree_name]
 proc = Procedure.objects.create(owner=user, data=wide(2), visibility="public")
-if tree_name != "crafted":
+if tree_name not in ("crafted", "probe", "nested"):
     proc.data = tree
     proc.save()  # the heavy tree as its version 2 (version 1 is small)
 code = proc.code
@@ -135,6 +168,7 @@ requests = {
     "facade.glb": lambda: anon.get(f"/api/v1/procedures/{code}/download/facade.glb"),
     "procedure.cga": lambda: anon.get(f"/api/v1/procedures/{code}/download/procedure.cga"),
     "complete-16MP": lambda: anon.post(f"/api/v1/photos/{photo.code}/complete", drawn, format="json"),
+    "page": lambda: anon.get(f"/procedures/{code}"),
 }
 anon.post("/api/v1/render", wide(2), format="json")  # warm: imports, URL resolution
 times, status = [], None
@@ -167,18 +201,18 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--case", nargs="*", choices=sorted(CASES), help="only these requests")
-    ap.add_argument("--tree", nargs="*", choices=["crafted", "deep", "wide", "photo"],
-                    default=["crafted", "deep", "wide", "photo"])
+    trees = ["crafted", "deep", "wide", "photo", "probe", "probe-stored", "probe-max", "nested"]
+    ap.add_argument("--tree", nargs="*", choices=trees, default=trees)
     args = ap.parse_args()
-    print(f"{'tree':8s} {'request':18s} {'status':>6s} {'seconds (median)':>17s}  runs")
+    print(f"{'tree':12s} {'request':18s} {'status':>6s} {'seconds (median)':>17s}  runs")
     for tree in args.tree:
         for case in args.case or CASES:
-            if tree == "crafted" and case not in BODY:
+            if tree in REFUSED and case not in BODY:
                 continue  # a tree the site refuses is never stored: only requests that carry one can send it
             if (tree == "photo") != (case == "complete-16MP"):
                 continue
             r = run_case(tree, case, args.repeat)
-            print(f"{tree:8s} {case:18s} {r['status']:6d} {statistics.median(r['times']):17.3f}  "
+            print(f"{tree:12s} {case:18s} {r['status']:6d} {statistics.median(r['times']):17.3f}  "
                   f"{', '.join(f'{t:.3f}' for t in r['times'])}   {CASES[case]}", flush=True)
 
 

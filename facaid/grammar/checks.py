@@ -15,7 +15,7 @@ from facaid.grammar.repeats import path_problem
 from facaid.numbers import finite
 
 if TYPE_CHECKING:
-    from facaid.grammar.procedure import Procedure
+    from facaid.grammar.procedure import Node, Procedure
 
 MODES = ("abs", "rel", "flt")
 
@@ -67,6 +67,25 @@ def check_meta(meta: dict) -> None:
     if len(text) > MAX_META_CHARS:
         raise ProcedureError("(document)", f"meta is too long ({len(text)} characters written out; at most "
                                            f"{MAX_META_CHARS})")
+
+
+def least_units(node: Node, bounds: dict[int, int]) -> int:
+    """A lower bound of what one instance of ``node`` costs (`count_expansion`'s units), from the bounds of its
+    children (``bounds``, by ``id``) alone, whatever its size: each ``"fill"`` repeat lays out at least one copy,
+    every copy of a repeat that an exception replaces a node of may cost nothing, and each instance of a repeat
+    handles all its exceptions. Computed bottom-up as a tree is read, so that a tree sure to cost too much is refused
+    before the rest of it is read, and before its exceptions are counted along their paths."""
+    if node.rule == "leaf":
+        return 1
+    kids = [1 if c.rule == "leaf" else bounds[id(c)] for c in node.children]
+    if node.rule == "split":
+        return 1 + sum(kids)
+    if node.rule == "mirror":
+        return 1 + 2 * sum(kids) - (kids[-1] if node.center else 0)
+    copies = 1 if node.count == "fill" else node.count
+    touched = {o.copy for o in node.exceptions if o.node is not None}  # a copy with a node replaced: maybe nothing
+    tail = 0 if node.count == "fill" and touched or node.count in touched else sum(kids[: node.tail])
+    return 1 + len(node.exceptions) + sum(kids) * sum(1 for c in range(copies) if c not in touched) + tail
 
 
 def check_expansion(proc: Procedure) -> None:

@@ -31,7 +31,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from facaid.grammar.checks import MODES, check_expansion, check_meta, check_size, is_number
+from facaid.grammar.checks import MODES, check_expansion, check_meta, check_size, is_number, least_units
 from facaid.grammar.errors import ProcedureError
 from facaid.grammar.limits import (
     MAX_CHILDREN,
@@ -267,7 +267,7 @@ class Procedure:
 
 # --- parsing and validation ---------------------------------------------------------------------------------
 
-def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
+def _parse_node(obj: Any, path: str, depth: int, counter: list) -> Node:
     if depth > MAX_DEPTH:
         raise ProcedureError(path, f"tree too deep (more than {MAX_DEPTH} levels)")
     counter[0] += 1
@@ -309,7 +309,8 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
     for i, s in enumerate(sizes_in):
         if not (isinstance(s, list) and len(s) == 2):
             raise ProcedureError(path, f"sizes[{i}] must be a [mode, value] pair, got {s!r}")
-        check_size(path, i, s[0], s[1])
+        if not _plain_size(s[0], s[1]):
+            check_size(path, i, s[0], s[1])
         sizes.append(Size(s[0], s[1]))
     node = Node(rule, axis=axis, sizes=sizes, role=role)
     if rule == "repeat":
@@ -331,13 +332,25 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list[int]) -> Node:
     node.children = [_parse_node(c, f"{path}/{i}", depth + 1, counter) for i, c in enumerate(children_in)]
     if rule == "repeat" and "exceptions" in obj:
         node.exceptions = _parse_exceptions(obj["exceptions"], node, path, depth, counter)
+    bounds = counter[1]
+    bounds[id(node)] = least_units(node, bounds)
+    if bounds[id(node)] > MAX_INSTANCES:  # refused as soon as a subtree is sure to cost too much, before the rest
+        raise ProcedureError(path, f"expands to more than {MAX_INSTANCES} node instances (each node once per copy "
+                                   f"of it, repeats and splits included, and each exception once at every level its "
+                                   f"path runs through): the limit of what one tree may cost")
     return node
 
 
 _EXCEPTION_KEYS = frozenset(("copy", "path", "size", "node"))
 
 
-def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: list[int]) -> list[Override]:
+def _plain_size(mode: Any, value: Any) -> bool:
+    """A size `check_size` accepts, told quickly (most are): a float or int, finite, in range for its mode."""
+    kind = type(value)
+    return (kind is float or kind is int) and mode in MODES and 0 <= value <= (1 if mode == "rel" else MAX_EXTENT)
+
+
+def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: list) -> list[Override]:
     if not isinstance(items, list):
         raise ProcedureError(path, f"exceptions must be a list, got {type(items).__name__}")
     if len(items) > MAX_EXCEPTIONS:
@@ -376,7 +389,8 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
             s = item["size"]
             if not (isinstance(s, list) and len(s) == 2):
                 raise ProcedureError(path, f"{where}.size must be a [mode, value] pair, got {s!r}")
-            check_size(path, e, s[0], s[1], what=f"{where}.size")
+            if not _plain_size(s[0], s[1]):  # the check with its message, for one that is not plainly fine
+                check_size(path, e, s[0], s[1], what=f"{where}.size")
             size = Size(s[0], s[1])
         sub = None
         if "node" in item:
@@ -413,7 +427,7 @@ def parse_procedure(obj: Any) -> Procedure:
         raise ProcedureError("(document)", f"unexpected key(s): {', '.join(extra)}")
     if "root" not in obj:
         raise ProcedureError("(document)", "missing 'root'")
-    root = _parse_node(obj["root"], "root", 0, [0])
+    root = _parse_node(obj["root"], "root", 0, [0, {}])  # nodes and exceptions read; each node's `least_units`
     proc = Procedure(obj["width"], obj["height"], root, meta)
     check_expansion(proc)
     return proc

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from facaid.formats.cga import procedure_cga
 from facaid.generator import generate_procedure
+from facaid.grammar.checks import least_units
 from facaid.grammar.execute import Trace, execute, first_boxes, flat_rows
 from facaid.grammar.layout import count_expansion, expand_over, layout
 from facaid.grammar.limits import MAX_INSTANCES
@@ -66,6 +67,7 @@ def test_the_probes_tree_is_refused_for_what_its_exceptions_cost():
     assert cost == units(one.root, one.width, one.height) == 1 + 1 + (1 + 1024) + 28 * 1025 + (1 + 1024) + 1024
     three = Procedure.from_dict(probe(rows=3, columns=1, count=256))  # each copy of R its own 31,824
     assert count_expansion(three.root, 4096, 4096).instances == 1 + 3 * (cost - 1)
+    assert bound(three.root) == 1 + 3 * (1 + (1 + 1024) + 28 + (1 + 1024 * 1))  # each copy: R, its chain, 4 leaves
     many = probe(rows=4, columns=1, count=256)
     with pytest.raises(ProcedureError, match="more than 100000 node instances"):
         Procedure.from_dict(many)
@@ -197,6 +199,19 @@ def walks(proc: Procedure) -> None:
     procedure_cga(proc, 0.02)
 
 
+def bound(root: Node) -> int:
+    """`least_units` of ``root``, computed bottom-up as parsing does."""
+    bounds: dict[int, int] = {}
+
+    def visit(node: Node) -> int:
+        for child in node.children:
+            visit(child)
+        bounds[id(node)] = least_units(node, bounds)
+        return bounds[id(node)]
+
+    return visit(root)
+
+
 SECONDS_PER_UNIT = 20e-6  # 8x what the walks take together on this project's machine (bench/bench_request_cost.py)
 
 
@@ -212,6 +227,7 @@ def test_an_accepted_trees_cpu_time_is_within_a_factor_of_its_cost(proc):
     cost = count_expansion(accepted.root, accepted.width, accepted.height).instances
     assert cost <= MAX_INSTANCES
     assert cost == units(accepted.root, accepted.width, accepted.height)  # what is charged is what is handled
+    assert bound(accepted.root) <= cost  # what parsing refuses early is sure to cost too much
     start = thread_time()
     walks(accepted)
     spent = thread_time() - start
