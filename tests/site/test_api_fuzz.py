@@ -210,3 +210,26 @@ def test_every_number_of_every_json_body_refuses_booleans_and_strings(world):
                                                                              r.status_code, r.content[:300])
                 checked.append((method, template, where))
     assert len({c[1] for c in checked}) >= 7 and len(checked) >= 2 * 14  # every operation the schema names
+
+
+@pytest.mark.django_db
+def test_every_boolean_of_every_json_body_is_true_or_false_only(world):
+    """Read from the schema: wherever a JSON body takes a boolean, 0, 1 and "true" are a 400 naming the field (DRF's
+    BooleanField takes them, and "yes" and "on", as booleans)."""
+    from django.contrib.auth import get_user_model
+    from rest_framework.test import APIClient
+
+    client = APIClient()
+    client.force_login(get_user_model().objects.get(username="alice"))
+    before = rows()
+    checked = []
+    for method, template, path, schema_, components in _json_bodies(client, world):
+        for bad in (0, 1, "true", "false"):
+            for where, data in _fields(schema_, components, ("boolean",), bad):
+                r = getattr(client, method)(path, data, format="json")
+                assert r.status_code == 400 and r.json().get(where[0]) == ["A boolean is required: true or false."], \
+                    (method, template, where, bad, r.status_code, r.content[:300])
+                checked.append((method, template, where))
+    assert {(c[1], c[2]) for c in checked} >= {("/api/v1/procedures/{code}/", ("share_photo",)),
+                                               ("/api/v1/procedures/{code}/parameters", ("save",))}
+    assert rows() == before

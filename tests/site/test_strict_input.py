@@ -1,6 +1,6 @@
 """JSON bodies are read strictly: a string that is not text (an unpaired surrogate, a NUL) is a 400 naming its field
-wherever it is sent, not a 500 when the answer echoes it; and the API's answers are written even where they hold
-text UTF-8 cannot write."""
+wherever it is sent, not a 500 when the answer echoes it; a boolean is ``true`` or ``false``, not 0, 1 or "true";
+and the API's answers are written even where they hold text UTF-8 cannot write."""
 
 from __future__ import annotations
 
@@ -96,3 +96,21 @@ def test_the_renderer_writes_what_utf8_cannot():
     assert JSONRenderer().render({"detail": f"\"{SURROGATE}\" is not a valid choice, façade"}) == \
         b'{"detail":"\\"\\ud800\\" is not a valid choice, fa\\u00e7ade"}'
     assert JSONRenderer().render({"detail": "façade"}) == '{"detail":"façade"}'.encode()
+
+
+# --- booleans are true or false -------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("bad", [0, 1, "true", "false", "yes", "on", None, [], {}])
+def test_a_boolean_is_true_or_false_only(as_alice, alice, world, bad):
+    code = world["procedure"]
+    before = state()
+    for path, body, field in ((f"/api/v1/procedures/{code}/", {"visibility": "public", "share_photo": bad},
+                               "share_photo"),
+                              (f"/api/v1/procedures/{code}/parameters", {"values": {}, "save": bad}, "save")):
+        r = raw(as_alice, "PATCH" if field == "share_photo" else "POST", path, body)
+        assert r.status_code == 400 and field in r.json(), (field, bad, r.status_code, r.content[:300])
+        assert state() == before
+    r = raw(as_alice, "PATCH", f"/api/v1/procedures/{code}/", {"visibility": "public", "share_photo": False})
+    assert r.status_code == 200 and r.json()["visibility"] == "public"
+    r = raw(as_alice, "POST", f"/api/v1/procedures/{code}/parameters", {"values": {}, "save": False})
+    assert r.status_code == 200, r.content[:300]
