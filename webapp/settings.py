@@ -81,6 +81,7 @@ INSTALLED_APPS = [
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
     "webapp.middleware.RequestSizeLimitMiddleware",  # before anything reads the body
+    "webapp.middleware.UnreadBodyMiddleware",  # what was answered before the body was read: the rest read
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     "django.middleware.common.CommonMiddleware",
