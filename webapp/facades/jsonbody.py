@@ -1,9 +1,9 @@
-"""JSON request bodies with bounded nesting and plain text: the API's parser and the pages' pasted JSON read through
+"""JSON request bodies with bounded nesting and text only: the API's parser and the pages' pasted JSON read through
 here, so a document nested thousands of levels deep is a 400 naming the problem instead of a RecursionError (a
-500), nothing deeper than `MAX_DEPTH` reaches the code that stores or walks the data, and no string in it holds a NUL
-or an unpaired surrogate (``"\\ud800"``: JSON may write one, UTF-8 cannot, so echoing it in an error, storing it or
-writing it to a file failed) - a 400 that names the field. The API's answers are written by `JSONRenderer`, which
-cannot fail on such text either."""
+500), nothing deeper than `MAX_DEPTH` reaches the code that stores or walks the data, and no key or string in it
+holds an unpaired surrogate (``"\\ud800"``: JSON may write one, UTF-8 cannot, so echoing it in an error message,
+storing it or writing it to a file failed): a 400 that names the field. The API's answers are written by
+`JSONRenderer`, which cannot fail on such text either. (A NUL is text: the fields that cannot store one say so.)"""
 
 from __future__ import annotations
 
@@ -20,9 +20,8 @@ from facaid.grammar.procedure import MAX_DEPTH as GRAMMAR_MAX_DEPTH
 # [...]}}}) and its sizes' pairs 2 deeper; the grammar allows d <= 32 (facaid.grammar.procedure.MAX_DEPTH)
 MAX_DEPTH = 2 * GRAMMAR_MAX_DEPTH + 8
 
-# what no text field takes: a NUL (PostgreSQL refuses it) and surrogates (only pairs are text, and a decoded JSON
-# string holds them paired as one character: any left is unpaired)
-_NOT_TEXT = re.compile("[\x00\ud800-\udfff]")
+# surrogates are text only in pairs, which a decoded JSON string holds as one character: any left is unpaired
+_NOT_TEXT = re.compile("[\ud800-\udfff]")
 
 
 class JSONError(ValueError):
@@ -38,8 +37,7 @@ def _text_error(text: str, path: tuple, what: str = "") -> str | None:
     bad = _NOT_TEXT.search(text)
     if bad is None:
         return None
-    holds = "a NUL character" if bad.group() == "\x00" else "an unpaired surrogate"
-    return f"{what or _where(path)} holds {holds} (U+{ord(bad.group()):04X}): not plain JSON text"
+    return f"{what or _where(path)} holds an unpaired surrogate (U+{ord(bad.group()):04X}): not plain JSON text"
 
 
 def document_error(obj: Any, limit: int = MAX_DEPTH) -> str | None:
