@@ -80,6 +80,7 @@ INSTALLED_APPS = [
 
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
+    "webapp.middleware.ContentSecurityPolicyMiddleware",  # every response, the error answers below included
     "webapp.middleware.RequestSizeLimitMiddleware",  # before anything reads the body
     "webapp.middleware.UnreadBodyMiddleware",  # what was answered before the body was read: the rest read
     "whitenoise.middleware.WhiteNoiseMiddleware",
