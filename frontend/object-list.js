@@ -1,6 +1,6 @@
 // The object list on the page: one group per class (its count, hide and lock) with an entry per rectangle that
 // selects it. Built from objects.js's groups; the editor says what a click does.
-import {cssColor} from "./labels.js";
+import {swatch} from "./panel.js";
 
 const button = (text, attrs = {}) => Object.assign(document.createElement("button"), {type: "button",
   textContent: text, ...attrs});
@@ -18,7 +18,7 @@ export function buildObjectList(box, groups, selection, open, on) {
       on.rebuild();
     });
     const summary = document.createElement("summary");
-    summary.innerHTML = `<span class="swatch" style="background:${cssColor(g.label)}"></span> `;
+    summary.append(swatch(g.label), " ");  // its colour set as a property: a style attribute breaks the page's CSP
     const name = Object.assign(document.createElement("span"), {className: "name", textContent: `${g.label} ${g.count}`});
     summary.append(name);
     for (const [kind, on1, off1] of [["hidden", "show", "hide"], ["locked", "unlock", "lock"]]) {

@@ -7,7 +7,7 @@ export function buildPalette(box, pick) {
     const b = document.createElement("button");
     b.type = "button";
     b.dataset.label = label;
-    b.innerHTML = `<span class="swatch" style="background:${cssColor(label)}"></span> ${label} <kbd>${HOTKEYS[i]}</kbd>`;
+    b.append(swatch(label), ` ${label} `, Object.assign(document.createElement("kbd"), {textContent: HOTKEYS[i]}));
     b.addEventListener("click", () => pick(label));
     return b;
   }));
@@ -16,4 +16,12 @@ export function buildPalette(box, pick) {
 /** Mark as active the buttons matching `selector` whose `data-<key>` is `value`, and no other. */
 export function markActive(selector, key, value) {
   for (const b of document.querySelectorAll(selector)) b.classList.toggle("active", b.dataset[key] === value);
+}
+
+// A label's colour swatch, its colour set as a style property: the site's Content-Security-Policy refuses style
+// attributes written in markup.
+export function swatch(label) {
+  const span = Object.assign(document.createElement("span"), {className: "swatch"});
+  span.style.background = cssColor(label);
+  return span;
 }

@@ -290,6 +290,10 @@ widthField?.addEventListener("input", () => {
   }
 });
 
+// a form that asks first (delete): its handler is here, as the site's Content-Security-Policy refuses inline ones
+for (const form of document.querySelectorAll("form[data-confirm]")) {
+  form.addEventListener("submit", (e) => { if (!confirm(form.dataset.confirm)) e.preventDefault(); });
+}
 document.getElementById("opacity")?.addEventListener("input", (e) => {
   document.getElementById("overlay").style.opacity = e.target.value;
 });

@@ -1,13 +1,16 @@
 """Site-wide guards that answer before a view runs or when the database cannot: a request body larger than any
 the site accepts is refused from its Content-Length (413) before a byte of it is read, and a database that is
 locked or unreachable is a 503 that says so instead of a 500. Both answer JSON under /api/ and the site's error page
-elsewhere (`webapp.errors`), drawn without the session or the database. And every request has a work budget: the
-trees it reads and makes may lay out at most ``FACAID_REQUEST_WORK`` node instances in all and take
-``FACAID_REQUEST_SECONDS`` of CPU (`facaid.grammar.budget`), past which it is a 400 that names the limit."""
+elsewhere (`webapp.errors`), drawn without the session or the database. Whatever is answered below the size limit,
+what the view left unread of the body is read first, so that the connection can carry the next request. And every
+request has a work budget: the trees it reads and makes may lay out at most ``FACAID_REQUEST_WORK`` node instances
+in all and take ``FACAID_REQUEST_SECONDS`` of CPU (`facaid.grammar.budget`), past which it is a 400 that names the
+limit."""
 
 from __future__ import annotations
 
 import logging
+import secrets
 
 from django.conf import settings
 from django.db import OperationalError
@@ -31,6 +34,30 @@ def max_request_bytes(content_type: str) -> tuple[int, str]:
     return settings.DATA_UPLOAD_MAX_MEMORY_SIZE, "JSON and form bodies"
 
 
+# What a page may load and run: only this site's own files (the pages are ES modules and stylesheets from
+# /static/, three.js among them), no inline script but the 3D preview's import map (which browsers read only inline)
+# by the request's nonce, no style attribute or <style> in markup (the scripts set styles as properties), pictures
+# also as data: (the icon) and blob: URLs (pictures fetched, and the 3D model's textures), which three.js's loader
+# also fetches; nothing framed, no plugin, forms posted here only.
+CONTENT_SECURITY_POLICY = ("default-src 'self'; script-src 'self' 'nonce-{nonce}'; style-src 'self'; "
+                           "img-src 'self' data: blob:; connect-src 'self' blob:; font-src 'self'; "
+                           "object-src 'none'; base-uri 'none'; form-action 'self'; frame-ancestors 'none'")
+
+
+class ContentSecurityPolicyMiddleware:
+    """A ``Content-Security-Policy`` header on every response (`CONTENT_SECURITY_POLICY`), with a nonce made for the
+    request (``request.csp_nonce``) that a template gives the one inline script it needs."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+
+    def __call__(self, request):
+        request.csp_nonce = nonce = secrets.token_urlsafe(16)
+        response = self.get_response(request)
+        response.setdefault("Content-Security-Policy", CONTENT_SECURITY_POLICY.format(nonce=nonce))
+        return response
+
+
 class RequestSizeLimitMiddleware:
     """413 for a declared body over the largest the site accepts of its kind (a photo upload, or a JSON or form
     body). Django reads no more than Content-Length, so a body without one is read as empty."""
@@ -48,6 +75,29 @@ class RequestSizeLimitMiddleware:
             return error_response(request, 413, f"the request is {length / 2**20:.1f} MB; at most "
                                                 f"{limit / 2**20:.0f} MB are accepted for {what}", static=True)
         return self.get_response(request)
+
+
+class UnreadBodyMiddleware:
+    """The rest of a request's body, where the answer came before the view read it all (a 503 of a busy process or
+    database, a 403, a 429), is read and dropped before the answer goes out. A server that keeps the connection
+    alive must skip those bytes to find the next request; gunicorn skips at most 64 KB and past that closes the
+    connection it announced as kept alive, so a client's next request on it failed. The body is at most the size
+    limit (`RequestSizeLimitMiddleware`, outside this one), and reading what a client sends costs no CPU to speak
+    of. (A WSGI application cannot say ``Connection: close``: servers drop hop-by-hop headers.)"""
+
+    CHUNK = 1 << 16
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+
+    def __call__(self, request):
+        response = self.get_response(request)
+        try:
+            while request.read(self.CHUNK):  # bounded by Content-Length; nothing left, or what a view kept, reads b""
+                pass
+        except OSError:  # the client went away (Django's UnreadablePostError is one): no next request to keep
+            pass
+        return response
 
 
 class BusyDatabaseMiddleware:

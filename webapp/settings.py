@@ -81,7 +81,9 @@ INSTALLED_APPS = [
 
 MIDDLEWARE = [
     "django.middleware.security.SecurityMiddleware",
+    "webapp.middleware.ContentSecurityPolicyMiddleware",  # every response, the error answers below included
     "webapp.middleware.RequestSizeLimitMiddleware",  # before anything reads the body
+    "webapp.middleware.UnreadBodyMiddleware",  # what was answered before the body was read: the rest read
     "whitenoise.middleware.WhiteNoiseMiddleware",
     "django.contrib.sessions.middleware.SessionMiddleware",
     "django.middleware.common.CommonMiddleware",
@@ -195,9 +197,12 @@ REST_FRAMEWORK = {
                                "heavy": env_rate("FACAID_API_HEAVY_RATE", "240/min"),
                                "signup": env_rate("FACAID_SIGNUP_RATE", "10/hour")},  # accounts/views.signup
     "NUM_PROXIES": FACAID_PROXY_COUNT,
-    # JSON with bounded nesting (a RecursionError would be a 500), then forms and uploads
+    # JSON with bounded nesting (a RecursionError would be a 500) and plain text, then forms and uploads
     "DEFAULT_PARSER_CLASSES": ["webapp.facades.jsonbody.JSONParser", "rest_framework.parsers.FormParser",
                                "rest_framework.parsers.MultiPartParser"],
+    # JSON that cannot fail on text UTF-8 cannot write (an unpaired surrogate: a 500 before), then the browsable API
+    "DEFAULT_RENDERER_CLASSES": ["webapp.facades.jsonbody.JSONRenderer",
+                                 "rest_framework.renderers.BrowsableAPIRenderer"],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
     "DEFAULT_PAGINATION_CLASS": "webapp.facades.paging.Pagination",
     "PAGE_SIZE": 24,  # (webapp.facades.paging.Pagination: at most 100)

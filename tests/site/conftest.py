@@ -4,7 +4,7 @@ made from generated facades, a media root per test."""
 from __future__ import annotations
 
 import pytest
-from site_helpers import CHROMIUM, CHROMIUM_ARGS, Redis, Worker, client_for, facade_png, upload
+from site_helpers import CHROMIUM, CHROMIUM_ARGS, Redis, Worker, client_for, facade_png, upload, wait_for_function
 
 
 @pytest.fixture(autouse=True)
@@ -84,6 +84,17 @@ def worker(redis, tmp_path):
     w = Worker(redis, tmp_path / "worker.log")
     yield w
     w.kill()
+
+
+@pytest.fixture(autouse=True)
+def csp_safe_waits(monkeypatch):
+    """Page.wait_for_function that works under the site's Content-Security-Policy (`site_helpers.wait_for_function`):
+    the browser tests run the pages under the policy they are served with."""
+    try:
+        from playwright.sync_api import Page
+    except ImportError:
+        return
+    monkeypatch.setattr(Page, "wait_for_function", wait_for_function)
 
 
 @pytest.fixture

@@ -7,7 +7,7 @@ import io
 
 import numpy as np
 from PIL import Image
-from site_helpers import login, upload
+from site_helpers import collect_errors, login, upload
 
 E = "window.facaidEditor"
 WINDOWS = [(x, y) for y in (60, 210) for x in (60, 200, 340)]  # top-left corners of six equal windows
@@ -47,11 +47,11 @@ def open_editor(live_server, as_alice, browser, viewport=(1400, 1000)):
 
 def open_page(live_server, browser, code: str, ready: str, viewport=(1400, 1000), has_touch=False, dialog=None):
     """(page, context): Alice logged in and the editor of her photo ``code`` open, once the JavaScript ``ready``
-    holds; the page's uncaught errors collect in `page.errors`; ``dialog`` answers the page's dialogs."""
+    holds; the page's uncaught errors and CSP refusals collect in `page.errors`; ``dialog`` answers the page's
+    dialogs."""
     context = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}, has_touch=has_touch)
     page = context.new_page()
-    page.errors = []
-    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    page.errors = collect_errors(page, [])
     if dialog is not None:
         page.on("dialog", dialog)
     login(page, live_server.url, "alice", "alice-password-1")

@@ -159,9 +159,39 @@ def login(page, base: str, username: str, password: str) -> None:
     page.wait_for_url(f"{base}/")
 
 
+def collect_errors(page, errors: list) -> list:
+    """The page's uncaught errors and what its Content-Security-Policy refused (Chromium says so on the console: an
+    inline script or style, a handler attribute, a load from elsewhere), into ``errors``."""
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.on("console", lambda m: errors.append(m.text) if "Content Security Policy" in m.text else None)
+    return errors
+
+
+def wait_for_function(page, expression: str, arg=None, *, timeout: float | None = None, polling=None) -> None:
+    """`Page.wait_for_function` for pages under the site's Content-Security-Policy. Playwright's own compiles the
+    expression in the page (``new Function``), which a policy without 'unsafe-eval' refuses; this one asks
+    `Page.evaluate` until the expression holds, which DevTools runs outside the page's policy. Installed for
+    every site test by conftest.py."""
+    from playwright.sync_api import Error
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    deadline = time.monotonic() + (30_000 if timeout is None else timeout) / 1000
+    pause = polling if isinstance(polling, int | float) else 50
+    while True:
+        try:
+            if page.evaluate(expression, arg):
+                return
+        except Error as exc:  # a navigation under way: ask the next page, as Playwright's own does
+            if "context was destroyed" not in str(exc) and "navigat" not in str(exc):
+                raise
+        if time.monotonic() > deadline:
+            raise PlaywrightTimeout(f"Timeout {timeout}ms exceeded waiting for {expression!r}")
+        page.wait_for_timeout(pause)  # (lets Playwright deliver the page's events meanwhile)
+
+
 def offline_page(browser, base: str, viewport=(1280, 900)):
     """A page whose requests to anything but ``base`` are refused and listed in `page.elsewhere`; its uncaught
-    errors collect in `page.errors`."""
+    errors and what its Content-Security-Policy refused collect in `page.errors`."""
     page = browser.new_context(viewport={"width": viewport[0], "height": viewport[1]}).new_page()
     page.elsewhere, page.errors = [], []
 
@@ -173,7 +203,7 @@ def offline_page(browser, base: str, viewport=(1280, 900)):
             r.abort()
 
     page.route("**/*", route)
-    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    collect_errors(page, page.errors)
     return page
 
 

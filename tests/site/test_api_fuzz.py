@@ -2,11 +2,15 @@
 generated inputs and on the real objects of a small world (so that path parameters reach the views, not only the
 404). No answer is a 5xx, and after a 4xx every row of the database is what it was before, every column.
 
+Schemathesis draws text that UTF-8 can write; the strings of its cases are made awkward as a hostile client would:
+lone surrogates (``"\\ud800"``, which JSON can write), NUL, U+FFFF and U+FFFE, and strings of 100,000 characters.
+
 The cases are drawn by Hypothesis under the suite's 'repeatable' profile (the same cases each run);
 HYPOTHESIS_PROFILE=explore and FACAID_FUZZ_EXAMPLES=N draw new and more."""
 
 from __future__ import annotations
 
+import json
 import os
 from contextlib import contextmanager
 
@@ -24,6 +28,27 @@ EXAMPLES = int(os.environ.get("FACAID_FUZZ_EXAMPLES", "15"))
 WHO = ("anonymous", "alice", "alice", "bob")  # alice owns the world's objects (drawn half the time); bob does not
 
 schema = schemathesis.openapi.from_wsgi("/api/v1/schema?format=json", get_wsgi_application())
+
+# what a hostile client puts in a string; surrogates only in JSON (a URL or a form cannot carry them: their bytes are
+# invalid UTF-8, which Django reads as U+FFFD)
+AWKWARD = ("\x00", "a\x00b", "\uffff", "\ufffe", "x" * 100_000, "\u0301" * 1000)
+SURROGATES = ("\ud800", "\udfff", "a\ud800b", "\udc00\ud800", "\ud83c")
+
+
+def awkward(value, strings: tuple[str, ...]) -> st.SearchStrategy:
+    """``value`` with some of its strings (and, in objects, an extra key) awkward: replaced, or prefixed or
+    suffixed by one of ``strings``."""
+    if isinstance(value, str):
+        return st.one_of(st.just(value), st.sampled_from(strings).flatmap(
+            lambda bad: st.sampled_from((bad, value + bad, bad + value))))
+    if isinstance(value, list):
+        return st.tuples(*(awkward(v, strings) for v in value)).map(list)
+    if isinstance(value, dict):
+        keys = list(value)
+        extra = st.one_of(st.just({}), st.sampled_from(strings).map(lambda bad: {bad: bad}))
+        return st.tuples(st.tuples(*(awkward(value[k], strings) for k in keys)), extra).map(
+            lambda drawn: {**dict(zip(keys, drawn[0], strict=True)), **drawn[1]})
+    return st.just(value)
 
 
 def rows() -> dict[str, list[tuple]]:
@@ -102,12 +127,22 @@ def real_parameters(case, world, pick: int) -> None:
 
 
 @schema.parametrize()
-@schema.given(who=st.sampled_from(WHO), real=st.sampled_from((True, True, True, False)), pick=st.integers(0, 100))
+@schema.given(who=st.sampled_from(WHO), real=st.sampled_from((True, True, True, False)), pick=st.integers(0, 100),
+              text=st.data())
 @settings(max_examples=EXAMPLES, deadline=None, suppress_health_check=list(HealthCheck))
 @pytest.mark.django_db
-def test_no_5xx_and_nothing_stored_by_a_4xx(case, who, real, pick, world):
+def test_no_5xx_and_nothing_stored_by_a_4xx(case, who, real, pick, text, world):
     if real:
         real_parameters(case, world, pick)
+    body = {}
+    if case.query:
+        case.query = text.draw(awkward(case.query, AWKWARD), label="query")
+    if case.media_type == "application/json" and isinstance(case.body, dict | list | str):
+        # sent as written, escapes and all: schemathesis checks a body against its schema before sending it, and
+        # its validator cannot read a lone surrogate
+        body["data"] = json.dumps(text.draw(awkward(case.body, AWKWARD + SURROGATES), label="body")).encode()
+    elif isinstance(case.body, dict):
+        case.body = text.draw(awkward(case.body, AWKWARD), label="form")
     headers, cookies = {}, {}
     if who != "anonymous":
         session = world["sessions"][who]
@@ -115,7 +150,7 @@ def test_no_5xx_and_nothing_stored_by_a_4xx(case, who, real, pick, world):
         headers["X-CSRFToken"] = session["csrftoken"]
     before = rows()
     with in_process():
-        response = case.call(headers=headers, cookies=cookies)
+        response = case.call(headers=headers, cookies=cookies, **body)
     assert response.status_code < 500, (who, case.method, case.formatted_path, response.text[:500])
     if 400 <= response.status_code < 500:
         assert rows() == before, (who, case.method, case.formatted_path, response.status_code)
@@ -127,22 +162,34 @@ def _resolve(node: dict, components: dict) -> dict:
     return node
 
 
-def _numbers(node: dict, components: dict, bad, path=()):
-    """Each number or integer of a request body's schema, as (its path, a body holding ``bad`` there and nothing
-    else: the least nesting that reaches it)."""
+def _fields(node: dict, components: dict, types: tuple[str, ...], bad, path=()):
+    """Each field of a request body's schema of one of ``types``, as (its path, a body holding ``bad`` there and
+    nothing else: the least nesting that reaches it)."""
     node = _resolve(node, components)
-    if node.get("type") in ("number", "integer"):
+    if node.get("type") in types:
         yield path, bad
     for key, sub in node.get("properties", {}).items():
         if not sub.get("readOnly"):
-            yield from ((p, {key: body}) for p, body in _numbers(sub, components, bad, (*path, key)))
+            yield from ((p, {key: body}) for p, body in _fields(sub, components, types, bad, (*path, key)))
     if isinstance(node.get("additionalProperties"), dict):
-        yield from ((p, {"floors": body}) for p, body in _numbers(node["additionalProperties"], components, bad,
-                                                                   (*path, "*")))
+        yield from ((p, {"floors": body}) for p, body in _fields(node["additionalProperties"], components, types,
+                                                                  bad, (*path, "*")))
     if "items" in node:
-        yield from ((p, [body]) for p, body in _numbers(node["items"], components, bad, (*path, "[]")))
+        yield from ((p, [body]) for p, body in _fields(node["items"], components, types, bad, (*path, "[]")))
     for alternative in node.get("allOf", []) + node.get("oneOf", []) + node.get("anyOf", []):
-        yield from _numbers(alternative, components, bad, path)
+        yield from _fields(alternative, components, types, bad, path)
+
+
+def _json_bodies(client, world):
+    """(method, path template, path, the JSON body's schema, the schema's components) of every operation."""
+    spec = client.get("/api/v1/schema?format=json").json()
+    for template, operations in spec["paths"].items():
+        path = template.replace("{code}", world["codes"]["procedures"][0] if "/procedures/" in template
+                                else world["codes"]["photos"][0])
+        for method, operation in operations.items():
+            body = operation.get("requestBody", {}).get("content", {}).get("application/json")
+            if body is not None:
+                yield method, template, path, body["schema"], spec["components"]["schemas"]
 
 
 @pytest.mark.django_db
@@ -154,20 +201,35 @@ def test_every_number_of_every_json_body_refuses_booleans_and_strings(world):
 
     client = APIClient()
     client.force_login(get_user_model().objects.get(username="alice"))
-    spec = client.get("/api/v1/schema?format=json").json()
-    components = spec["components"]["schemas"]
     checked = []
-    for template, operations in spec["paths"].items():
-        path = template.replace("{code}", world["codes"]["procedures"][0] if "/procedures/" in template
-                                else world["codes"]["photos"][0])
-        for method, operation in operations.items():
-            body = operation.get("requestBody", {}).get("content", {}).get("application/json")
-            if body is None:
-                continue
-            for bad, says in ((True, "not a boolean"), ("5", "not a string")):
-                for where, data in _numbers(body["schema"], components, bad):
-                    r = getattr(client, method)(path, data, format="json")
-                    assert r.status_code == 400 and says in r.content.decode(), (method, template, where, bad,
-                                                                                 r.status_code, r.content[:300])
-                    checked.append((method, template, where))
+    for method, template, path, schema_, components in _json_bodies(client, world):
+        for bad, says in ((True, "not a boolean"), ("5", "not a string")):
+            for where, data in _fields(schema_, components, ("number", "integer"), bad):
+                r = getattr(client, method)(path, data, format="json")
+                assert r.status_code == 400 and says in r.content.decode(), (method, template, where, bad,
+                                                                             r.status_code, r.content[:300])
+                checked.append((method, template, where))
     assert len({c[1] for c in checked}) >= 7 and len(checked) >= 2 * 14  # every operation the schema names
+
+
+@pytest.mark.django_db
+def test_every_boolean_of_every_json_body_is_true_or_false_only(world):
+    """Read from the schema: wherever a JSON body takes a boolean, 0, 1 and "true" are a 400 naming the field (DRF's
+    BooleanField takes them, and "yes" and "on", as booleans)."""
+    from django.contrib.auth import get_user_model
+    from rest_framework.test import APIClient
+
+    client = APIClient()
+    client.force_login(get_user_model().objects.get(username="alice"))
+    before = rows()
+    checked = []
+    for method, template, path, schema_, components in _json_bodies(client, world):
+        for bad in (0, 1, "true", "false"):
+            for where, data in _fields(schema_, components, ("boolean",), bad):
+                r = getattr(client, method)(path, data, format="json")
+                assert r.status_code == 400 and r.json().get(where[0]) == ["A boolean is required: true or false."], \
+                    (method, template, where, bad, r.status_code, r.content[:300])
+                checked.append((method, template, where))
+    assert {(c[1], c[2]) for c in checked} >= {("/api/v1/procedures/{code}/", ("share_photo",)),
+                                               ("/api/v1/procedures/{code}/parameters", ("save",))}
+    assert rows() == before

@@ -6,7 +6,11 @@ worker read; the set-up, CI and the image vendor three.js from npm at the lock f
 from __future__ import annotations
 
 import json
+import os
 import re
+import secrets
+import subprocess
+import sys
 from pathlib import Path
 
 import yaml
@@ -40,13 +44,45 @@ def test_compose_services_healthchecks_volumes_and_gpu():
         # the settings refuse to start without a key when DEBUG is off; compose refuses before that
         assert env["SECRET_KEY"].startswith("${SECRET_KEY:?") and "DEBUG" not in env
         assert "FACAID_REQUIRE_SECRET" not in env  # gone: a key is always required in production
-        # plain http on port 8000 unless the operator puts a TLS proxy in front (docs/site.md, Security)
-        assert env["FACAID_HTTPS"] == "${FACAID_HTTPS:-0}"
-        assert {"FACAID_PROXY_SSL_HEADER", "FACAID_PROXY_COUNT"} <= set(env)
+        # https-only behind a TLS proxy on the host unless told otherwise (docs/site.md, Security)
+        assert env["FACAID_HTTPS"] == "${FACAID_HTTPS:-1}"
+        assert env["FACAID_PROXY_SSL_HEADER"] == "${FACAID_PROXY_SSL_HEADER:-X-Forwarded-Proto}"
+        assert env["FACAID_PROXY_COUNT"] == "${FACAID_PROXY_COUNT:-1}"
         for dep in ("postgres", "redis"):
             assert services[name]["depends_on"][dep]["condition"] == "service_healthy"
+    # the proxy's headers are trusted, so only this host reaches the port (plain http too: FACAID_HTTPS=0)
+    assert services["web"]["ports"] == ["127.0.0.1:8000:8000"]
+    assert all("ports" not in s for name, s in services.items() if name != "web")
     used = {v.split(":")[0] for s in services.values() for v in s.get("volumes", [])}
     assert used <= set(c["volumes"]) and {"postgres", "redis", "media"} <= used
+
+
+def compose_environment(**given: str) -> dict[str, str]:
+    """The site's environment in docker-compose.yml as compose would resolve it, ``given`` set in the shell."""
+    def value(match: re.Match) -> str:
+        name, how, default = match.groups()
+        return given.get(name) or (default if how == ":-" else "")
+
+    spec = compose()["services"]["web"]["environment"]
+    return {k: re.sub(r"\$\{(\w+)(:-|:\?)([^}]*)\}", value, str(v)) for k, v in spec.items()}
+
+
+def deploy_check(tmp_path, **given: str) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("SECRET_KEY", "DEBUG", "ALLOWED_HOSTS", "FACAID_",
+                                                                     "CSRF_"))}
+    env.update(compose_environment(SECRET_KEY=secrets.token_urlsafe(50), **given), FACAID_VAR=str(tmp_path))
+    return subprocess.run([sys.executable, "manage.py", "check", "--deploy", "--fail-level", "WARNING"], cwd=ROOT,
+                          env=env, capture_output=True, text=True, timeout=120)
+
+
+def test_the_compose_environment_passes_the_deployment_checks(tmp_path):
+    """As shipped, `check --deploy` has nothing to say; with FACAID_HTTPS=0 (this host only) it names what plain http
+    gives up: HSTS, the redirect, secure session and CSRF cookies (W004, W008, W012, W016)."""
+    r = deploy_check(tmp_path)
+    assert r.returncode == 0 and "no issues" in r.stdout, r.stdout + r.stderr
+    r = deploy_check(tmp_path, FACAID_HTTPS="0")
+    assert r.returncode != 0 and all(f"security.{w}" in r.stderr + r.stdout
+                                          for w in ("W004", "W008", "W012", "W016")), r.stdout + r.stderr
 
 
 def test_dockerfile_copies_what_the_site_and_worker_read():

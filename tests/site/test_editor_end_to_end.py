@@ -11,7 +11,7 @@ import zipfile
 
 import pytest
 from PIL import Image, ImageOps
-from site_helpers import login
+from site_helpers import collect_errors, login
 
 from facaid.formats.render import render_segmentation
 from facaid.generator import generate
@@ -26,8 +26,7 @@ PAD = 40  # the facade sits inside a border that rectification crops away
 @pytest.fixture
 def page(browser):
     page = browser.new_page(viewport={"width": 1400, "height": 1000}, accept_downloads=True)
-    page.errors = []
-    page.on("pageerror", lambda e: page.errors.append(str(e)))
+    page.errors = collect_errors(page, [])
     page.on("dialog", lambda d: d.accept())
     return page
 

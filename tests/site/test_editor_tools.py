@@ -9,7 +9,7 @@ import shutil
 
 import pytest
 from editor_helpers import WINDOWS, E, drag, import_file, open_page, rects, screen, selected
-from site_helpers import login
+from site_helpers import collect_errors, login
 
 from webapp.facades.models import Segmentation
 
@@ -24,8 +24,7 @@ def small_screen(live_server, facade_photo, browser):
     photo, seg = facade_photo
     context = browser.new_context(viewport={"width": 1280, "height": 720})
     page = context.new_page()
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
+    errors = collect_errors(page, [])
     login(page, live_server.url, "alice", "alice-password-1")
     page.goto(f"{live_server.url}/photos/{photo['code']}/edit")
     page.wait_for_function(f"{E}?.seg?.size === {seg['rect_count']}")

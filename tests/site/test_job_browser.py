@@ -6,7 +6,7 @@ from __future__ import annotations
 import shutil
 
 import pytest
-from site_helpers import login
+from site_helpers import collect_errors, login
 
 from facaid.generator import generate
 from webapp.facades.models import Job, Procedure, Segmentation
@@ -21,8 +21,7 @@ def test_job_page_follows_the_stages_to_the_procedure(live_server, alice, facade
     job = Job.objects.create(owner=alice, segmentation=segmentation, status=Job.Status.RUNNING, progress=0.05,
                              stage="loading the model")
     page = browser.new_page(viewport={"width": 1200, "height": 800})
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
+    errors = collect_errors(page, [])  # script errors, and what the page's CSP refused
     login(page, live_server.url, "alice", "alice-password-1")
     page.goto(f"{live_server.url}/jobs/{job.code}")
     assert page.text_content("#stage") == "loading the model"

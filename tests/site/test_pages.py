@@ -105,8 +105,11 @@ def test_the_procedure_pages_3d_panel_loads_three_js_from_this_site(alice):
     owner = Client()
     owner.force_login(alice)
     for client, photo_visible in ((owner, True), (Client(), False)):  # the photo is private: the owner's glTF only
-        html = client.get(f"/procedures/{proc.code}").content.decode()
-        imports = json.loads(re.search(r'<script type="importmap">(.*?)</script>', html, re.S).group(1))["imports"]
+        r = client.get(f"/procedures/{proc.code}")
+        html = r.content.decode()
+        nonce, imports = re.search(r'<script type="importmap" nonce="([^"]+)">(.*?)</script>', html, re.S).groups()
+        assert f"script-src 'self' 'nonce-{nonce}';" in r["Content-Security-Policy"]  # the only inline script
+        imports = json.loads(imports)["imports"]
         assert imports == {"three": "/static/vendor/three/build/three.module.js",
                            "three/addons/": "/static/vendor/three/examples/jsm/"}
         panel = re.search(r'<details class="panel preview3d" id="preview3d"([^>]*)>', html).group(1)
@@ -124,8 +127,10 @@ def test_the_api_docs_page_names_only_files_of_this_site():
     assert r.status_code == 200 and r["Content-Type"].startswith("text/html")
     assert r["Cross-Origin-Opener-Policy"] == "same-origin"  # the site's, not drf-spectacular's unsafe-none
     html = r.content.decode()
-    assert '<header class="top">' in html and "SwaggerUIBundle" in html
-    urls = re.findall(r'(?:src|href)="([^"]*)"', html) + re.findall(r'url: "([^"]*)"', html)
+    assert '<header class="top">' in html and '<script src="/api/v1/docs?script="></script>' in html
+    script = Client().get("/api/v1/docs?script=")  # Swagger UI's set-up, a file of its own: the CSP runs no inline one
+    assert script["Content-Type"].startswith("application/javascript") and "SwaggerUIBundle" in script.text
+    urls = re.findall(r'(?:src|href)="([^"]*)"', html) + re.findall(r'url: "([^"]*)"', script.text)
     assert len(urls) > 5
     for url in urls:
         assert url.startswith("/") and not url.startswith("//") or url.startswith("data:"), url

@@ -11,7 +11,7 @@ import os
 import shutil
 
 import pytest
-from site_helpers import login
+from site_helpers import collect_errors, login
 
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
@@ -27,8 +27,7 @@ def open_as_alice(browser, live_server, proc: Procedure, viewport: dict, advance
     """Alice's browser on the procedure's page (with its raw tree opened, unless not ``advanced``), and the list its
     script errors are gathered in."""
     page = browser.new_page(viewport=viewport)
-    errors = []
-    page.on("pageerror", lambda e: errors.append(str(e)))
+    errors = collect_errors(page, [])  # script errors, and what the page's CSP refused
     login(page, live_server.url, "alice", "alice-password-1")
     page.goto(f"{live_server.url}/procedures/{proc.code}")
     if advanced:

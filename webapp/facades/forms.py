@@ -23,7 +23,7 @@ class RealSizeForm(forms.Form):
     """The facade's real width or height; its range is checked where the API's is (`PhotoSerializer`)."""
 
     side = forms.ChoiceField(choices=(("width", "width"), ("height", "height")), initial="width")
-    metres = forms.FloatField(required=False, widget=forms.NumberInput(attrs={"step": "0.01", "style": "width:7rem"}),
+    metres = forms.FloatField(required=False, widget=forms.NumberInput(attrs={"step": "0.01", "class": "metres"}),
                               help_text="empty: none (a storey is taken to be 3 m tall)")
 
 

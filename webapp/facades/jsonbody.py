@@ -1,13 +1,17 @@
-"""JSON request bodies with bounded nesting: the API's parser and the pages' pasted JSON read through here, so a
-document nested thousands of levels deep is a 400 naming the problem instead of a RecursionError (a 500), and
-nothing deeper than `MAX_DEPTH` reaches the code that stores or walks the data."""
+"""JSON request bodies with bounded nesting and text only: the API's parser and the pages' pasted JSON read through
+here, so a document nested thousands of levels deep is a 400 naming the problem instead of a RecursionError (a
+500), nothing deeper than `MAX_DEPTH` reaches the code that stores or walks the data, and no key or string in it
+holds an unpaired surrogate (``"\\ud800"``: JSON may write one, UTF-8 cannot, so echoing it in an error message,
+storing it or writing it to a file failed): a 400 that names the field. The API's answers are written by
+`JSONRenderer`, which cannot fail on such text either. (A NUL is text: the fields that cannot store one say so.)"""
 
 from __future__ import annotations
 
 import json
+import re
 from typing import Any
 
-from rest_framework import parsers
+from rest_framework import parsers, renderers
 from rest_framework.exceptions import ParseError
 
 from facaid.grammar.procedure import MAX_DEPTH as GRAMMAR_MAX_DEPTH
@@ -16,21 +20,43 @@ from facaid.grammar.procedure import MAX_DEPTH as GRAMMAR_MAX_DEPTH
 # [...]}}}) and its sizes' pairs 2 deeper; the grammar allows d <= 32 (facaid.grammar.procedure.MAX_DEPTH)
 MAX_DEPTH = 2 * GRAMMAR_MAX_DEPTH + 8
 
+# surrogates are text only in pairs, which a decoded JSON string holds as one character: any left is unpaired
+_NOT_TEXT = re.compile("[\ud800-\udfff]")
+
 
 class JSONError(ValueError):
-    """Malformed or too deeply nested JSON; the message says which."""
+    """Malformed or too deeply nested JSON, or a string that is not text; the message says which."""
 
 
-def depth_error(obj: Any, limit: int = MAX_DEPTH) -> str | None:
-    """The message for a document nested deeper than ``limit`` containers, else None. Walked without recursion,
-    with one iterator per open container: memory grows with the depth, not with the size."""
-    stack = [iter((obj,))]
+def _where(path: tuple) -> str:
+    out = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".")
+    return out or "the body"
+
+
+def _text_error(text: str, path: tuple, what: str = "") -> str | None:
+    bad = _NOT_TEXT.search(text)
+    if bad is None:
+        return None
+    return f"{what or _where(path)} holds an unpaired surrogate (U+{ord(bad.group()):04X}): not plain JSON text"
+
+
+def document_error(obj: Any, limit: int = MAX_DEPTH) -> str | None:
+    """The message for a document nested deeper than ``limit`` containers, or with a key or string that is not
+    plain text (naming where), else None. Walked without recursion, with one iterator per open container: memory
+    grows with the depth, not with the size."""
+    stack = [(iter(((None, obj),)), ())]
     while stack:
-        for value in stack[-1]:
+        items, where = stack[-1]
+        for key, value in items:
+            here = where if key is None else (*where, key)
+            if isinstance(key, str) and (message := _text_error(key, here, f"a key of {_where(where)}")):
+                return message
+            if isinstance(value, str) and (message := _text_error(value, here)):
+                return message
             if isinstance(value, dict | list):
                 if len(stack) > limit:
                     return f"JSON nested more than {limit} levels deep"
-                stack.append(iter(value.values() if isinstance(value, dict) else value))
+                stack.append((iter(value.items() if isinstance(value, dict) else enumerate(value)), here))
                 break
         else:
             stack.pop()
@@ -38,28 +64,43 @@ def depth_error(obj: Any, limit: int = MAX_DEPTH) -> str | None:
 
 
 def loads(raw: str | bytes) -> Any:
-    """`json.loads` with bounded nesting; raise `JSONError` with a message for a person."""
+    """`json.loads` with bounded nesting and plain text; raise `JSONError` with a message for a person."""
     try:
         obj = json.loads(raw)
     except RecursionError:
         raise JSONError(f"JSON nested more than {MAX_DEPTH} levels deep") from None
     except ValueError as exc:  # malformed, not UTF-8, or an integer of more digits than Python converts
         raise JSONError(f"not valid JSON: {exc}") from None
-    message = depth_error(obj)
+    message = document_error(obj)
     if message:
         raise JSONError(message)
     return obj
 
 
 class JSONParser(parsers.JSONParser):
-    """DRF's JSON parser (strict: no NaN or Infinity) with bounded nesting."""
+    """DRF's JSON parser (strict: no NaN or Infinity) with bounded nesting and plain text."""
 
     def parse(self, stream, media_type=None, parser_context=None):
         try:
             data = super().parse(stream, media_type, parser_context)
         except RecursionError:
             raise ParseError(f"JSON parse error - nested more than {MAX_DEPTH} levels deep") from None
-        message = depth_error(data)
+        message = document_error(data)
         if message:
             raise ParseError(f"JSON parse error - {message}")
         return data
+
+
+class JSONRenderer(renderers.JSONRenderer):
+    """DRF's JSON renderer, which writes text as UTF-8 or, where that cannot be done (an unpaired surrogate that
+    reached an answer some other way than a JSON body), escaped: the same JSON, not a 500."""
+
+    def render(self, data, accepted_media_type=None, renderer_context=None):
+        try:
+            return super().render(data, accepted_media_type, renderer_context)
+        except UnicodeEncodeError:
+            return _EscapedJSONRenderer().render(data, accepted_media_type, renderer_context)
+
+
+class _EscapedJSONRenderer(renderers.JSONRenderer):
+    ensure_ascii = True

@@ -79,6 +79,18 @@ class WholeNumberField(serializers.IntegerField):
         return super().to_internal_value(data)
 
 
+class StrictBooleanField(serializers.BooleanField):
+    """``true`` or ``false`` in a JSON body: DRF's BooleanField also takes 0, 1, "true", "yes" and "on", so that
+    ``"save": 0`` passed as a boolean (a form or multipart body sends its booleans as text and is read as before)."""
+
+    default_error_messages = {"invalid": "A boolean is required: true or false."}
+
+    def to_internal_value(self, data):
+        if not isinstance(data, bool) and _json_body(self):
+            self.fail("invalid")
+        return super().to_internal_value(data)
+
+
 def real_size_field(side: str) -> NumberField:
     lo, hi = REAL_SIZE_M
     return NumberField(min_value=lo, max_value=hi, required=False, allow_null=True,
@@ -287,7 +299,7 @@ class ProcedureWriteSerializer(SaveAsNewSerializer):
 
 
 class ProcedureEditSerializer(ProcedureWriteSerializer):
-    share_photo = serializers.BooleanField(
+    share_photo = StrictBooleanField(
         required=False,
         help_text="share the procedure's photo (yours) as widely as the procedure, so that viewers see the overlay")
 
@@ -371,8 +383,8 @@ class VariationsSerializer(serializers.Serializer):
 class ParametersSerializer(serializers.Serializer):
     values = serializers.DictField(child=NumberField(), allow_empty=True,
                                    help_text="named parameters to set, e.g. {\"floors\": 6}")
-    save = serializers.BooleanField(default=False, help_text="save the result as the procedure's next version "
-                                                             "(owner only); else it is only returned")
+    save = StrictBooleanField(default=False, help_text="save the result as the procedure's next version "
+                                                      "(owner only); else it is only returned")
     data = serializers.JSONField(required=False, help_text="the tree to edit (a procedure JSON, validated; default "
                                                            "the procedure's saved one): the page's unsaved edits")
 
