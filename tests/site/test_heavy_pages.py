@@ -116,3 +116,22 @@ def test_comparing_reads_each_tree_once_before_drawing_either(alice, as_charlie,
     settings.FACAID_REQUEST_WORK = work - 1
     r = as_charlie.get(f"{url}.png?a=1&b=2")
     assert r.status_code == 400 and "node instances in all" in r.json()["detail"]
+
+
+def test_a_download_is_charged_what_writing_its_rectangles_costs_before_it_is_written(alice, as_charlie, settings):
+    """IFC writes about 100 us a rectangle (bench/bench_request_cost.py): its cost is charged to the request's budget
+    with the tree's own, before a byte is written, so a tree it cannot write in its budget is a 400 at once."""
+    from facaid.grammar.layout import count_leaves
+    from webapp.facades.downloads import DOWNLOADS
+
+    tree = generate(3).procedure
+    proc = Procedure.objects.create(owner=alice, data=tree.to_dict(), visibility="public")
+    units = count_expansion(tree.root, tree.width, tree.height).instances
+    writing = DOWNLOADS["facade.ifc"].per_leaf * count_leaves(tree.root, tree.width, tree.height)
+    url = f"/api/v1/procedures/{proc.code}/download/facade.ifc"
+    settings.FACAID_REQUEST_WORK = units + writing
+    assert as_charlie.get(url).status_code == 200
+    settings.FACAID_REQUEST_WORK = units + writing - 1
+    r = as_charlie.get(url)
+    assert r.status_code == 400 and "node instances in all" in r.json()["detail"]
+    assert as_charlie.get(f"/api/v1/procedures/{proc.code}/download/procedure.json").status_code == 200

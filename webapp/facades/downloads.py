@@ -22,6 +22,8 @@ from facaid.formats.mesh import MeshTooLarge, procedure_mesh
 from facaid.formats.render import segmentation_svg
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
+from facaid.grammar.budget import charge
+from facaid.grammar.layout import count_leaves
 from webapp.facades import access, disclosure, rendering
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
@@ -38,6 +40,7 @@ class Download:
     build: Builder | None  # None: a picture kept in storage
     needs_photo: bool = False  # offered only where the procedure's photo is visible to the user
     scaled: bool = False  # in metres: takes ``metres_per_pixel``, else the scale of `download_scale`
+    per_leaf: int = 0  # work units (about a microsecond each) it takes a rectangle, charged before it is built
 
 
 def drawn_on_original(proc: Procedure) -> bool:
@@ -182,32 +185,32 @@ DOWNLOADS: dict[str, Download] = {
                                "meta names the metres per pixel where the photo's real size (or metres_per_pixel) "
                                "gives them", "application/json", _procedure_json),
     "segmentation.json": Download("the labelled rectangles it draws", "application/json",
-                                  lambda proc, tree, params, viewer: to_segmentation(tree).to_json()),
+                                  lambda proc, tree, params, viewer: to_segmentation(tree).to_json(), per_leaf=5),
     "segmentation.coco.json": Download("its elements as COCO object detection annotations, one box each (pieces of "
                                        "one element merged, the wall under them)", "application/json",
-                                       _annotations("coco")),
+                                       _annotations("coco"), per_leaf=15),
     "segmentation.labelme.json": Download("the same boxes as a LabelMe file", "application/json",
-                                          _annotations("labelme")),
+                                          _annotations("labelme"), per_leaf=15),
     "segmentation.cvat.xml": Download("the same boxes as CVAT for images XML", "application/xml",
-                                      _annotations("cvat")),
+                                      _annotations("cvat"), per_leaf=15),
     "labels.png": Download("the label map as a picture", "image/png", None),
     "labels.svg": Download("the label map as vector rectangles, one group per class", "image/svg+xml",
-                           lambda proc, tree, params, viewer: segmentation_svg(to_segmentation(tree))),
+                           lambda proc, tree, params, viewer: segmentation_svg(to_segmentation(tree)), per_leaf=3),
     "procedure.cga": Download("CityEngine CGA rules: apply Facade to a facade shape", "text/plain; charset=utf-8",
                               _cga, scaled=True),
     "mesh.zip": Download("a 3D relief mesh (OBJ and MTL) for Blender and other 3D tools", "application/zip",
-                         _metric(_mesh_zip), scaled=True),
+                         _metric(_mesh_zip), scaled=True, per_leaf=10),
     "facade.glb": Download("the relief as glTF (binary) for 3D tools and the web: a node per element with its label "
                            "and tree path, repeated ones as instances of one mesh, a material per class",
-                           "model/gltf-binary", _metric(_gltf(binary=True)), scaled=True),
+                           "model/gltf-binary", _metric(_gltf(binary=True)), scaled=True, per_leaf=20),
     "facade.gltf": Download("the same glTF as text, its data inline", "model/gltf+json", _metric(_gltf(binary=False)),
-                            scaled=True),
+                            scaled=True, per_leaf=20),
     "facade-photo.glb": Download("that glTF with the photo on the fronts", "model/gltf-binary",
-                                 _metric(_gltf(binary=True, photo=True)), needs_photo=True, scaled=True),
+                                 _metric(_gltf(binary=True, photo=True)), needs_photo=True, scaled=True, per_leaf=20),
     "facade.ifc": Download("IFC4 for BIM tools: a wall whose openings hold its windows and doors", "application/x-step",
-                           _metric(_ifc), scaled=True),
+                           _metric(_ifc), scaled=True, per_leaf=100),
     "facade.city.json": Download("CityJSON 2.0 for GIS: an LoD3 building with wall, window and door surfaces",
-                                 "application/city+json", _metric(_cityjson), scaled=True),
+                                 "application/city+json", _metric(_cityjson), scaled=True, per_leaf=80),
     "overlay.png": Download("the label map over the photo", "image/png", _overlay, needs_photo=True),
 }
 
@@ -215,4 +218,7 @@ DOWNLOADS: dict[str, Download] = {
 def build(name: str, proc: Procedure, params: Params, viewer) -> bytes | str:
     """The download ``name`` of a procedure (one with a builder) as ``viewer`` may have it (no real size or title of
     a photo they may not see); a `ValidationError` names a bad parameter."""
-    return DOWNLOADS[name].build(proc, parse_procedure(proc.data), params, viewer)
+    download, tree = DOWNLOADS[name], parse_procedure(proc.data)  # the tree's own units charged as it is read
+    if download.per_leaf:  # and what writing its rectangles costs, before any of it is written
+        charge(download.per_leaf * count_leaves(tree.root, tree.width, tree.height))
+    return download.build(proc, tree, params, viewer)
