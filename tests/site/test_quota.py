@@ -98,3 +98,29 @@ def test_a_large_tree_counts_as_stored_not_as_compressed(as_alice, alice, settin
     r = as_alice.post("/api/v1/procedures/", {"data": tree}, format="json")
     assert r.status_code == 400 and "procedures" in r.json()["detail"]
     assert Procedure.objects.count() == 1
+
+
+@pytest.mark.django_db(transaction=True)
+def test_migration_0008_measures_what_every_row_stores(alice, tmp_path):
+    from django.core.files.base import ContentFile
+    from django.core.files.storage import default_storage
+    from django.db import connection
+    from django.db.migrations.executor import MigrationExecutor
+
+    before = [("facades", "0007_compressed_versions")]
+    executor = MigrationExecutor(connection)
+    executor.migrate(before)
+    old = executor.loader.project_state(before).apps
+    name = default_storage.save("photos/p.png", ContentFile(image_bytes(size=(64, 48))))
+    photo = old.get_model("facades", "Photo").objects.create(owner_id=alice.id, title="p", image=name, width=64,
+                                                             height=48)
+    _, data = facade_png(3)
+    seg = old.get_model("facades", "Segmentation").objects.create(photo_id=photo.id, version=1, data=data)
+    tree = generate(3).procedure.to_dict()
+    proc = old.get_model("facades", "Procedure").objects.create(owner_id=alice.id, data=tree, digest="x")
+    executor = MigrationExecutor(connection)
+    executor.loader.build_graph()
+    executor.migrate(executor.loader.graph.leaf_nodes())
+    assert Photo.objects.get(id=photo.id).stored_bytes == len(image_bytes(size=(64, 48))) > 0
+    assert Segmentation.objects.get(id=seg.id).size == json_size(data)
+    assert Procedure.objects.get(id=proc.id).data_size == json_size(tree)

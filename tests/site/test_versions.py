@@ -401,6 +401,8 @@ def test_migration_0007_stores_every_version_compressed_and_keeps_its_tree(alice
     executor = MigrationExecutor(connection)
     executor.loader.build_graph()
     executor.migrate([("facades", "0007_compressed_versions")])
+    executor.loader.build_graph()
+    executor.migrate(executor.loader.graph.leaf_nodes())  # the later ones too: the tests after this one need them
     versions = ProcedureVersion.objects.filter(procedure_id=proc.id).order_by("version")
     assert [v.data for v in versions] == trees  # (PostgreSQL's jsonb kept them in its own key order)
     assert all(v.size == len(pack(v.data)) for v in versions)
