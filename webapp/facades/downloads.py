@@ -9,19 +9,19 @@ import zipfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from PIL import Image
 from rest_framework.exceptions import ValidationError
 
 from facaid.formats import interchange
 from facaid.formats.annotation import written_as
 from facaid.formats.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
 from facaid.formats.cityjson import cityjson_text, procedure_cityjson
-from facaid.formats.gltf import procedure_gltf
+from facaid.formats.gltf import MAX_TEXTURE, procedure_gltf
 from facaid.formats.ifc import procedure_ifc
 from facaid.formats.mesh import MeshTooLarge, procedure_mesh
 from facaid.formats.render import segmentation_svg
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
+from facaid.photo.files import read_photo
 from webapp.facades import access, rendering
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
@@ -137,8 +137,9 @@ def _gltf(binary: bool, photo: bool = False) -> Callable[[Procedure, Tree, float
         if not photo:
             return procedure_gltf(tree, scale, binary=binary, scale_from=source, name=proc.title or stem(proc))
         drawn = proc.photo.image if drawn_on_original(proc) else proc.photo.working_image()
-        with drawn.open("rb") as f:  # read as the texture needs it (`gltf._add_photo`), not at full size first
-            return procedure_gltf(tree, scale, binary=binary, photo=Image.open(f), scale_from=source,
+        with drawn.open("rb") as f:  # read at the texture's size (`gltf.MAX_TEXTURE`), not at full size first
+            texture = read_photo(f, mode="RGB", max_side=MAX_TEXTURE)
+            return procedure_gltf(tree, scale, binary=binary, photo=texture, scale_from=source,
                                   name=proc.title or stem(proc))
     return write
 
@@ -159,7 +160,7 @@ def _overlay(proc: Procedure, tree: Tree, params: Params) -> bytes:
     if not 0.0 <= alpha <= 1.0:
         raise ValidationError({"alpha": "alpha must be a number between 0 and 1"})
     with proc.photo.working_image().open("rb") as f:
-        return rendering.overlay_png(to_segmentation(tree), Image.open(f), alpha)
+        return rendering.overlay_png(to_segmentation(tree), f, alpha)
 
 
 def _annotations(fmt: str) -> Callable[[Procedure, Tree, Params], bytes]:
