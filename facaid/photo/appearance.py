@@ -20,6 +20,9 @@ PATCH = 12  # side of the patches compared: a window's panes and frame at any si
 FLAT = 0.5  # grey levels: a patch whose spread is below this (a flat colour, a render) has no appearance
 
 
+KEPT_SCALES = 2  # scaled copies of the levels a call keeps (the search's and the sharpening's: ≤ 1 + 16 MB)
+
+
 class Levels:
     """A photo's grey levels with what the searches and checks of one call share: the picture PIL resizes patches
     from (a copy of the levels, made once: it was made per search, most of a call's time with many types). The
@@ -30,6 +33,7 @@ class Levels:
         self.shape = grey_levels.shape
         self.scale = np.array([*scale, *scale], dtype=float)  # x, y, x, y: boxes in pixels of the segmentation
         self._image: Image.Image | None = None
+        self._scaled: dict[float, np.ndarray] = {}
 
     @property
     def image(self) -> Image.Image:
@@ -38,11 +42,18 @@ class Levels:
         return self._image
 
     def scaled(self, f: float) -> np.ndarray:
-        """The levels scaled by ``f`` (≤ 1; OpenCV's area average), made anew: a copy per scale kept for the call
+        """The levels scaled by ``f`` (≤ 1; OpenCV's area average; read only). The last `KEPT_SCALES` are kept: the
+        searches of most types ask for the same capped scales in turn, while a copy per scale kept for the call
         would hold up to 16 MB for each type searched."""
         import cv2
 
-        return self.array if f >= 1 else cv2.resize(self.array, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+        if f >= 1:
+            return self.array
+        if f not in self._scaled:
+            self._scaled[f] = cv2.resize(self.array, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+            while len(self._scaled) > KEPT_SCALES:
+                self._scaled.pop(next(iter(self._scaled)))
+        return self._scaled[f]
 
 
 def _levels(grey_levels: np.ndarray | Levels) -> Levels:
