@@ -14,10 +14,13 @@ from typing import Any
 import numpy as np
 from PIL import Image
 
-from facaid.photo.files import open_photo
+from facaid.photo.files import read_photo
 
 PATCH = 12  # side of the patches compared: a window's panes and frame at any size, little of the noise
 FLAT = 0.5  # grey levels: a patch whose spread is below this (a flat colour, a render) has no appearance
+
+
+KEPT_SCALES = 2  # scaled copies of the levels a call keeps (the search's and the sharpening's: ≤ 1 + 16 MB)
 
 
 class Levels:
@@ -30,6 +33,7 @@ class Levels:
         self.shape = grey_levels.shape
         self.scale = np.array([*scale, *scale], dtype=float)  # x, y, x, y: boxes in pixels of the segmentation
         self._image: Image.Image | None = None
+        self._scaled: dict[float, np.ndarray] = {}
 
     @property
     def image(self) -> Image.Image:
@@ -38,11 +42,18 @@ class Levels:
         return self._image
 
     def scaled(self, f: float) -> np.ndarray:
-        """The levels scaled by ``f`` (≤ 1; OpenCV's area average), made anew: a copy per scale kept for the call
+        """The levels scaled by ``f`` (≤ 1; OpenCV's area average; read only). The last `KEPT_SCALES` are kept: the
+        searches of most types ask for the same capped scales in turn, while a copy per scale kept for the call
         would hold up to 16 MB for each type searched."""
         import cv2
 
-        return self.array if f >= 1 else cv2.resize(self.array, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+        if f >= 1:
+            return self.array
+        if f not in self._scaled:
+            self._scaled[f] = cv2.resize(self.array, None, fx=f, fy=f, interpolation=cv2.INTER_AREA)
+            while len(self._scaled) > KEPT_SCALES:
+                self._scaled.pop(next(iter(self._scaled)))
+        return self._scaled[f]
 
 
 def _levels(grey_levels: np.ndarray | Levels) -> Levels:
@@ -56,8 +67,8 @@ def levels(photo: Any, width: int, height: int, max_pixels: int = WORK_PIXELS) -
     """The grey levels of a photo (a PIL image, a path, a file, an (H, W) / (H, W, C) array, or `Levels` already,
     returned as they are) for a segmentation of ``width`` x ``height``, at most ``max_pixels`` of them: a larger one
     is read at a smaller scale, and the answers about boxes are still in the segmentation's pixels. A path or file
-    is opened here and let go once it is grey (a JPEG decoded at a reduced scale already), so the call holds one
-    full-size decoded copy at most for a moment."""
+    is opened here and let go once it is grey (a JPEG decoded at a reduced scale already, a WebP scaled as it is
+    decoded), so the call holds one full-size decoded copy at most for a moment."""
     if isinstance(photo, Levels):
         return photo
     s = min(1.0, float(np.sqrt(max_pixels / max(1, width * height))))
@@ -71,9 +82,8 @@ def levels(photo: Any, width: int, height: int, max_pixels: int = WORK_PIXELS) -
         image = Image.fromarray(array, "F")
     elif isinstance(photo, Image.Image):
         image = photo.convert("L")
-    else:
-        # upright as a viewer shows it; a large JPEG decodes at a reduced scale (at scale 1, the full decode)
-        image = open_photo(photo, draft=(tw, th) if s < 1 else None, grey=True)
+    else:  # upright as a viewer shows it, read at a reduced size (`read_photo`): one full-size decode at most
+        image = read_photo(photo, (tw, th), "L")
     if image.size != (tw, th):
         image = image.resize((tw, th), Image.Resampling.BILINEAR)
     return Levels(np.asarray(image, dtype=np.float32), (tw / width, th / height))

@@ -9,21 +9,21 @@ import zipfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from PIL import Image
 from rest_framework.exceptions import ValidationError
 
 from facaid.formats import interchange
 from facaid.formats.annotation import written_as
 from facaid.formats.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
 from facaid.formats.cityjson import cityjson_text, procedure_cityjson
-from facaid.formats.gltf import procedure_gltf
+from facaid.formats.gltf import MAX_TEXTURE, procedure_gltf
 from facaid.formats.ifc import procedure_ifc
-from facaid.formats.mesh import MeshTooLarge, procedure_mesh
+from facaid.formats.mesh import MAX_MESH_RECTS, MeshTooLarge, procedure_mesh
 from facaid.formats.render import segmentation_svg
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
 from facaid.grammar.budget import charge
 from facaid.grammar.layout import count_leaves
+from facaid.photo.files import read_photo
 from webapp.facades import access, disclosure, rendering
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
@@ -149,8 +149,9 @@ def _gltf(binary: bool, photo: bool = False) -> Callable[[Procedure, Tree, float
         if not photo:
             return procedure_gltf(tree, scale, binary=binary, scale_from=source, name=name)
         drawn = proc.photo.image if drawn_on_original(proc) else proc.photo.working_image()
-        with drawn.open("rb") as f:  # read as the texture needs it (`gltf._add_photo`), not at full size first
-            return procedure_gltf(tree, scale, binary=binary, photo=Image.open(f), scale_from=source, name=name)
+        with drawn.open("rb") as f:  # read at the texture's size (`gltf.MAX_TEXTURE`), not at full size first
+            texture = read_photo(f, mode="RGB", max_side=MAX_TEXTURE)
+            return procedure_gltf(tree, scale, binary=binary, photo=texture, scale_from=source, name=name)
     return write
 
 
@@ -170,7 +171,7 @@ def _overlay(proc: Procedure, tree: Tree, params: Params, viewer) -> bytes:
     if not 0.0 <= alpha <= 1.0:
         raise ValidationError({"alpha": "alpha must be a number between 0 and 1"})
     with proc.photo.working_image().open("rb") as f:
-        return rendering.overlay_png(to_segmentation(tree), Image.open(f), alpha)
+        return rendering.overlay_png(to_segmentation(tree), f, alpha)
 
 
 def _annotations(fmt: str) -> Builder:
@@ -219,6 +220,8 @@ def build(name: str, proc: Procedure, params: Params, viewer) -> bytes | str:
     """The download ``name`` of a procedure (one with a builder) as ``viewer`` may have it (no real size or title of
     a photo they may not see); a `ValidationError` names a bad parameter."""
     download, tree = DOWNLOADS[name], parse_procedure(proc.data)  # the tree's own units charged as it is read
-    if download.per_leaf:  # and what writing its rectangles costs, before any of it is written
-        charge(download.per_leaf * count_leaves(tree.root, tree.width, tree.height))
+    if download.per_leaf:  # and what writing its rectangles costs, before any of it is written (the 3D formats
+        # refuse more than MAX_MESH_RECTS once they are laid out, so no more are charged: those say how many)
+        leaves = count_leaves(tree.root, tree.width, tree.height)
+        charge(download.per_leaf * (min(leaves, MAX_MESH_RECTS) if download.scaled else leaves))
     return download.build(proc, tree, params, viewer)

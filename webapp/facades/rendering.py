@@ -2,7 +2,7 @@
 
 A request's cost is bounded by what is drawn, not by what a procedure declares: the rectangles are scaled to the
 picture (at most `MAX_RENDER_SIDE` a side) and painted there, so a 16,384 px facade costs what a 2,048 px one
-does. Photos are decoded at reduced size where the format allows (JPEG) and shrunk before they are converted.
+does. Photos are read at the picture's size (`facaid.photo.files.read_photo`).
 `bench/bench_render_memory.py` measures the peak memory of each picture request."""
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from facaid.formats.render import colorize
 from facaid.grammar import Procedure as Tree
 from facaid.labels import PRIORITY
 from facaid.metrics import scaled_procedure_map
+from facaid.photo.files import read_photo
 from facaid.segmentation import Segmentation as SegmentationData
 
 MAX_RENDER_SIDE = 2048
@@ -62,23 +63,15 @@ def label_map_png(seg: SegmentationData, max_side: int = MAX_RENDER_SIDE) -> byt
     return _png(colorize(label_map(seg, max_side)))
 
 
-def photo_at(photo: Image.Image, size: tuple[int, int]) -> Image.Image:
-    """An opened (not yet decoded) photo as RGB at ``size``: a JPEG decodes at the nearest larger DCT scale,
-    and the rest is shrunk in its own mode before the conversion, so no full-size RGB copy is made."""
-    photo.draft("RGB", size)  # JPEG only; a no-op for other formats
-    if photo.size != size:
-        photo = photo.resize(size, Image.Resampling.BILINEAR, reducing_gap=2.0)
-    return photo.convert("RGB")
-
-
-def overlay_png(seg: SegmentationData, photo: Image.Image, alpha: float = 0.5,
-                max_side: int = MAX_RENDER_SIDE) -> bytes:
-    """The label map over the photo (stretched to the segmentation's size), ``alpha`` opaque."""
+def overlay_png(seg: SegmentationData, photo, alpha: float = 0.5, max_side: int = MAX_RENDER_SIDE) -> bytes:
+    """The label map over the photo (a path or an open file; stretched to the segmentation's size), ``alpha``
+    opaque. The photo is read at the picture's size (`facaid.photo.files.read_photo`: a JPEG at its nearest larger
+    DCT scale, the rest shrunk strip by strip in RGB), so no full-size RGB copy is made."""
     if not 0.0 <= alpha <= 1.0:
         raise ValueError(f"alpha must be between 0 and 1, got {alpha!r}")
     labels = label_map(seg, max_side)
     size = (labels.shape[1], labels.shape[0])
-    return _png(Image.blend(photo_at(photo, size), colorize(labels), alpha))
+    return _png(Image.blend(read_photo(photo, size, "RGB"), colorize(labels), alpha))
 
 
 def common_maps(a: Tree, b: Tree, max_side: int = COMPARE_SIDE) -> tuple[np.ndarray, np.ndarray]:
