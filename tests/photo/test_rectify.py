@@ -192,3 +192,30 @@ def test_cli_rectify_refuses_a_file_that_is_no_image(tmp_path, capsys):
     (tmp_path / "x.png").write_text("not a picture")
     assert main(["rectify", str(tmp_path / "x.png"), "--propose"]) == 2
     assert "not an image" in capsys.readouterr().err
+
+
+def test_the_whole_photo_as_its_own_quadrilateral_comes_back_as_it_was():
+    """Pixel centres line up: the identity warp moves no pixel (OpenCV samples at whole coordinates, the corners
+    are continuous ones)."""
+    _, photo, _ = scene(2)
+    w, h = photo.size
+    out = np.asarray(rectify(photo, [[0, 0], [w, 0], [w, h], [0, h]], size=(w, h)), dtype=float)
+    assert np.abs(out - np.asarray(photo.convert("RGB"), dtype=float)).max() <= 1
+
+
+def test_a_large_jpeg_is_read_at_a_reduced_scale_and_rectifies_as_the_full_one():
+    """A JPEG four times larger than what its rectified image needs is decoded at half its scale or less, and the
+    result is the full-scale rectification within a few grey levels."""
+    import io
+
+    from facaid.photo.rectify import rectify_file
+
+    facade, photo, true = scene(5)
+    big = photo.resize((photo.width * 4, photo.height * 4), Image.Resampling.BICUBIC)
+    buf = io.BytesIO()
+    big.save(buf, "JPEG", quality=95)
+    corners = [[4 * x, 4 * y] for x, y in true]
+    reduced = rectify_file(io.BytesIO(buf.getvalue()), corners, max_pixels=facade.width * facade.height)
+    full = rectify(Image.open(io.BytesIO(buf.getvalue())), corners, size=reduced.size)
+    diff = np.abs(np.asarray(reduced, dtype=float) - np.asarray(full, dtype=float)).mean()
+    assert reduced.size == full.size and diff < 3, diff

@@ -32,7 +32,7 @@ def photo_path(photo: Photo, filename: str) -> str:
 
 
 def rectified_path(photo: Photo, filename: str) -> str:
-    return f"photos/{photo.code}/rectified.png"
+    return f"photos/{photo.code}/rectified.{filename.rsplit('.', 1)[-1].lower()}"  # .jpg (.png before issue 66)
 
 
 class Photo(models.Model):
