@@ -8,6 +8,7 @@ overlap; `flatten` resolves overlaps by the paint order of `facaid.labels` and `
 
 from __future__ import annotations
 
+import bisect
 import json
 from dataclasses import dataclass
 from typing import Any, NamedTuple
@@ -273,16 +274,26 @@ def aligned_lines(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
     their horizontal ones): sorted by centre, an interval joins the line before it
     when it overlaps that line's median interval by at least half its own length."""
     order = np.argsort((lo + hi) / 2, kind="stable")
-    lines: list[list[int]] = []
+    los, his = np.asarray(lo, dtype=np.float64).tolist(), np.asarray(hi, dtype=np.float64).tolist()
+    lines: list[tuple[list[int], list[float], list[float]]] = []  # members, and their lo and hi kept sorted
     for i in order.tolist():
         if lines:
-            members = lines[-1]
-            a, b = np.median(lo[members]), np.median(hi[members])
-            if min(b, hi[i]) - max(a, lo[i]) >= 0.5 * (hi[i] - lo[i]):
+            members, ends_lo, ends_hi = lines[-1]
+            a, b = _sorted_median(ends_lo), _sorted_median(ends_hi)
+            if min(b, his[i]) - max(a, los[i]) >= 0.5 * (his[i] - los[i]):
                 members.append(i)
+                bisect.insort(ends_lo, los[i])
+                bisect.insort(ends_hi, his[i])
                 continue
-        lines.append([i])
-    return [np.array(m) for m in lines]
+        lines.append(([i], [los[i]], [his[i]]))
+    return [np.array(m) for m, _, _ in lines]
+
+
+def _sorted_median(values: list[float]) -> float:
+    """The median of sorted values, as `np.median` has it (the mean of the middle two of an even count): a line's
+    median kept as it grows, where `np.median` took 25 us a call (2,000 rectangles: 0.3 s)."""
+    n = len(values)
+    return values[n // 2] if n % 2 else (values[n // 2 - 1] + values[n // 2]) / 2
 
 
 def region_roots(boxes: np.ndarray) -> np.ndarray:

@@ -2,8 +2,9 @@
 
 `read_photo` bounds what a read holds: a JPEG decodes at the smallest of its DCT scales (1/2, 1/4, 1/8) that is
 still at least the size asked for (`draft`); a WebP is scaled by libwebp while it decodes (`facaid.photo.webp`); a
-PNG, which can do neither, decodes whole once and is converted and resized strip by strip (`resized`), so no second
-full-size copy exists (PIL's own conversion, or a resize of an image with alpha, which premultiplies, makes one).
+PNG asked for at half its size or less is decoded so by OpenCV, 2, 4 or 8 times smaller (`_png_reduced`), else
+it decodes whole once and is converted and resized strip by strip (`resized`), so no second full-size copy exists
+(PIL's own conversion, or a resize of an image with alpha, which premultiplies, makes one).
 Modes are converted and the EXIF orientation applied after the reduction, on the small picture.
 """
 
@@ -20,7 +21,10 @@ STRIP_PIXELS = 1 << 20  # source pixels converted at a time (4 MB of RGBA): copi
 
 
 def orientation(image: Image.Image) -> int:
-    """The EXIF orientation of an opened photo (1: stored upright)."""
+    """The EXIF orientation of an opened photo (1: stored upright). A PNG's is read from an eXIf chunk before its
+    pixels only: PIL looks for one after them by decoding the whole picture first (0.2 s for 40 MP)."""
+    if image.format == "PNG" and "exif" not in image.info:
+        return 1
     return image.getexif().get(ORIENTATION, 1)
 
 
@@ -61,6 +65,8 @@ def read_photo(source: Any, size: tuple[int, int] | None = None, mode: str | Non
         stored = size[::-1] if size is not None and turn in TURNED else size  # in the stored pixels' axes
         if raw.format == "WEBP":
             image = _webp(raw, stored, mode)
+        elif raw.format == "PNG" and (reduced := _png_reduced(source, raw, stored, mode)) is not None:
+            image = reduced
         else:
             if stored is not None:
                 raw.draft(mode if mode in ("RGB", "L") else None, stored)  # JPEG only; a no-op for the rest
@@ -79,6 +85,38 @@ def read_photo(source: Any, size: tuple[int, int] | None = None, mode: str | Non
 TRANSPOSE = {2: Image.Transpose.FLIP_LEFT_RIGHT, 3: Image.Transpose.ROTATE_180, 4: Image.Transpose.FLIP_TOP_BOTTOM,
              5: Image.Transpose.TRANSPOSE, 6: Image.Transpose.ROTATE_270, 7: Image.Transpose.TRANSVERSE,
              8: Image.Transpose.ROTATE_90}  # what each EXIF orientation asks for (as `ImageOps.exif_transpose`)
+
+
+def _png_reduced(source: Any, raw: Image.Image, size: tuple[int, int] | None, mode: str | None) -> Image.Image | None:
+    """A PNG at ``size`` in ``mode`` (L or RGB) by OpenCV's reduced decode, where ``size`` is half its own or less
+    (it decodes and shrinks by 2, 4 or 8 a row at a time: a 40 MP PNG to grey levels in 0.18 s, where PIL's decode
+    and strip-wise resize took 0.4 s), then shrunk to ``size`` by area; None where that does not apply."""
+    if size is None or mode not in ("L", "RGB"):
+        return None
+    factor = next((f for f in (8, 4, 2) if raw.width // f >= size[0] and raw.height // f >= size[1]), 1)
+    if factor == 1:
+        return None
+    import cv2
+    import numpy as np
+
+    flags = {("L", 2): cv2.IMREAD_REDUCED_GRAYSCALE_2, ("L", 4): cv2.IMREAD_REDUCED_GRAYSCALE_4,
+             ("L", 8): cv2.IMREAD_REDUCED_GRAYSCALE_8, ("RGB", 2): cv2.IMREAD_REDUCED_COLOR_2,
+             ("RGB", 4): cv2.IMREAD_REDUCED_COLOR_4, ("RGB", 8): cv2.IMREAD_REDUCED_COLOR_8}
+    if hasattr(source, "read"):
+        source.seek(0)
+        data = source.read()
+    else:
+        with open(source, "rb") as f:
+            data = f.read()
+    pixels = cv2.imdecode(np.frombuffer(data, dtype=np.uint8), flags[mode, factor] | cv2.IMREAD_IGNORE_ORIENTATION)
+    del data
+    if pixels is None or pixels.dtype != np.uint8:
+        return None
+    if (pixels.shape[1], pixels.shape[0]) != tuple(size):
+        pixels = cv2.resize(pixels, tuple(size), interpolation=cv2.INTER_AREA)
+    if mode == "RGB":
+        pixels = cv2.cvtColor(pixels, cv2.COLOR_BGR2RGB)
+    return Image.fromarray(pixels, mode)
 
 
 def _webp(raw: Image.Image, size: tuple[int, int] | None, mode: str | None) -> Image.Image:

@@ -137,3 +137,28 @@ def test_schema_accepts_what_the_parser_accepts(cmp_records):
     schema = json.loads((Path(facaid.__file__).parent / "segmentation.schema.json").read_text())
     for rec in cmp_records[:5]:
         jsonschema.validate(rec, schema)
+
+
+def _aligned_lines_reference(lo, hi):
+    """`aligned_lines` as it was written first, with `np.median` of each line's members at every step."""
+    order = np.argsort((lo + hi) / 2, kind="stable")
+    lines = []
+    for i in order.tolist():
+        if lines:
+            members = lines[-1]
+            a, b = np.median(lo[members]), np.median(hi[members])
+            if min(b, hi[i]) - max(a, lo[i]) >= 0.5 * (hi[i] - lo[i]):
+                members.append(i)
+                continue
+        lines.append([i])
+    return [np.array(m) for m in lines]
+
+
+@given(st.lists(st.tuples(st.integers(0, 400), st.integers(1, 60)), min_size=1, max_size=200), st.booleans())
+def test_aligned_lines_keep_each_lines_median_as_np_median_has_it(intervals, floats):
+    from facaid.segmentation import aligned_lines
+
+    lo = np.array([a for a, _ in intervals], dtype=float if floats else np.int64)
+    hi = lo + np.array([n for _, n in intervals], dtype=lo.dtype) / (3 if floats else 1)
+    got, want = aligned_lines(lo, hi), _aligned_lines_reference(lo, hi)
+    assert [m.tolist() for m in got] == [m.tolist() for m in want]
