@@ -95,18 +95,19 @@ def patches(grey_levels: np.ndarray | Levels, boxes: np.ndarray) -> tuple[np.nda
     h, w = levels.shape
     image = levels.image
     out = np.zeros((len(boxes), PATCH * PATCH), dtype=np.float32)
-    flat = np.ones(len(boxes), dtype=bool)
+    drawn = np.zeros(len(boxes), dtype=bool)
     for i, (x0, y0, x1, y1) in enumerate(np.asarray(boxes, dtype=float).tolist()):
         x0, y0, x1, y1 = max(0, int(x0)), max(0, int(y0)), min(w, int(round(x1))), min(h, int(round(y1)))
         if x1 - x0 < 1 or y1 - y0 < 1:
             continue
-        patch = np.asarray(image.resize((PATCH, PATCH), Image.Resampling.BILINEAR, box=(x0, y0, x1, y1)),
-                           dtype=np.float32).ravel()
-        patch = patch - patch.mean()
-        spread = float(np.sqrt((patch**2).mean()))
-        if spread >= FLAT:
-            out[i] = patch / (spread * np.sqrt(patch.size))
-            flat[i] = False
+        out[i] = np.asarray(image.resize((PATCH, PATCH), Image.Resampling.BILINEAR, box=(x0, y0, x1, y1)),
+                            dtype=np.float32).ravel()
+        drawn[i] = True
+    out -= out.mean(axis=1, keepdims=True)  # normalized all at once (one patch at a time took a third of the time)
+    spread = np.sqrt((out**2).mean(axis=1))
+    flat = ~drawn | (spread < FLAT)
+    out[flat] = 0.0
+    out[~flat] /= (spread[~flat] * np.float32(np.sqrt(PATCH * PATCH)))[:, None]
     return out, flat
 
 

@@ -128,6 +128,7 @@ class _Reading:
         self.to_work = levels.scale * f  # segmentation pixels to working pixels (x, y, x, y)
         self.boxes = drawn[:, 1:] * self.to_work
         self.crops = [None if self.flat else _crop(self.norm, b) for b in self.boxes]
+        self.cores: dict[int, np.ndarray | None] = {}  # each element alone (no context), where it is not flat
 
     def shifts(self, support: int) -> list[tuple[int, int]]:
         """The repeats (working pixels) that ``support`` drawn elements or more vote for, and their sums."""
@@ -143,6 +144,15 @@ class _Reading:
         sx, sy = _shifts(votes[0], tol, support), _shifts(votes[1], tol, support)
         return ([(dx, 0) for dx in sx] + [(0, dy) for dy in sy]
                 + [(dx, dy) for dx in sx[:MAX_SUMS] for dy in sy[:MAX_SUMS]])
+
+    def _core(self, k: int) -> np.ndarray | None:
+        """Element ``k``'s patch without its context, None where that is too small or flat: read once, for every
+        shift it is carried by."""
+        if k not in self.cores:
+            patch, (mx, my) = self.crops[k]
+            core = patch[my: patch.shape[0] - my, mx: patch.shape[1] - mx]
+            self.cores[k] = core if min(core.shape) >= 3 and core.std() > 1e-3 else None
+        return self.cores[k]
 
     def carry(self, k: int, shift: tuple[int, int]) -> tuple[np.ndarray, float] | None:
         """Element ``k`` carried by ``shift`` to where the photo looks most like it (within `JITTER`): (its box in
@@ -160,10 +170,10 @@ class _Reading:
             return None
         r = cv2.matchTemplate(self.norm[t: t + ph + 2 * JITTER, a: a + pw + 2 * JITTER], patch, cv2.TM_CCOEFF_NORMED)
         r = np.where(np.isfinite(r), r, -1.0)
-        iy, ix = np.unravel_index(int(r.argmax()), r.shape)
+        iy, ix = divmod(int(r.argmax()), r.shape[1])
         sim = float(r[iy, ix])
-        core = patch[my: ph - my, mx: pw - mx]  # the element alone: what its context shares with its neighbours'
-        if min(core.shape) >= 3 and core.std() > 1e-3:
+        core = self._core(k)  # the element alone: what its context shares with its neighbours'
+        if core is not None:
             there = self.norm[t + iy + my: t + iy + ph - my, a + ix + mx: a + ix + pw - mx]
             sim = min(sim, float(cv2.matchTemplate(there, core, cv2.TM_CCOEFF_NORMED)[0, 0]))
         dx, dy = (a + ix - x) / self.to_work[0], (t + iy - y) / self.to_work[1]  # in the segmentation's pixels
