@@ -5,7 +5,9 @@ Each tree is bounded on its own when it is parsed or validated (`limits.MAX_INST
 edit validates a tree per value, a variation per variant. `work_budget` bounds their sum: every validation inside it
 charges the tree's instances, and the one past the budget raises `WorkLimitError`, before that tree's work is done.
 Instances do not price every step alike (setting a named parameter of a tree with many exceptions costs more than
-laying it out), so a budget may also bound the CPU seconds its thread spends, checked at each charge.
+laying it out), so a budget may also bound the CPU seconds its thread spends, checked at each charge. A request
+that is about to make many trees (n variants, k parameter values) `reserve`s them first, so that it is refused
+before the first is made rather than after the work it could pay for.
 The site opens one budget per request (`webapp.middleware.WorkBudgetMiddleware`); outside a budget nothing is
 counted (the command line and the worker, whose jobs have their own limits).
 """
@@ -49,6 +51,17 @@ def charge(instances: int) -> None:
         raise WorkLimitError(
             f"this request needs more than {budget[2]:g} s of computing: ask for less at once (fewer values or "
             "variants) or use a smaller tree")
+
+
+def reserve(instances: int) -> None:
+    """Refuse now, before any of it is done, work the current budget cannot pay: ``instances`` more than it has
+    spent (the trees a request is about to make, charged again as each is made). Outside a budget, nothing."""
+    budget = _budget.get()
+    if budget is not None and budget[1] + instances > budget[0]:
+        raise WorkLimitError(
+            f"this request would lay out more than {int(budget[0]):,} node instances in all (every tree it reads or "
+            "makes, each node once per copy of it): ask for less at once (fewer values or variants) or use a "
+            "smaller tree")
 
 
 def spent() -> int | None:

@@ -135,3 +135,23 @@ def test_a_download_is_charged_what_writing_its_rectangles_costs_before_it_is_wr
     r = as_charlie.get(url)
     assert r.status_code == 400 and "node instances in all" in r.json()["detail"]
     assert as_charlie.get(f"/api/v1/procedures/{proc.code}/download/procedure.json").status_code == 200
+
+
+def test_variations_and_parameter_edits_are_refused_before_their_trees_are_made(alice, as_charlie, settings):
+    """A request for n variants or k values is charged n (k) trees before one is made: past the budget, a 400 at
+    once, where it was one after the work (32 variations of a 95,474-unit tree: 2 s, then a 400)."""
+    from webapp.facades.api.procedures import PARAMETER_WORK, VARIANT_WORK
+
+    tree = generate(3).procedure
+    proc = Procedure.objects.create(owner=alice, data=tree.to_dict(), visibility="public")
+    units = count_expansion(tree.root, tree.width, tree.height).instances
+    settings.FACAID_REQUEST_WORK = units * (1 + 2 * VARIANT_WORK)
+    url = f"/api/v1/procedures/{proc.code}"
+    assert as_charlie.post(f"{url}/variations", {"n": 2}, format="json").status_code == 200
+    r = as_charlie.post(f"{url}/variations", {"n": 3}, format="json")
+    assert r.status_code == 400 and "node instances in all" in r.json()["detail"]
+    settings.FACAID_REQUEST_WORK = units * (1 + 2 * PARAMETER_WORK)
+    values = {"width": tree.width + 20, "height": tree.height + 20}
+    assert as_charlie.post(f"{url}/parameters", {"values": values}, format="json").status_code == 200
+    r = as_charlie.post(f"{url}/parameters", {"values": {**values, "floor_height": 90}}, format="json")
+    assert r.status_code == 400 and "node instances in all" in r.json()["detail"]

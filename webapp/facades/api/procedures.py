@@ -18,6 +18,8 @@ from rest_framework.response import Response
 
 from facaid.formats.relief import MAX_MESH_RECTS, drawn_leaves
 from facaid.grammar import to_segmentation
+from facaid.grammar.budget import reserve
+from facaid.grammar.layout import count_expansion
 from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
 from facaid.parameters import named_parameters, set_parameters
@@ -126,12 +128,24 @@ def procedure_variations(request, code):
     form.is_valid(raise_exception=True)
     try:
         ranges = {k: tuple(v) for k, v in form.validated_data.get("ranges", {}).items()} or None
-        variants = vary(parse_procedure(proc.data), form.validated_data["n"], form.validated_data["seed"], ranges)
+        tree = parse_procedure(proc.data)
+        reserve(VARIANT_WORK * form.validated_data["n"] * _units(tree))  # the variants, refused before they are made
+        variants = vary(tree, form.validated_data["n"], form.validated_data["seed"], ranges)
     except (ProcedureError, ValueError) as exc:
         field = "ranges" if form.validated_data.get("ranges") else "data"
         raise ValidationError({field: f"no variations of this procedure: {exc}"}) from None
     shown = disclosure.tree if disclosure.hidden(request.user, proc) else dict  # no accuracy of a private photo's
     return Response({"variants": [shown(v.to_dict()) for v in variants]})
+
+
+# what making a variant, or setting a named parameter, costs per unit of its tree's (`count_expansion`), measured on
+# the heaviest accepted trees (bench/bench_request_cost.py: 3.8 and 2.5 us a unit, where laying a tree out is 1)
+VARIANT_WORK = 4
+PARAMETER_WORK = 3
+
+
+def _units(tree) -> int:
+    return count_expansion(tree.root, tree.width, tree.height).instances
 
 
 def _leaves(tree) -> list | None:
@@ -163,8 +177,9 @@ def procedure_parameters(request, code):
     if form.validated_data["save"]:  # refused before the work, not after it
         proc = access.get_rw_procedure_for_user(request.user, code)
     try:
-        tree = form.validated_data.get("data") or proc.data
-        edited = set_parameters(parse_procedure(tree), form.validated_data["values"])
+        tree = parse_procedure(form.validated_data.get("data") or proc.data)
+        reserve(PARAMETER_WORK * len(form.validated_data["values"]) * _units(tree))  # a tree a value, at least
+        edited = set_parameters(tree, form.validated_data["values"])
     except (ProcedureError, ValueError) as exc:
         raise ValidationError({"values": str(exc)}) from None
     answer = {"data": edited.to_dict(), "parameters": [p.to_dict() for p in named_parameters(edited)],
