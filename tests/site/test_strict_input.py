@@ -7,6 +7,8 @@ from __future__ import annotations
 import json
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from site_helpers import facade_png
 
 from facaid.generator import generate
@@ -125,3 +127,27 @@ def test_a_boolean_is_true_or_false_only(as_alice, alice, world, bad):
     assert r.status_code == 200 and r.json()["visibility"] == "public"
     r = raw(as_alice, "POST", f"/api/v1/procedures/{code}/parameters", {"values": {}, "save": False})
     assert r.status_code == 200, r.content[:300]
+
+
+_JSON = st.recursive(st.none() | st.booleans() | st.integers() | st.text(), lambda inner: st.lists(inner, max_size=4)
+                     | st.dictionaries(st.text(max_size=5), inner, max_size=4), max_leaves=40)
+
+
+@given(_JSON, st.integers(1, 8))
+def test_the_quick_scan_passes_only_what_the_walk_passes(value, limit):
+    """`plainly_fine` reads the text (brackets outside strings, surrogates written or escaped) in C-speed scans:
+    whatever it passes, the walk over every value passes too (it may leave one to the walk, never pass a bad one)."""
+    from webapp.facades.jsonbody import document_error, plainly_fine
+
+    for text in (json.dumps(value), json.dumps(value, ensure_ascii=False)):
+        if plainly_fine(text, limit):
+            assert document_error(json.loads(text), limit) is None, text
+
+
+def test_the_quick_scan_counts_brackets_outside_strings_only():
+    from webapp.facades.jsonbody import plainly_fine
+
+    assert plainly_fine('{"a": "[[[[[[[[[[{{{{{{{{{{", "b": [[1]]}', 3)
+    assert not plainly_fine('{"a": [[[[1]]]]}', 3)
+    assert not plainly_fine('{"a": "\\udfff"}') and not plainly_fine('["\\ud83d\\ude00"]')  # left to the walk
+    assert plainly_fine('{"a": "\\\\[\\"]"}', 1)

@@ -11,8 +11,11 @@ import json
 import re
 from typing import Any
 
+import numpy as np
+from django.conf import settings
 from rest_framework import parsers, renderers
 from rest_framework.exceptions import ParseError
+from rest_framework.utils import json as drf_json
 
 from facaid.grammar.procedure import MAX_DEPTH as GRAMMAR_MAX_DEPTH
 
@@ -63,6 +66,27 @@ def document_error(obj: Any, limit: int = MAX_DEPTH) -> str | None:
     return None
 
 
+_STRING = re.compile(r'"[^"\\]*(?:\\.[^"\\]*)*"', re.S)  # a JSON string literal, escapes and all
+_NOT_BRACKET = re.compile(r"[^\[\]{}]+")
+_SURROGATE_ESCAPE = re.compile(r"\\u[dD][89a-fA-F]")  # a surrogate written as an escape (paired or not)
+
+
+def plainly_fine(raw: str | bytes, limit: int = MAX_DEPTH) -> bool:
+    """Whether a document that parsed is sure to pass `document_error`, told from its text in C-speed scans (the
+    walk over every value took 8 ms of a 137 KB tree's 25 ms refusal): no surrogate in it, written or escaped, and
+    its brackets, outside its strings, nested ``limit`` deep at most. False where it cannot tell (then walk)."""
+    try:
+        text = raw if isinstance(raw, str) else raw.decode("utf-8")
+    except UnicodeDecodeError:  # UTF-16 or -32, which json.loads also reads
+        return False
+    if _SURROGATE_ESCAPE.search(text) or _NOT_TEXT.search(text):
+        return False
+    brackets = np.frombuffer(_NOT_BRACKET.sub("", _STRING.sub("", text)).encode(), dtype=np.uint8)
+    if not len(brackets):
+        return True
+    return int(np.cumsum(np.where((brackets == ord("[")) | (brackets == ord("{")), 1, -1)).max()) <= limit
+
+
 def loads(raw: str | bytes) -> Any:
     """`json.loads` with bounded nesting and plain text; raise `JSONError` with a message for a person."""
     try:
@@ -71,6 +95,8 @@ def loads(raw: str | bytes) -> Any:
         raise JSONError(f"JSON nested more than {MAX_DEPTH} levels deep") from None
     except ValueError as exc:  # malformed, not UTF-8, or an integer of more digits than Python converts
         raise JSONError(f"not valid JSON: {exc}") from None
+    if plainly_fine(raw):
+        return obj
     message = document_error(obj)
     if message:
         raise JSONError(message)
@@ -81,11 +107,15 @@ class JSONParser(parsers.JSONParser):
     """DRF's JSON parser (strict: no NaN or Infinity) with bounded nesting and plain text."""
 
     def parse(self, stream, media_type=None, parser_context=None):
-        try:
-            data = super().parse(stream, media_type, parser_context)
+        encoding = (parser_context or {}).get("encoding", settings.DEFAULT_CHARSET)
+        try:  # as DRF's parser reads it (strict: no NaN or Infinity), keeping the text for `plainly_fine`
+            text = (stream.read() if stream is not None else b"").decode(encoding)
+            data = json.loads(text, parse_constant=drf_json.strict_constant if self.strict else None)
         except RecursionError:
             raise ParseError(f"JSON parse error - nested more than {MAX_DEPTH} levels deep") from None
-        message = document_error(data)
+        except ValueError as exc:
+            raise ParseError(f"JSON parse error - {exc}") from None
+        message = None if plainly_fine(text) else document_error(data)
         if message:
             raise ParseError(f"JSON parse error - {message}")
         return data
