@@ -31,7 +31,16 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
-from facaid.grammar.checks import MODES, check_expansion, check_meta, check_size, is_number, least_units
+from facaid.grammar.checks import (
+    MODES,
+    TOO_COSTLY,
+    check_expansion,
+    check_meta,
+    check_size,
+    is_number,
+    least_units,
+    least_units_of_json,
+)
 from facaid.grammar.errors import ProcedureError
 from facaid.grammar.limits import (
     MAX_CHILDREN,
@@ -234,7 +243,7 @@ class Procedure:
             obj = json.loads(text)
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise ProcedureError("(document)", f"malformed JSON: {exc}") from None
-        return parse_procedure(obj)
+        return parse_procedure(obj, sent=True)
 
     def nodes(self) -> Iterator[tuple[str, Node]]:
         return self.root.walk()
@@ -335,13 +344,12 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list) -> Node:
     bounds = counter[1]
     bounds[id(node)] = least_units(node, bounds)
     if bounds[id(node)] > MAX_INSTANCES:  # refused as soon as a subtree is sure to cost too much, before the rest
-        raise ProcedureError(path, f"expands to more than {MAX_INSTANCES} node instances (each node once per copy "
-                                   f"of it, repeats and splits included, and each exception once at every level its "
-                                   f"path runs through): the limit of what one tree may cost")
+        raise ProcedureError(path, TOO_COSTLY)
     return node
 
 
 _EXCEPTION_KEYS = frozenset(("copy", "path", "size", "node"))
+
 
 
 def _plain_size(mode: Any, value: Any) -> bool:
@@ -403,8 +411,12 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
     return out
 
 
-def parse_procedure(obj: Any) -> Procedure:
-    """Validate a decoded procedure JSON object and return a `Procedure`; raise `ProcedureError`."""
+def parse_procedure(obj: Any, sent: bool = False) -> Procedure:
+    """Validate a decoded procedure JSON object and return a `Procedure`; raise `ProcedureError`. ``sent``: it comes
+    from a person, who may have crafted it, so a tree sure to cost too much (`least_units_of_json`) is refused before
+    any of it is read into nodes."""
+    if sent and isinstance(obj, dict) and (least_units_of_json(obj.get("root")) or 0) > MAX_INSTANCES:
+        raise ProcedureError("root", TOO_COSTLY)
     if not isinstance(obj, dict):
         raise ProcedureError("(document)", f"a procedure must be a JSON object, got {type(obj).__name__}")
     if obj.get("format") != FORMAT:

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from facaid.formats.cga import procedure_cga
 from facaid.generator import generate_procedure
-from facaid.grammar.checks import least_units
+from facaid.grammar.checks import least_units, least_units_of_json
 from facaid.grammar.execute import Trace, execute, first_boxes, flat_rows
 from facaid.grammar.layout import count_expansion, expand_over, layout
 from facaid.grammar.limits import MAX_INSTANCES
@@ -101,6 +101,18 @@ def test_the_count_is_the_units_every_walk_handles():
     for proc in trees:
         assert count_expansion(proc.root, proc.width, proc.height).instances == units(proc.root, proc.width,
                                                                                       proc.height)
+
+
+def test_a_tree_sent_sure_to_cost_too_much_is_refused_before_it_is_read():
+    """What a person sends is bounded from its JSON first (`least_units_of_json`): the probe is refused by its cost
+    even with a malformed exception deep inside, which reading it would have named; code's own trees are read."""
+    tree = probe(count=256)
+    tree["root"]["children"][0]["children"][0]["exceptions"][5]["size"] = ["abs", -1]
+    with pytest.raises(ProcedureError, match="more than 100000 node instances"):
+        Procedure.from_json(json.dumps(tree))
+    with pytest.raises(ProcedureError, match=r"exceptions\[5\]\.size is negative"):
+        Procedure.from_dict(tree)  # not sent: read node by node, and the first problem named
+    assert least_units_of_json({"rule": "repeat", "count": "many"}) is None  # not plainly a node: left to the reading
 
 
 def test_parsing_walks_no_path_of_a_tree_refused_for_its_cost():
@@ -228,6 +240,7 @@ def test_an_accepted_trees_cpu_time_is_within_a_factor_of_its_cost(proc):
     assert cost <= MAX_INSTANCES
     assert cost == units(accepted.root, accepted.width, accepted.height)  # what is charged is what is handled
     assert bound(accepted.root) <= cost  # what parsing refuses early is sure to cost too much
+    assert least_units_of_json(accepted.to_dict()["root"]) == bound(accepted.root)  # and before it is read, the same
     start = thread_time()
     walks(accepted)
     spent = thread_time() - start

@@ -8,6 +8,7 @@ from rest_framework.exceptions import ValidationError
 
 from facaid.grammar import Procedure as ProcedureTree
 from facaid.grammar.procedure import ProcedureError
+from facaid.grammar.procedure import parse_procedure as parse_tree
 from facaid.segmentation import Segmentation as SegmentationData
 
 
@@ -18,8 +19,10 @@ def parse_segmentation(data) -> SegmentationData:
         raise ValidationError({"segmentation": str(exc)}) from None
 
 
-def parse_procedure(data) -> ProcedureTree:
+def parse_procedure(data, sent: bool = True) -> ProcedureTree:
+    """A procedure JSON read into the library's tree; ``sent`` (the default): from a request, where a tree sure to
+    cost too much is refused before it is read (`facaid.grammar.procedure.parse_procedure`)."""
     try:
-        return ProcedureTree.from_dict(data)
+        return parse_tree(data, sent=sent)
     except (ProcedureError, ValueError, TypeError, KeyError) as exc:
         raise ValidationError({"data": str(exc)}) from None
