@@ -110,7 +110,10 @@ async function askNamed(values = {}) {
   const mine = ++namedRequest;
   const [r, answer] = await send(`/api/v1/procedures/${code}/parameters`, "POST", {data: proc, values});
   if (mine !== namedRequest) return;  // a later edit asked again
-  if (!r.ok) { status.textContent = `not set: ${answer.values || JSON.stringify(answer)}`; return; }
+  if (!r.ok) {
+    status.textContent = `not set: ${answer.values || firstMessage(answer) || JSON.stringify(answer)}`;
+    return;
+  }
   status.textContent = "";
   leaves = answer.leaves || [];
   parameters = answer.parameters;
@@ -122,6 +125,16 @@ async function askNamed(values = {}) {
   }
   drawNamed(answer.parameters);
   showSelection();
+}
+
+// The first message of an error answer ({"detail": ...}, {"data": {"data": ...}}, {"values": [...]}), for a person
+function firstMessage(answer) {
+  if (typeof answer === "string") return answer;
+  for (const value of Object.values(answer && typeof answer === "object" ? answer : {})) {
+    const text = firstMessage(Array.isArray(value) ? value[0] : value);
+    if (text) return text;
+  }
+  return "";
 }
 
 // Ranges for variations, one row per named parameter that can change (of the saved procedure, which the server
@@ -374,7 +387,8 @@ function fitOverlay() {
 
 drawTree();
 fitOverlay();
-askNamed();
+if (document.getElementById("render").hasAttribute("src")) askNamed();  // a tree that cannot be drawn: said above
+else document.getElementById("named-status").textContent = "The named parameters are not read: see above.";
 versions.refresh().then(() => {
   // a re-run that fits worse is shown beside the version it continued
   const warned = document.querySelector("#rerun-warning [data-compare]");

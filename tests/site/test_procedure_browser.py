@@ -431,3 +431,25 @@ def test_the_overlay_hides_while_the_procedure_is_not_the_photos_size(live_serve
     field.dispatch_event("change")
     page.wait_for_function("document.getElementById('overlay-note').hidden")
     assert page.is_visible("#overlay") and not errors
+
+
+def test_a_tree_that_cannot_be_drawn_is_shown_without_its_picture(live_server, alice, browser, tmp_path):
+    """Issue 66: a tree stored before the cost model counted exceptions (the probe's shape, 100 copies) is refused
+    when read; its page says so in place of the picture, the parameters are not asked for, and nothing fails."""
+    node = {"rule": "repeat", "axis": "x", "count": "fill", "sizes": [["abs", 5000]] * 4,
+            "children": [{"rule": "leaf", "label": "window"}] * 4}
+    for _ in range(28):
+        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
+    r = {"rule": "repeat", "axis": "y", "count": 1, "sizes": [["flt", 1]], "children": [node],
+         "exceptions": [{"copy": 0, "path": [0] + [0] * 28 + [x], "size": ["abs", 3]} for x in range(1024)]}
+    data = {**generate(3).procedure.to_dict(), "width": 4096, "height": 4096,
+            "root": {"rule": "repeat", "axis": "y", "count": 100, "sizes": [["flt", 1]], "children": [r]}}
+    data.pop("meta", None)
+    proc = Procedure.objects.create(owner=alice, title="stored before", data=data, visibility="public")
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900}, advanced=False)
+    page.wait_for_selector("#picture-note")
+    assert "This procedure cannot be drawn" in page.inner_text("#picture-note")
+    assert not page.is_visible("#render") and page.get_attribute("#render", "src") is None
+    assert page.inner_text("#named-status") == "The named parameters are not read: see above."
+    page.screenshot(path=str(tmp_path / "not-drawn.png"))
+    assert errors == []
