@@ -76,8 +76,8 @@ def least_units(node: Node, bounds: dict[int, int]) -> int:
     """A lower bound of what one instance of ``node`` costs (`count_expansion`'s units), from the bounds of its
     children (``bounds``, by ``id``) alone, whatever its size: each ``"fill"`` repeat lays out at least one copy,
     every copy of a repeat that an exception replaces a node of may cost nothing, and each instance of a repeat
-    handles all its exceptions. Computed bottom-up as a tree is read, so that a tree sure to cost too much is refused
-    before the rest of it is read, and before its exceptions are counted along their paths."""
+    handles all its exceptions. Computed bottom-up as a tree is read: the root's (laid out once, where a node below
+    may never be) refuses a tree sure to cost too much before its exceptions are counted along their paths."""
     if node.rule == "leaf":
         return 1
     kids = [1 if c.rule == "leaf" else bounds[id(c)] for c in node.children]
@@ -119,8 +119,10 @@ def least_units_of_json(obj: Any, depth: int = 0) -> int | None:
         if not (count == "fill" or type(count) is int and 1 <= count <= MAX_COUNT) or type(tail) is not int \
                 or not 0 <= tail < len(kids) or not isinstance(exceptions, list):
             return None
-        touched = {e.get("copy") for e in exceptions if isinstance(e, dict) and "node" in e}
-        return _least(rule, kids, count, tail, False, len(exceptions), touched)
+        touched = [e.get("copy") for e in exceptions if isinstance(e, dict) and "node" in e]
+        if not all(type(c) is int for c in touched):
+            return None  # a copy that is not one: reading it says so
+        return _least(rule, kids, count, tail, False, len(exceptions), set(touched))
     return _least(rule, kids, None, 0, obj.get("center") is True, 0, set())
 
 

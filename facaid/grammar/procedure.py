@@ -341,10 +341,7 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list) -> Node:
     node.children = [_parse_node(c, f"{path}/{i}", depth + 1, counter) for i, c in enumerate(children_in)]
     if rule == "repeat" and "exceptions" in obj:
         node.exceptions = _parse_exceptions(obj["exceptions"], node, path, depth, counter)
-    bounds = counter[1]
-    bounds[id(node)] = least_units(node, bounds)
-    if bounds[id(node)] > MAX_INSTANCES:  # refused as soon as a subtree is sure to cost too much, before the rest
-        raise ProcedureError(path, TOO_COSTLY)
+    counter[1][id(node)] = least_units(node, counter[1])  # the root's is a bound of the tree's (`parse_procedure`)
     return node
 
 
@@ -439,7 +436,10 @@ def parse_procedure(obj: Any, sent: bool = False) -> Procedure:
         raise ProcedureError("(document)", f"unexpected key(s): {', '.join(extra)}")
     if "root" not in obj:
         raise ProcedureError("(document)", "missing 'root'")
-    root = _parse_node(obj["root"], "root", 0, [0, {}])  # nodes and exceptions read; each node's `least_units`
+    counter = [0, {}]  # nodes and exceptions read; each node's `least_units`
+    root = _parse_node(obj["root"], "root", 0, counter)
+    if counter[1].get(id(root), 1) > MAX_INSTANCES:  # the root is laid out once (a node below may never be)
+        raise ProcedureError("root", TOO_COSTLY)
     proc = Procedure(obj["width"], obj["height"], root, meta)
     check_expansion(proc)
     return proc

@@ -117,7 +117,7 @@ def rectify_file(fp, corners, max_pixels: int | None = None) -> Image.Image:
 
     p = _check_corners(corners)  # before anything is decoded
     head = Image.open(fp)
-    (width, height), fmt = head.size, head.format
+    fmt = head.format
     size = output_size(p, max_pixels)
     factor = 1
     if fmt == "JPEG":
@@ -134,7 +134,7 @@ def rectify_file(fp, corners, max_pixels: int | None = None) -> Image.Image:
         image.load()
         return rectify(image, p, size)
     cv2.cvtColor(pixels, cv2.COLOR_BGR2RGB, dst=pixels)
-    return Image.fromarray(_warp(pixels, p * [pixels.shape[1] / width, pixels.shape[0] / height], size))
+    return Image.fromarray(_warp(pixels, p / factor, size))  # reduced pixel k covers the photo's [k f, (k + 1) f)
 
 
 # --- proposing the four corners from the photo ------------------------------------------------------------------

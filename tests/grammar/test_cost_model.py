@@ -115,6 +115,25 @@ def test_a_tree_sent_sure_to_cost_too_much_is_refused_before_it_is_read():
     assert least_units_of_json({"rule": "repeat", "count": "many"}) is None  # not plainly a node: left to the reading
 
 
+def test_a_costly_subtree_that_is_never_laid_out_is_no_cost():
+    """The bound is the root's: a subtree of 16 million units that an exception replaces in the only copy there is
+    is never laid out (review of issue 66: it was refused as it was read). A copy that is not one leaves the JSON's
+    bound to the reading, which names it."""
+    leaf = {"rule": "leaf", "label": "window"}
+
+    def rep(child, n, exceptions=()):
+        node = {"rule": "repeat", "axis": "x", "count": n, "sizes": [["flt", 1]], "children": [child]}
+        return {**node, "exceptions": list(exceptions)} if exceptions else node
+
+    tree = doc(rep(rep(rep(rep(leaf, 256), 256), 256), 1, [{"copy": 0, "path": [0], "node": leaf}]))
+    proc = Procedure.from_json(json.dumps(tree))
+    assert count_expansion(proc.root, proc.width, proc.height).instances == 3
+    tree["root"]["exceptions"][0]["copy"] = [0]
+    assert least_units_of_json(tree["root"]) is None
+    with pytest.raises(ProcedureError, match=r"exceptions\[0\]\.copy must be a copy"):
+        Procedure.from_json(json.dumps(tree))
+
+
 def test_parsing_walks_no_path_of_a_tree_refused_for_its_cost():
     """Issue 66's 460 KB tree of 8 nested repeats, each with 1,010 exceptions: its paths were walked one by one, each
     through every exception of the repeats below (1 s). Counted along its trie instead, and refused by its count."""

@@ -211,11 +211,11 @@ def test_a_large_jpeg_is_read_at_a_reduced_scale_and_rectifies_as_the_full_one()
     from facaid.photo.rectify import rectify_file
 
     facade, photo, true = scene(5)
-    big = photo.resize((photo.width * 4, photo.height * 4), Image.Resampling.BICUBIC)
-    buf = io.BytesIO()
+    big = photo.resize((round(photo.width * 4.1) | 1, round(photo.height * 4.1) | 1), Image.Resampling.BICUBIC)
+    buf = io.BytesIO()  # odd sides: the reduced decode's last pixel covers less of the photo than the others
     big.save(buf, "JPEG", quality=95)
-    corners = [[4 * x, 4 * y] for x, y in true]
+    corners = [[x * big.width / photo.width, y * big.height / photo.height] for x, y in true]
     reduced = rectify_file(io.BytesIO(buf.getvalue()), corners, max_pixels=facade.width * facade.height)
     full = rectify(Image.open(io.BytesIO(buf.getvalue())), corners, size=reduced.size)
     diff = np.abs(np.asarray(reduced, dtype=float) - np.asarray(full, dtype=float)).mean()
-    assert reduced.size == full.size and diff < 3, diff
+    assert reduced.size == full.size and diff < 1.5, diff  # 0.68 measured (1.39 scaled by the sizes' ratio)

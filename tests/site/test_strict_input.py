@@ -151,3 +151,4 @@ def test_the_quick_scan_counts_brackets_outside_strings_only():
     assert not plainly_fine('{"a": [[[[1]]]]}', 3)
     assert not plainly_fine('{"a": "\\udfff"}') and not plainly_fine('["\\ud83d\\ude00"]')  # left to the walk
     assert plainly_fine('{"a": "\\\\[\\"]"}', 1)
+    assert not plainly_fine('{"note":"\\ud800"}'.encode("utf-16-le"))  # read as UTF-8: NULs, escapes misread

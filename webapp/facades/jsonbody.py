@@ -79,8 +79,8 @@ def plainly_fine(raw: str | bytes, limit: int = MAX_DEPTH) -> bool:
         text = raw if isinstance(raw, str) else raw.decode("utf-8")
     except UnicodeDecodeError:  # UTF-16 or -32, which json.loads also reads
         return False
-    if _SURROGATE_ESCAPE.search(text) or _NOT_TEXT.search(text):
-        return False
+    if "\x00" in text or _SURROGATE_ESCAPE.search(text) or _NOT_TEXT.search(text):
+        return False  # (a NUL: UTF-16 or -32 read as UTF-8, where the scans below would misread escapes)
     brackets = np.frombuffer(_NOT_BRACKET.sub("", _STRING.sub("", text)).encode(), dtype=np.uint8)
     if not len(brackets):
         return True
