@@ -299,7 +299,8 @@ def procedure_cga(proc: Procedure, scale: float | None = None, name: str = "", s
     scale = checked_scale(proc, scale)
     writer = _Writer(proc, scale)
     root = writer.rule(proc.root, (False, False))
-    width, height = writer.metres(proc.width), writer.metres(proc.height)
+    # the extent the 3D exports have (`relief.Relief`: whole pixels, as labels.png), so that every file says one size
+    width, height = writer.metres(round(proc.width)), writer.metres(round(proc.height))
     name = _one_line(name)
     title = f" {name}" if name else ""
     source = _one_line(scale_from or ("given" if given else f"a storey {STOREY_M:g} m tall"))

@@ -323,3 +323,19 @@ def test_exceptions_become_variants_picked_by_split_index():
         assert_same_leaves(deep, broken, 0.02)
     sized = example()
     assert_same_leaves(sized, procedure_cga(sized, scale=0.02), 0.02)
+
+
+def test_the_header_says_the_size_the_3d_exports_have():
+    """Issue 67: the CGA header said 24.5174 m where the glTF said 24.5053 m for one procedure, the header from the
+    procedure's width in pixels unrounded, the glTF (and IFC, CityJSON) from the whole pixels it draws. One extent."""
+    import json as _json
+
+    from facaid.formats.gltf import procedure_gltf
+
+    proc = generate(3).procedure
+    proc.width, proc.height = proc.width + 0.4, proc.height - 0.3  # a sized procedure's extent is not whole pixels
+    header = re.search(r"Drawn at (\d+) x (\d+) px, ([\d.]+) m x ([\d.]+) m at ([\d.]+) m per pixel", procedure_cga(
+        proc, 0.0199321))
+    about = _json.loads(procedure_gltf(proc, 0.0199321, binary=False))["asset"]["extras"]["facaid"]
+    assert (float(header[3]), float(header[4])) == (about["width_m"], about["height_m"])
+    assert (int(header[1]), int(header[2])) == (round(proc.width), round(proc.height))
