@@ -69,18 +69,15 @@ from django.core.management import call_command
 call_command("migrate", verbosity=0)
 from django.contrib.auth import get_user_model
 from rest_framework.test import APIClient
-from facaid.grammar.procedure import GRAMMAR_VERSION
 from webapp.facades.models import Procedure
+
+sys.path.insert(0, "tests")
+from grammar_helpers import doc, nested, probe  # issue 66's trees, as the tests build them
 
 tree_name, case, repeat = sys.argv[1], sys.argv[2], int(sys.argv[3])
 user = get_user_model().objects.create_user("bench", "b@example.com", "bench-password-1")
 owner = APIClient(); owner.force_login(user)
 anon = APIClient()
-
-
-def doc(root, side=4096):
-    return {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR_VERSION, "width": side, "height": side,
-            "root": root}
 
 
 def chain(n_x, n_y, depth):
@@ -100,28 +97,8 @@ def wide(n):
                 "children": [row]})
 
 
-def probe(rows, columns, count="fill"):
-    node = {"rule": "repeat", "axis": "x", "count": count, "sizes": [["abs", 5000]] * 4,
-            "children": [{"rule": "leaf", "label": "window"}] * 4}
-    for _ in range(28):
-        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
-    r = {"rule": "repeat", "axis": "y", "count": 1, "sizes": [["flt", 1]], "children": [node],
-         "exceptions": [{"copy": 0, "path": [0] + [0] * 28 + [x], "size": ["abs", 3]} for x in range(1024)]}
-    inner = {"rule": "repeat", "axis": "x", "count": columns, "sizes": [["flt", 1]], "children": [r]}
-    return doc({"rule": "repeat", "axis": "y", "count": rows, "sizes": [["flt", 1]], "children": [inner]})
-
-
-def nested():
-    node = {"rule": "leaf", "label": "window"}
-    for level in range(8):
-        node = {"rule": "repeat", "axis": "xy"[level % 2], "count": 4, "sizes": [["flt", 1]], "children": [node]}
-        node["exceptions"] = [{"copy": e % 4, "path": [0] + [(e >> (2 * k + 2)) % 4 for k in range(level)],
-                               "size": ["flt", 2]} for e in range(4 * 4 ** level)][:1010]
-    return doc(node)
-
-
 tree = {"crafted": chain(256, 256, 29), "deep": chain(256, 12, 29), "wide": wide(157), "photo": wide(2),
-        "probe": probe(256, 11), "probe-stored": probe(100, 1), "probe-max": probe(3, 1, 256),
+        "probe": probe(256, 11), "probe-stored": probe(100, 1), "probe-max": probe(3, 1, count=256),
         "nested": nested()}[tree_name]
 proc = Procedure.objects.create(owner=user, data=wide(2), visibility="public")
 if tree_name not in ("crafted", "probe", "nested"):

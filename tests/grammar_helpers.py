@@ -1,8 +1,9 @@
-"""Procedures the grammar and format tests share: a facade whose repeats have exceptions."""
+"""Procedures the grammar, format and site tests share: a facade whose repeats have exceptions, and the trees of
+exceptions issue 66's probe crafted (also built by `bench/bench_request_cost.py` and `bench/bench_cost_model.py`)."""
 
 import numpy as np
 
-from facaid.grammar.procedure import Node, Override, Procedure, ProcedureError, Size
+from facaid.grammar.procedure import GRAMMAR_VERSION, Node, Override, Procedure, ProcedureError, Size
 from facaid.grammar.repeats import expanded_count, pattern_child
 from facaid.labels import LABEL_ID
 from facaid.segmentation import Segmentation
@@ -114,3 +115,34 @@ def random_exceptions(proc: Procedure, rng: np.random.Generator, n: int = 6) -> 
             except ProcedureError:
                 node.exceptions.pop()
     return Procedure.from_dict(proc.to_dict())
+
+
+def doc(root: dict, side: int = 4096) -> dict:
+    """A procedure's JSON around ``root``, ``side`` pixels square."""
+    return {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR_VERSION, "width": side, "height": side,
+            "root": root}
+
+
+def probe(rows: int = 256, columns: int = 11, exceptions: int = 1024, chain: int = 28, count="fill") -> dict:
+    """Issue 66's tree: repeat y x ``rows`` -> repeat x x ``columns`` -> R, a repeat of one copy whose
+    ``exceptions`` size-only exceptions, all in copy 0, have paths [0, 0 x ``chain``, x] down ``chain`` one-child
+    splits to a repeat (``count``) of 4 leaves of abs 5000."""
+    node = {"rule": "repeat", "axis": "x", "count": count, "sizes": [["abs", 5000]] * 4,
+            "children": [{"rule": "leaf", "label": "window"}] * 4}
+    for _ in range(chain):
+        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
+    r = {"rule": "repeat", "axis": "y", "count": 1, "sizes": [["flt", 1]], "children": [node],
+         "exceptions": [{"copy": 0, "path": [0] + [0] * chain + [x], "size": ["abs", 3]} for x in range(exceptions)]}
+    inner = {"rule": "repeat", "axis": "x", "count": columns, "sizes": [["flt", 1]], "children": [r]}
+    return doc({"rule": "repeat", "axis": "y", "count": rows, "sizes": [["flt", 1]], "children": [inner]})
+
+
+def nested() -> dict:
+    """Issue 66's other shape: 8 nested repeats of 4 copies, each with 1,010 exceptions whose paths run down
+    through the repeats below (265 KB; the probe's was 460 KB)."""
+    node = {"rule": "leaf", "label": "window"}
+    for level in range(8):
+        node = {"rule": "repeat", "axis": "xy"[level % 2], "count": 4, "sizes": [["flt", 1]], "children": [node]}
+        node["exceptions"] = [{"copy": e % 4, "path": [0] + [(e >> (2 * k + 2)) % 4 for k in range(level)],
+                               "size": ["flt", 2]} for e in range(4 * 4 ** level)][:1010]
+    return doc(node)

@@ -7,7 +7,7 @@ from time import thread_time
 
 import numpy as np
 import pytest
-from grammar_helpers import example, random_exceptions
+from grammar_helpers import doc, example, nested, probe, random_exceptions
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -17,28 +17,9 @@ from facaid.grammar.checks import least_units, least_units_of_json
 from facaid.grammar.execute import Trace, execute, first_boxes, flat_rows
 from facaid.grammar.layout import count_expansion, expand_over, layout
 from facaid.grammar.limits import MAX_INSTANCES
-from facaid.grammar.procedure import GRAMMAR_VERSION, Node, Override, Procedure, ProcedureError, Size
+from facaid.grammar.procedure import Node, Override, Procedure, ProcedureError, Size
 from facaid.grammar.repeats import expanded_count, pattern_child
 from facaid.parameters import named_parameters
-
-
-def doc(root: dict, side: int = 4096) -> dict:
-    return {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR_VERSION, "width": side, "height": side,
-            "root": root}
-
-
-def probe(rows: int = 256, columns: int = 11, exceptions: int = 1024, chain: int = 28, count="fill") -> dict:
-    """Issue 66's tree: repeat y x ``rows`` -> repeat x x ``columns`` -> R, a repeat of one copy whose
-    ``exceptions`` size-only exceptions, all in copy 0, have paths [0, 0 x ``chain``, x] down ``chain`` one-child
-    splits to a repeat (``count``) of 4 leaves of abs 5000."""
-    node = {"rule": "repeat", "axis": "x", "count": count, "sizes": [["abs", 5000]] * 4,
-            "children": [{"rule": "leaf", "label": "window"}] * 4}
-    for _ in range(chain):
-        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
-    r = {"rule": "repeat", "axis": "y", "count": 1, "sizes": [["flt", 1]], "children": [node],
-         "exceptions": [{"copy": 0, "path": [0] + [0] * chain + [x], "size": ["abs", 3]} for x in range(exceptions)]}
-    inner = {"rule": "repeat", "axis": "x", "count": columns, "sizes": [["flt", 1]], "children": [r]}
-    return doc({"rule": "repeat", "axis": "y", "count": rows, "sizes": [["flt", 1]], "children": [inner]})
 
 
 def units(node, w: float, h: float, pending: list | None = None) -> int:
@@ -137,12 +118,7 @@ def test_a_costly_subtree_that_is_never_laid_out_is_no_cost():
 def test_parsing_walks_no_path_of_a_tree_refused_for_its_cost():
     """Issue 66's 460 KB tree of 8 nested repeats, each with 1,010 exceptions: its paths were walked one by one, each
     through every exception of the repeats below (1 s). Counted along its trie instead, and refused by its count."""
-    node = {"rule": "leaf", "label": "window"}
-    for level in range(8):
-        node = {"rule": "repeat", "axis": "xy"[level % 2], "count": 4, "sizes": [["flt", 1]], "children": [node]}
-        node["exceptions"] = [{"copy": e % 4, "path": [0] + [(e >> (2 * k + 2)) % 4 for k in range(level)],
-                               "size": ["flt", 2]} for e in range(4 * 4 ** level)][:1010]
-    text = json.dumps(doc(node))
+    text = json.dumps(nested())
     assert len(text) > 150_000
     with pytest.raises(ProcedureError, match="more than 100000 node instances"):
         Procedure.from_json(text)

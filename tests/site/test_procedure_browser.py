@@ -11,6 +11,7 @@ import os
 import shutil
 
 import pytest
+from grammar_helpers import probe
 from site_helpers import collect_errors, login
 
 from facaid.generator import generate
@@ -436,16 +437,8 @@ def test_the_overlay_hides_while_the_procedure_is_not_the_photos_size(live_serve
 def test_a_tree_that_cannot_be_drawn_is_shown_without_its_picture(live_server, alice, browser, tmp_path):
     """Issue 66: a tree stored before the cost model counted exceptions (the probe's shape, 100 copies) is refused
     when read; its page says so in place of the picture, the parameters are not asked for, and nothing fails."""
-    node = {"rule": "repeat", "axis": "x", "count": "fill", "sizes": [["abs", 5000]] * 4,
-            "children": [{"rule": "leaf", "label": "window"}] * 4}
-    for _ in range(28):
-        node = {"rule": "split", "axis": "y", "sizes": [["flt", 1]], "children": [node]}
-    r = {"rule": "repeat", "axis": "y", "count": 1, "sizes": [["flt", 1]], "children": [node],
-         "exceptions": [{"copy": 0, "path": [0] + [0] * 28 + [x], "size": ["abs", 3]} for x in range(1024)]}
-    data = {**generate(3).procedure.to_dict(), "width": 4096, "height": 4096,
-            "root": {"rule": "repeat", "axis": "y", "count": 100, "sizes": [["flt", 1]], "children": [r]}}
-    data.pop("meta", None)
-    proc = Procedure.objects.create(owner=alice, title="stored before", data=data, visibility="public")
+    proc = Procedure.objects.create(owner=alice, title="stored before", data=probe(rows=100, columns=1),
+                                   visibility="public")
     page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900}, advanced=False)
     page.wait_for_selector("#picture-note")
     assert "This procedure cannot be drawn" in page.inner_text("#picture-note")
