@@ -28,6 +28,9 @@ def is_number(v: Any) -> bool:
 
 
 def check_size(path: str, i: int, mode: str, value: Any, what: str | None = None) -> None:
+    kind = type(value)
+    if (kind is float or kind is int) and mode in MODES and 0 <= value <= (1 if mode == "rel" else MAX_EXTENT):
+        return  # most sizes: told fine before any message is made (NaN and infinities fail the range)
     what = what or f"sizes[{i}]"
     if mode not in MODES:
         raise ProcedureError(path, f"{what} has unknown mode {mode!r}; expected one of {', '.join(MODES)}")

@@ -318,8 +318,7 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list) -> Node:
     for i, s in enumerate(sizes_in):
         if not (isinstance(s, list) and len(s) == 2):
             raise ProcedureError(path, f"sizes[{i}] must be a [mode, value] pair, got {s!r}")
-        if not _plain_size(s[0], s[1]):
-            check_size(path, i, s[0], s[1])
+        check_size(path, i, s[0], s[1])
         sizes.append(Size(s[0], s[1]))
     node = Node(rule, axis=axis, sizes=sizes, role=role)
     if rule == "repeat":
@@ -346,13 +345,6 @@ def _parse_node(obj: Any, path: str, depth: int, counter: list) -> Node:
 
 
 _EXCEPTION_KEYS = frozenset(("copy", "path", "size", "node"))
-
-
-
-def _plain_size(mode: Any, value: Any) -> bool:
-    """A size `check_size` accepts, told quickly (most are): a float or int, finite, in range for its mode."""
-    kind = type(value)
-    return (kind is float or kind is int) and mode in MODES and 0 <= value <= (1 if mode == "rel" else MAX_EXTENT)
 
 
 def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: list) -> list[Override]:
@@ -394,8 +386,7 @@ def _parse_exceptions(items: Any, node: Node, path: str, depth: int, counter: li
             s = item["size"]
             if not (isinstance(s, list) and len(s) == 2):
                 raise ProcedureError(path, f"{where}.size must be a [mode, value] pair, got {s!r}")
-            if not _plain_size(s[0], s[1]):  # the check with its message, for one that is not plainly fine
-                check_size(path, e, s[0], s[1], what=f"{where}.size")
+            check_size(path, e, s[0], s[1], what=f"{where}.size")
             size = Size(s[0], s[1])
         sub = None
         if "node" in item:
