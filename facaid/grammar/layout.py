@@ -9,7 +9,8 @@ use it.
 from __future__ import annotations
 
 import contextlib
-from typing import NamedTuple
+from collections.abc import Iterator
+from typing import Any, NamedTuple
 
 from facaid.grammar.limits import MAX_COUNT, MAX_INSTANCES, MAX_LEAVES
 
@@ -43,6 +44,15 @@ def expand(node, length: float) -> tuple[list, list, list[bool]]:
             [False] * len(node.children) + [True] * len(back))
 
 
+def laid_out(node, n: int) -> Iterator[tuple[tuple[int, ...], Any]]:
+    """The exceptions of the repeat ``node`` that apply when it lays out ``n`` copies (the tail's items too), each
+    with its path's steps from the repeat down, the first the expanded child it names (`expand`'s order)."""
+    k = len(node.children)
+    for o in node.exceptions:
+        if o.copy < n or (o.copy == n and o.path[0] < node.tail):
+            yield (o.copy * k + o.path[0], *o.path[1:]), o
+
+
 def expand_over(node, length: float, pending: list | None,
                 applied: set[int] | None = None) -> tuple[list, list, list[bool], list | None, list | None]:
     """`expand` with the exceptions applied: those of ``node`` (a repeat's `Override`s) and ``pending``, the
@@ -57,12 +67,7 @@ def expand_over(node, length: float, pending: list | None,
     exceptions = node.exceptions if node.rule == "repeat" else ()
     if not exceptions and not pending:
         return sizes, children, reflected, None, None
-    entries = []
-    if exceptions:
-        k, n = len(node.children), repeat_count(node, length)
-        for o in exceptions:
-            if o.copy < n or (o.copy == n and o.path[0] < node.tail):
-                entries.append(((o.copy * k + o.path[0], *o.path[1:]), o, node))
+    entries = [(steps, o, node) for steps, o in laid_out(node, repeat_count(node, length))] if exceptions else []
     if pending:
         entries.extend(pending)
     if not entries:
@@ -140,15 +145,13 @@ class _Paths:
         the expanded child it names (`expand_over`'s order); None when none does. Built from the paths in sorted
         order, each sharing its prefix with the one before (compared by slices, in C), so that the work is the
         trie's nodes, not the paths' steps."""
-        k = len(node.children)
-        keyed = sorted(((o.copy * k + o.path[0], *o.path[1:]), e) for e, o in enumerate(node.exceptions)
-                       if o.copy < n or (o.copy == n and o.path[0] < node.tail))
+        keyed = sorted((steps, e, o) for e, (steps, o) in enumerate(laid_out(node, n)))  # e: no tie reaches o
         if not keyed:
             return None
         root = _Paths()
         made = [(root, None)]  # every trie node with its parent, parents first
         stack, before = [root], ()
-        for steps, e in keyed:
+        for steps, _, o in keyed:
             inner = steps[:-1]
             shared = _common(before, inner)
             del stack[shared + 1:]
@@ -157,7 +160,7 @@ class _Paths:
                 stack[-1].kids[s] = t
                 made.append((t, stack[-1]))
                 stack.append(t)
-            stack[-1].ends.setdefault(steps[-1], []).append(node.exceptions[e])
+            stack[-1].ends.setdefault(steps[-1], []).append(o)
             before = inner
         for t, parent in reversed(made):
             t.total += sum(map(len, t.ends.values()))
