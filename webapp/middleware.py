@@ -157,8 +157,7 @@ class HeavySlotsMiddleware:
             return None
         slots = throttling.slots()
         if not slots.take():
-            return error_response(request, 503, f"the site is busy with {slots.slots} heavy requests (rendering, "
-                                                "variations, downloads) in this process; try again in a moment",
-                                  **{"Retry-After": "2", "X-Facaid-Busy": "slots"})
+            return throttling.busy(request, f"with {slots.slots} heavy requests (rendering, variations, downloads) in "
+                                            "this process")
         request._heavy_slots = slots
         return None

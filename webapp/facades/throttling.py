@@ -16,6 +16,8 @@ from rest_framework.permissions import SAFE_METHODS
 from rest_framework.settings import api_settings
 from rest_framework.throttling import UserRateThrottle
 
+from webapp.errors import error_response
+
 
 class HeavyRateThrottle(UserRateThrottle):
     scope = "heavy"
@@ -99,3 +101,10 @@ def heavy_slot(request) -> Iterator[bool]:
         yield True
     finally:
         held.give_back()
+
+
+def busy(request, what: str):
+    """The answer to a heavy request that found no slot free: a 503 with ``Retry-After``, answered before any of its
+    work, which ``X-Facaid-Busy: slots`` tells clients (safe to send again, whatever its method)."""
+    return error_response(request, 503, f"the site is busy {what}; try again in a moment",
+                          **{"Retry-After": "2", "X-Facaid-Busy": "slots"})

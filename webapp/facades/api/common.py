@@ -14,7 +14,6 @@ from rest_framework.parsers import BaseParser
 
 from facaid.formats import interchange
 from facaid.grammar.procedure import ProcedureError
-from webapp.errors import error_response
 from webapp.facades import pictures, throttling
 from webapp.facades.models import (
     Procedure,
@@ -82,8 +81,7 @@ def stored_picture(request, proc: Procedure, kind: str) -> HttpResponse:
             if resp is None:  # to be drawn: a heavy request, which takes a slot or is told to come back
                 with throttling.heavy_slot(request) as held:
                     if not held:
-                        return error_response(request, 503, "the site is busy drawing pictures; try again in a "
-                                                             "moment", **{"Retry-After": "2", "X-Facaid-Busy": "slots"})
+                        return throttling.busy(request, "drawing pictures")
                     name, tag, png = pictures.stored(proc, kind, redraw=True)
                 resp = HttpResponse(png, content_type="image/png")
         except ProcedureError as exc:  # stored before a limit it now breaks
