@@ -161,12 +161,13 @@ def add_segmentation(photo: Photo, data, format: str | None = None,
     loaded = _segmentation_of(photo, data, format, image)
     seg = loaded.segmentation
     data = seg.to_dict()
+    size = json_size(data)
     with transaction.atomic():
         last = Segmentation.objects.select_for_update().filter(photo=photo).aggregate(v=Max("version"))["v"]
         draft = Draft.objects.filter(photo=photo).values_list("size", flat=True).first() or 0
-        check_quota(photo.owner_id, json_size(data), replaced=draft)
+        check_quota(photo.owner_id, size, replaced=draft)
         version = Segmentation.objects.create(photo=photo, version=(last or 0) + 1, data=data,
-                                              rect_count=len(seg.rects), size=json_size(data))
+                                              rect_count=len(seg.rects), size=size)
         drop_draft(photo)  # saved: the draft it was is the version now
     return version, loaded.warnings
 
