@@ -70,27 +70,33 @@ def home(request):
 @login_required
 def photo_new(request):
     form = PhotoForm(request.POST or None, request.FILES or None)
-    status = 200
+    busy = False
     if request.method == "POST" and form.is_valid():
         with throttling.heavy_slot(request) as held:  # decoding a photo is a heavy request, as the API's upload
             allowed, wait = throttling.allow_heavy(request) if held else (False, 2)
-            if not allowed:
+            busy = not allowed
+            if busy:
                 form.add_error("image", f"the site is busy with other uploads and drawings; send it again in "
                                         f"{math.ceil(wait or 2)} s")
-                status = 503
             else:
-                try:
-                    photo = services.create_photo(request.user, form.cleaned_data["image"],
-                                                  form.cleaned_data["title"], form.cleaned_data["visibility"])
-                except ValidationError as exc:
-                    form.add_error("image", _error_text(exc).removeprefix("image: "))
-                except QuotaError as exc:
-                    form.add_error("image", str(exc))
-                else:
+                photo = _upload(request, form)
+                if photo is not None:
                     messages.success(request, "Photo uploaded. Rectify it if needed, then add a segmentation.")
                     return redirect(photo)
-    return render(request, "facades/photo_new.html", {"form": form}, status=400 if status == 200 and form.errors
-                  else status)
+    return render(request, "facades/photo_new.html", {"form": form},
+                  status=503 if busy else 400 if form.errors else 200)
+
+
+def _upload(request, form: PhotoForm) -> Photo | None:
+    """The photo the form uploads, or None with what was wrong added to the form's image field."""
+    try:
+        return services.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
+                                     form.cleaned_data["visibility"])
+    except ValidationError as exc:
+        form.add_error("image", _error_text(exc).removeprefix("image: "))
+    except QuotaError as exc:
+        form.add_error("image", str(exc))
+    return None
 
 
 def photo(request, code):
