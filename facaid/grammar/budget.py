@@ -43,10 +43,7 @@ def charge(instances: int) -> None:
         return
     budget[1] += instances
     if budget[1] > budget[0]:
-        raise WorkLimitError(
-            f"this request would lay out more than {int(budget[0]):,} node instances in all (every tree it reads or "
-            "makes, each node once per copy of it): ask for less at once (fewer values or variants) or use a "
-            "smaller tree")
+        raise _past(budget)
     if thread_time() - budget[3] > budget[2]:
         raise WorkLimitError(
             f"this request needs more than {budget[2]:g} s of computing: ask for less at once (fewer values or "
@@ -58,10 +55,14 @@ def reserve(instances: int) -> None:
     spent (the trees a request is about to make, charged again as each is made). Outside a budget, nothing."""
     budget = _budget.get()
     if budget is not None and budget[1] + instances > budget[0]:
-        raise WorkLimitError(
-            f"this request would lay out more than {int(budget[0]):,} node instances in all (every tree it reads or "
-            "makes, each node once per copy of it): ask for less at once (fewer values or variants) or use a "
-            "smaller tree")
+        raise _past(budget)
+
+
+def _past(budget: list[float]) -> WorkLimitError:
+    return WorkLimitError(
+        f"this request would lay out more than {int(budget[0]):,} node instances in all (every tree it reads or "
+        "makes, each node once per copy of it): ask for less at once (fewer values or variants) or use a "
+        "smaller tree")
 
 
 def spent() -> int | None:
