@@ -231,9 +231,12 @@ def named_parameters(proc: Procedure) -> list[Parameter]:
     return sorted(out, key=lambda p: order[p.name])
 
 
-def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
+def _grow(proc: Procedure, axis: str, own: dict[int, float], shrink: bool = False) -> None:
     """Grow the nodes in ``own`` (id → change of each instance's length along ``axis``) and, to fit them, every
-    node enclosing them and the image; a normalised tree stays normalised, so nothing else changes size."""
+    node enclosing them and the image; a normalised tree stays normalised, so nothing else changes size. With
+    ``shrink`` (a count made smaller), a node whose edited children shrink shrinks with them and its other children
+    follow (a floor fewer makes the image lower beside it too); else the wall takes what they give up (a narrower
+    window leaves its floor as high)."""
     memo: dict[int, float] = {}
     holds: dict[int, bool] = {}
 
@@ -270,11 +273,12 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float]) -> None:
             g = own[key]
         elif node.rule == "leaf":
             g = 0.0
-        elif node.axis != axis:
+        elif node.axis != axis:  # its children side by side: all as long as the longest needs (see ``shrink``)
             parts = [grow(c) for c in node.children]
-            g = max(parts)
+            edited = [d for c, d in zip(node.children, parts, strict=True) if has_target(c)]
+            g = max(edited) if shrink and edited else max(parts)
             for c, d in zip(node.children, parts, strict=True):
-                if d < g:
+                if d != g:
                     pad(c, g - d)
         else:
             parts = [grow(c) for c in node.children]
@@ -387,7 +391,10 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             own[id(node)] = delta * unit
             in_step = main is not None and main.count == node.count and name == "bays"
             recount(out.root, node, new, copies_moved(main, new) if in_step else None)
-        _grow(out, axis, own)
+        if not own and change:
+            raise ValueError(f"{name} cannot be {value:g} here: no row of {role}s takes {change:+d} (a mirrored row "
+                             f"changes by two)")
+        _grow(out, axis, own, shrink=change < 0)
     try:
         validate(out)
     except ProcedureError as exc:

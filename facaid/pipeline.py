@@ -12,7 +12,7 @@ the sampling is skipped. ``result.source`` says which kind of structure won.
 
 Two structures (``structure``): the model's, where it wins, is compact and editable already (a generated facade);
 where induction wins (a real facade, whose induced procedure copies the annotation as drawn: the *exact* one), the
-lattice reader (`facaid.lattice`) reads the facade as floors of tiles with exceptions, and that sized is the
+lattice reader (`facaid.reading.lattice`) reads the facade as floors of tiles with exceptions, and that sized is the
 *editable* one. ``structure="editable"`` (the default) returns it with the exact one as ``alternative``;
 ``"exact"`` the other way round. Where there is no lattice to read, both are the one procedure.
 
@@ -39,10 +39,10 @@ from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.induce import induce_procedure
 from facaid.labels import FACADE
-from facaid.lattice import read_lattice
 from facaid.metrics import element_leaves, procedure_accuracy, unexplained
 from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
+from facaid.reading.lattice import read_lattice
 from facaid.segmentation import Segmentation, flatten, flatten_array, rasterize
 from facaid.sizing import fit_sizes
 from facaid.tokenizer import Tokenizer

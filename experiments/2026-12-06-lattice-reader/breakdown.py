@@ -6,7 +6,7 @@ import argparse
 import collections
 import statistics
 
-from facaid import lattice
+from facaid.reading import lattice
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.metrics import element_rectangles
 from facaid.paths import DEFAULT_CMP

@@ -6,7 +6,7 @@
 import argparse
 import json
 
-from facaid import lattice
+from facaid.reading import lattice
 from facaid.evaluation.editability import editability, segmentation_lattice
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.grammar.execute import to_segmentation

@@ -14,7 +14,7 @@ import numpy as np
 sys.path.insert(0, "experiments/2026-12-06-lattice-reader")
 from snap import snap  # noqa: E402
 
-from facaid import lattice  # noqa: E402
+from facaid.reading import lattice  # noqa: E402
 from facaid.augmentation import annotator_noise  # noqa: E402
 from facaid.evaluation.real import DEV_FACADES, load_records  # noqa: E402
 from facaid.grammar.execute import to_segmentation  # noqa: E402

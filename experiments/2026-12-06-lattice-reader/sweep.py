@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from facaid import lattice
+from facaid.reading import lattice
 from facaid.evaluation.editability import editability, segmentation_lattice
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.grammar.execute import to_segmentation

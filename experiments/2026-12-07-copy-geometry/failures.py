@@ -6,7 +6,7 @@ import argparse
 import json
 import os
 
-from facaid import lattice
+from facaid.reading import lattice
 from facaid.evaluation.editability import flat_rows, lattice as rows_cols
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.grammar.procedure import Procedure

@@ -1,56 +1,74 @@
-"""Whether a procedure can be edited as a person means: its windows' rows and columns, and what ``floors`` + 1 and
-``bays`` + 1 do to them (issue 55's figures, `facaid evaluate-real`).
+"""Whether a procedure can be edited as a person means (`facaid evaluate-real`).
 
-A window is a connected region of window-or-blind pixels of the label map (a window cut into pieces by its blind
-or sill counts once). Window rows are the bands of window centres along y, split where the gap between neighbouring
-centres exceeds half the median window height; columns the same along x with the width. A facade is *eligible*
-when its annotation has at least two rows and two columns.
+Two measures of `floors` + 1 and `bays` + 1. Issue 55's counts the windows (`facaid.editing.windows`): one more row
+(column) of window centres, the same columns (rows). Issue 67's looks at the picture (`facaid.editing.check`): the
+old facade with one band like its others put in between two, every other pixel where it was. A facade is
+*eligible* when its annotation has at least two rows and two columns of windows. And what the procedure keeps of
+what was drawn (`kept_elements`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from facaid.editing.check import check_edits
+from facaid.editing.windows import lattice, pitches, segmentation_lattice, window_boxes
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
-from facaid.labels import GLASS
+from facaid.labels import FACADE
 from facaid.parameters import named_parameters, set_parameter
-from facaid.segmentation import Segmentation, flatten_array, region_boxes
+from facaid.segmentation import region_boxes
+
+KEPT = 0.5  # an element is kept when the procedure paints at least this share of its pixels with its label
 
 
-def window_boxes(rows: np.ndarray) -> np.ndarray:
-    """The windows of a flattened segmentation's rows (N, 5: label, x0, y0, x1, y1; a partition of the label map):
-    the bounding boxes (M, 4) of the connected regions of its window and blind pieces."""
-    return region_boxes(rows, GLASS)
+def kept_elements(rows: np.ndarray, target: np.ndarray, pred: np.ndarray) -> tuple[int, int]:
+    """(elements drawn, elements kept): the connected regions of each label but wall in a flattened annotation's
+    ``rows`` whose label map is ``target``, and of those the ones ``pred`` paints with their label on at least `KEPT`
+    of their area, where they were drawn or off by up to half their thinner side (a 3 px sill drawn 2 px lower is
+    still there)."""
+    drawn = kept = 0
+    height, width = target.shape
+    for label in sorted({int(v) for v in rows[:, 0]} - {FACADE}):
+        for x0, y0, x1, y1 in region_boxes(rows, (label,)):
+            area = int((target[y0:y1, x0:x1] == label).sum())
+            if not area:
+                continue
+            drawn += 1
+            r = max(1, (min(x1 - x0, y1 - y0) + 1) // 2)
+            near = pred[max(0, y0 - r) : min(height, y1 + r), max(0, x0 - r) : min(width, x1 + r)]
+            kept += int((near == label).sum() >= KEPT * area)
+    return drawn, kept
 
 
-def _bands(centres: np.ndarray, sizes: np.ndarray) -> int:
-    if len(centres) == 0:
-        return 0
-    c = np.sort(centres)
-    return int(1 + np.sum(np.diff(c) > 0.5 * np.median(sizes)))
+PITCH = 0.15  # floor_height within this share of the window rows' pitch
 
 
-def lattice(rows: np.ndarray) -> tuple[int, int]:
-    """(window rows, window columns) of a flattened segmentation's rows."""
-    w = window_boxes(rows)
-    if len(w) == 0:
-        return 0, 0
-    return (_bands((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]), _bands((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
-
-
-def segmentation_lattice(seg: Segmentation) -> tuple[int, int]:
-    return lattice(flatten_array(seg.width, seg.height, seg.to_array()))
+def describes(proc: Procedure, rows: np.ndarray) -> dict:
+    """Whether the named parameters describe the building of a flattened annotation's ``rows``: ``floor_height``
+    within `PITCH` of the median spacing of its window rows (where it has at least three), ``tile_width`` the same
+    of its window columns', and no narrower than ``window_width`` (None where there is nothing to judge)."""
+    names = {p.name: p.value for p in named_parameters(proc)}
+    floor, bay = pitches(rows)
+    out = {"floor_pitch": floor, "bay_pitch": bay, "floor_height": names.get("floor_height"),
+           "tile_width": names.get("tile_width"), "floor_height_ok": None, "tile_width_ok": None}
+    if floor is not None and "floor_height" in names:
+        out["floor_height_ok"] = abs(names["floor_height"] / floor - 1) <= PITCH
+    if bay is not None and "tile_width" in names:
+        out["tile_width_ok"] = (abs(names["tile_width"] / bay - 1) <= PITCH
+                                and names["tile_width"] >= names.get("window_width", 0.0))
+    return out
 
 
 def editability(proc: Procedure, annotation: tuple[int, int] | None = None) -> dict:
-    """What a person gets editing ``proc`` by its named parameters: whether ``floors`` and ``bays`` exist, and
-    whether + 1 of each adds exactly one row (column) of windows and keeps the columns (rows). ``annotation``: the
-    lattice of the annotation it reconstructs, for ``eligible``."""
+    """What a person gets editing ``proc`` by its named parameters: whether ``floors`` and ``bays`` exist; whether
+    + 1 of each adds exactly one row (column) of windows and keeps the columns (rows) (``*_plus_one``), and whether
+    it is clean as a person looks at it (``*_clean``, with the reason where it is not). ``annotation``: the lattice
+    of the annotation it reconstructs, for ``eligible``."""
     names = {p.name: p for p in named_parameters(proc)}
     rows, cols = lattice(flat_rows(proc))
     out = {"rows": rows, "columns": cols, "floors": "floors" in names, "bays": "bays" in names,
-           "floors_plus_one": False, "bays_plus_one": False}
+           "floors_plus_one": False, "bays_plus_one": False, "floors_clean": False, "bays_clean": False}
     if annotation is not None:
         out["eligible"] = annotation[0] >= 2 and annotation[1] >= 2
     for name, key, grows, keeps in (("floors", "floors_plus_one", 0, 1), ("bays", "bays_plus_one", 1, 0)):
@@ -64,4 +82,15 @@ def editability(proc: Procedure, annotation: tuple[int, int] | None = None) -> d
         after = lattice(flat_rows(edited))
         before = (rows, cols)
         out[key] = after[grows] == before[grows] + 1 and after[keeps] == before[keeps]
+    for key, verdict in check_edits(proc).items():
+        name, change = key[:-2], key[-2:]
+        if change == "+1":
+            out[f"{name}_clean"] = verdict.clean
+            out[f"{name}_why"] = verdict.reason
+        else:
+            out[f"{name}_minus_clean"] = verdict.clean
     return out
+
+
+__all__ = ["KEPT", "PITCH", "describes", "editability", "kept_elements", "lattice", "segmentation_lattice",
+           "window_boxes"]

@@ -25,7 +25,7 @@ from tqdm import tqdm
 
 from facaid.augmentation import annotator_noise
 from facaid.defaults import DEFAULT_K
-from facaid.evaluation.editability import editability, segmentation_lattice
+from facaid.evaluation.editability import describes, editability, kept_elements, segmentation_lattice
 from facaid.formats.render import colorize, side_by_side
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import BACKGROUND, FACADE, LABELS
@@ -92,7 +92,9 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
                   "baseline": base[-1], "seconds": times[-1], "source": result.source, "shortcut": result.shortcut,
                   "denoised": result.denoised, "nodes": nodes[-1], "compression": compression(result.procedure, given),
                   "structure": result.structure, "lattice_seconds": result.timings.get("lattice", 0.0),
-                  **editability(result.procedure, segmentation_lattice(seg))}
+                  **editability(result.procedure, segmentation_lattice(seg)),
+                  **describes(result.procedure, flat.to_array())}
+        record["drawn"], record["kept"] = kept_elements(flat.to_array(), target, pred)
         if result.alternative is not None:  # the other structure, scored against the same target
             record["alternative_accuracy"] = pixel_accuracy(rasterize(to_segmentation(result.alternative)), target)
         if perturb is not None:  # the perturbed input's own accuracy against the clean annotation
@@ -145,8 +147,16 @@ def _summary(facades: list[dict]) -> dict:
     if "eligible" in facades[0]:  # the editability figures, over the facades with a lattice of windows
         eligible = [f for f in facades if f["eligible"]]
         out["eligible"] = len(eligible)
-        for key in ("floors", "bays", "floors_plus_one", "bays_plus_one"):
+        for key in ("floors", "bays", "floors_plus_one", "bays_plus_one", "floors_clean", "bays_clean"):
             out[f"{key}_share"] = float(np.mean([f[key] for f in eligible])) if eligible else 0.0
+        for key in ("floor_height_ok", "tile_width_ok"):  # over the facades with 3+ rows (columns) of windows
+            judged = [f[key] for f in facades if f.get(key) is not None]
+            out[f"{key}_share"] = float(np.mean(judged)) if judged else None
+            out[f"{key}_judged"] = len(judged)
+    if "drawn" in facades[0]:
+        out["elements_drawn"] = int(sum(f["drawn"] for f in facades))
+        out["elements_kept_share"] = float(sum(f["kept"] for f in facades) / max(1, out["elements_drawn"]))
+        out["nothing_lost_share"] = float(np.mean([f["kept"] == f["drawn"] for f in facades]))
         out["lattice_seconds_median"] = float(np.median([f["lattice_seconds"] for f in facades]))
     if any("alternative_accuracy" in f for f in facades):
         out["alternative_accuracy_mean"] = float(np.mean(
@@ -197,7 +207,16 @@ def format_summary(result: dict) -> str:
             share = {k: f"{100 * group[f'{k}_share']:.0f} %" for k in ("floors", "bays", "floors_plus_one",
                                                                          "bays_plus_one")}
             line += (f"; of {group['eligible']} with 2+ rows and columns of windows: floors {share['floors']}, bays "
-                     f"{share['bays']}, floors + 1 works {share['floors_plus_one']}, bays + 1 {share['bays_plus_one']}")
+                     f"{share['bays']}, floors + 1 works {share['floors_plus_one']}, bays + 1 {share['bays_plus_one']}"
+                     f" (counting window rows); clean as a person looks: floors + 1 "
+                     f"{100 * group['floors_clean_share']:.1f} %, bays + 1 {100 * group['bays_clean_share']:.1f} %")
+            for key, what in (("floor_height_ok", "floor_height within 15 % of the rows' pitch"),
+                              ("tile_width_ok", "tile_width the columns' pitch")):
+                if group.get(f"{key}_share") is not None:
+                    line += f"; {what} {100 * group[f'{key}_share']:.0f} % of {group[f'{key}_judged']}"
+        if "elements_kept_share" in group:
+            line += (f"; elements kept {100 * group['elements_kept_share']:.1f} % of {group['elements_drawn']}, "
+                     f"nothing lost on {100 * group['nothing_lost_share']:.0f} % of the facades")
         if "alternative_accuracy_mean" in group:
             line += f"; the other structure {100 * group['alternative_accuracy_mean']:.2f} %"
         if "input_accuracy_mean" in group:

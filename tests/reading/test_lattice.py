@@ -5,15 +5,20 @@ import numpy as np
 import pytest
 from grammar_helpers import real_like
 
-from facaid import lattice
-from facaid.evaluation.editability import editability, segmentation_lattice
+from facaid.evaluation.editability import editability, kept_elements, segmentation_lattice
 from facaid.generator import generate
 from facaid.grammar.execute import flat_rows, to_segmentation
 from facaid.grammar.procedure import Procedure
-from facaid.labels import LABEL_ID
-from facaid.metrics import compression, pixel_accuracy
+from facaid.labels import GLASS, LABEL_ID
+from facaid.metrics import pixel_accuracy
 from facaid.parameters import named_parameters, set_parameter
-from facaid.segmentation import Segmentation, flatten, rasterize
+from facaid.reading import lattice
+from facaid.segmentation import Segmentation, flatten, rasterize, region_boxes
+from facaid.sizing import fit_sizes
+
+
+def window_array(seg: Segmentation) -> np.ndarray:
+    return region_boxes(flatten(seg).to_array(), GLASS)
 
 
 def accuracy(proc: Procedure, seg: Segmentation) -> float:
@@ -26,20 +31,48 @@ def test_a_real_like_facade_reads_as_floors_of_tiles():
     params = {p.name: p.value for p in named_parameters(proc)}
     assert params["floors"] == 5 and params["bays"] == 6
     assert accuracy(proc, seg) > 0.94
-    assert compression(proc, flatten(seg)) > 5  # 94 drawn elements in a few leaves and their exceptions
-    assert editability(proc, segmentation_lattice(seg)) == {
+    got = editability(proc, segmentation_lattice(seg))
+    assert {k: got[k] for k in ("rows", "columns", "floors", "bays", "floors_plus_one", "bays_plus_one",
+                                 "floors_clean", "bays_clean", "eligible")} == {
         "rows": 5, "columns": 6, "floors": True, "bays": True, "floors_plus_one": True, "bays_plus_one": True,
-        "eligible": True}
+        "floors_clean": True, "bays_clean": True, "eligible": True}
+
+
+def test_nothing_drawn_is_lost():
+    """Every element drawn is in the reading, as part of a typical copy or as an exception (issue 67): those not kept
+    are thin ones a hand drew a few pixels off the typical copy's (jitter, restored), never a delta priced away."""
+    seg = real_like()
+    flat = flatten(seg)
+    target = rasterize(flat)
+    read = lattice.read_lattice(seg)
+    drawn, kept = kept_elements(flat.to_array(), target, rasterize(to_segmentation(read)))
+    assert drawn > 90 and kept >= drawn - 7
+    drawn, kept = kept_elements(flat.to_array(), target, rasterize(to_segmentation(fit_sizes(read, flat).procedure)))
+    assert kept >= drawn - 3
+
+
+def test_the_typical_floor_is_a_real_one():
+    """A new floor repeats a floor of the facade as drawn (the medoid), not a blend of them: the typical floor laid
+    out alone at a drawn floor's size equals that floor but for a hand's jitter."""
+    seg = real_like()
+    label_map = rasterize(flatten(seg))
+    proc = lattice.read_lattice(seg)
+    floors = next(n for _, n in proc.nodes() if n.role == "floors")
+    grid = lattice.read_grid(label_map, window_array(seg))
+    alike = [pixel_accuracy(rasterize(to_segmentation(Procedure(proc.width, b - a, floors.children[0]))),
+                            label_map[a:b]) for a, b in zip(grid.ys[:-1], grid.ys[1:], strict=True)]
+    assert max(alike) > 0.96
 
 
 def test_the_closed_blind_and_the_balcony_floor_are_exceptions():
     proc = lattice.read_lattice(real_like())
     floors = next(n for _, n in proc.nodes() if n.role == "floors")
-    blinds = [o for o in floors.exceptions if o.node is not None and o.node.rule == "leaf" and o.node.label == "blind"]
-    assert [(o.copy, o.path[2]) for o in blinds] == [(3, 2)]  # floor 3, tile 2, one leaf
+    blinds = [o for o in floors.exceptions if o.node is not None and o.node.rule != "repeat"
+              and any(n.label == "blind" for _, n in o.node.walk())]
+    assert [(o.copy, o.path[2]) for o in blinds] == [(3, 2)]  # floor 3, tile 2: that tile as drawn
     rows = [o for o in floors.exceptions if o.node is not None and o.node.rule == "repeat"]
-    assert [o.copy for o in rows] == [1]  # the balcony floor: its own row of tiles
-    labels = {n.label for _, n in rows[0].node.walk() if n.rule == "leaf"}
+    balcony = [o for o in rows if o.copy == 1]  # the balcony floor: its own row of tiles
+    labels = {n.label for _, n in balcony[0].node.walk() if n.rule == "leaf"}
     assert "balcony" in labels and "window" in labels
 
 
@@ -50,14 +83,6 @@ def test_floors_plus_one_adds_a_typical_floor():
     before = np.bincount(flat_rows(proc)[:, 0], minlength=12)
     assert counts[LABEL_ID["blind"]] == before[LABEL_ID["blind"]] == 1  # the exception is not copied
     assert editability(more)["rows"] == 6
-
-
-def test_the_reading_restores_a_hands_jitter():
-    """The same facade drawn twice by different hands reads the same: the typical copies, not the jitter."""
-    a, b = lattice.read_lattice(real_like(seed=1)), lattice.read_lattice(real_like(seed=2))
-    fa, fb = rasterize(to_segmentation(a)), rasterize(to_segmentation(b))
-    drawn_a, drawn_b = rasterize(flatten(real_like(seed=1))), rasterize(flatten(real_like(seed=2)))
-    assert pixel_accuracy(fa, fb) > pixel_accuracy(drawn_a, drawn_b)
 
 
 def test_no_lattice_no_reading():

@@ -1,0 +1,188 @@
+"""Whether an edit of a count did what a person means, judged from the facade before and after (no annotation).
+
+`floors` + 1 on a facade means: the old facade with one floor more, put in *between* two floors, a floor like
+those it already has, every other pixel where it was. Counting rows of window centres passes a facade whose new
+floor is a blend of three floors or sits under the shops; looking at the picture does not. So an edit is *clean*
+(issue 67) when:
+
+1. the edited label map is the old one with one band inserted (`insertion`: the row where it went in that leaves
+   most pixels where they were), not at the image's edge, and around it at least `KEEP` of the old pixels are
+   unchanged (`KEEP_BAY` for a bay, whose new column may re-lay the ground floor's shops around its door);
+2. the inserted band is a copy of a band of the old facade: at least `COPY` of its pixels equal those of the most
+   alike band of its size;
+3. it holds windows, and the rows (columns) of windows grow by as many as it holds (one; two where a bay is a
+   pair of windows, or a floor has a mezzanine) while the columns (rows) stay as they were.
+
+A removal (− 1) is judged as the insertion that would undo it: the old facade is the new one with a band put in.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from facaid.editing.windows import centre_bands, lattice, window_boxes
+from facaid.grammar.execute import flat_rows
+from facaid.grammar.procedure import Procedure
+from facaid.parameters import named_parameters, set_parameter
+from facaid.segmentation import Segmentation, rasterize
+
+KEEP = 0.98  # share of the old pixels a new floor leaves where they were
+KEEP_BAY = 0.93  # the same for a new bay column (the ground floor may re-lay its shops around the door)
+COPY = 0.90  # share of the new band's pixels that equal the most alike band of the old facade
+EDGE = 2  # a band put in within this many pixels of the image's edge is stuck on, not inserted
+NEAR = 0.01  # rows that keep this much less than the most kept are as good a place for the band
+TRIES = 8  # of those, this many (evenly spaced) are tried for the band's likeness
+SAMPLE = (2, 4)  # the band's rows and columns compared in the copy search: every 2nd row, every 4th column
+EDITS = (("floors", 1), ("floors", -1), ("bays", 1), ("bays", -1))
+_AXIS = {"floors": "y", "bays": "x"}
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """What an edit did: whether it is clean, and the figures the rule reads (shares of pixels, 0 to 1)."""
+
+    clean: bool
+    reason: str  # in words: what passed, or the first thing that did not
+    unchanged: float = 0.0  # of the old pixels, the share where they were
+    copy: float = 0.0  # of the band's pixels, the share equal to the most alike old band
+    at: int = -1  # where the band went in (px from the top, or the left)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def label_map(proc: Procedure) -> np.ndarray:
+    """The procedure's label map at full resolution, flattened as a person's annotation is."""
+    rows = flat_rows(proc)
+    return rasterize(Segmentation.from_array(round(proc.width), round(proc.height), rows))
+
+
+def kept(old: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """For each row y of ``old`` (0 to its height), the share of its pixels left where they were if a band of
+    ``new.shape[0] - old.shape[0]`` rows went in at y to make ``new`` (of the same width)."""
+    h = new.shape[0] - old.shape[0]
+    above = np.concatenate([[0], np.cumsum((new[: old.shape[0]] == old).sum(axis=1))])  # rows < y kept
+    below = np.concatenate([np.cumsum(((new[h:] == old).sum(axis=1))[::-1])[::-1], [0]])  # rows >= y, moved by h
+    return (above + below) / old.size
+
+
+def insertion(old: np.ndarray, new: np.ndarray, keep: float) -> tuple[int, float, float]:
+    """Where a band went into ``old`` to make ``new``: of the rows away from the edges that keep nearly the most of
+    ``old``'s pixels (and at least ``keep``), the one whose band is most alike a band of ``old`` (a band between two
+    like floors can go in at any row of them: only some of those cut a floor where the old ones are cut), with the
+    share kept and the band's likeness (`best_copy`)."""
+    h = new.shape[0] - old.shape[0]
+    share = kept(old, new)
+    inner = share[EDGE + 1 : len(share) - EDGE - 1]
+    if not len(inner):
+        at = int(np.argmax(share))
+        return at, float(share[at]), 0.0
+    near = np.flatnonzero(inner >= max(keep, inner.max() - NEAR)) + EDGE + 1
+    if not len(near):
+        at = int(np.argmax(share))  # at an edge, or too much changed: judged as it is
+        return at, float(share[at]), best_copy(new[at : at + h], old)
+    spread = near[np.unique(np.linspace(0, len(near) - 1, min(len(near), TRIES)).round().astype(int))]
+    best = (-1.0, 0.0, 0)
+    for y in sorted(spread.tolist(), key=lambda y: -share[y]):  # the most kept first; a copy found ends it
+        best = max(best, (best_copy(new[y : y + h], old), float(share[y]), y))
+        if best[0] >= COPY:
+            break
+    return best[2], best[1], best[0]
+
+
+def best_copy(band: np.ndarray, old: np.ndarray) -> float:
+    """The share of ``band``'s pixels (sampled, `SAMPLE`) equal to those of the most alike band of ``old`` of its
+    height (0 where ``old`` is lower than it)."""
+    h = band.shape[0]
+    if h > old.shape[0] or h == 0:
+        return 0.0
+    sy, sx = SAMPLE
+    sample = band[::sy, ::sx]
+    columns = old[:, ::sx]
+    starts = np.arange(old.shape[0] - h + 1)
+    alike = np.zeros(len(starts), dtype=np.int64)
+    for i, row in enumerate(sample):  # row i of the sample against row i * sy of every band of old
+        alike += (columns[starts + i * sy] == row).sum(axis=1)
+    return float(alike.max() / sample.size)
+
+
+def band_lattice(windows: np.ndarray, at: int, h: int, axis: str) -> int:
+    """How many rows (``axis`` "y") or columns ("x") of windows the band [at, at + h) holds: of ``windows`` (boxes
+    x0, y0, x1, y1), those whose centres lie in it, in bands of centres (`centre_bands`)."""
+    lo, hi = (1, 3) if axis == "y" else (0, 2)
+    centres = (windows[:, lo] + windows[:, hi]) / 2
+    inside = (centres >= at) & (centres < at + h)
+    return centre_bands(centres[inside], (windows[:, hi] - windows[:, lo])[inside])
+
+
+def judge_insert(old: np.ndarray, new: np.ndarray, old_lattice: tuple[int, int], new_lattice: tuple[int, int],
+                 new_windows: np.ndarray, axis: str, keep: float) -> Verdict:
+    """Whether ``new`` is ``old`` with one band inserted along ``axis`` ("y": a floor, "x": a bay) by the module's
+    rule. The lattices are (window rows, window columns) of each; ``new_windows`` the windows of ``new`` (boxes)."""
+    word = "floor" if axis == "y" else "bay"
+    if axis == "x":
+        old, new = old.T, new.T
+    if new.shape[1] != old.shape[1]:
+        return Verdict(False, f"the facade's other side changed too ({old.shape[1]} px to {new.shape[1]} px)")
+    h = new.shape[0] - old.shape[0]
+    if h <= 0:
+        return Verdict(False, f"the facade did not grow by a {word}")
+    at, unchanged, copy = insertion(old, new, keep)
+    figures = {"unchanged": unchanged, "copy": copy, "at": at}
+    grows, stays = (0, 1) if axis == "y" else (1, 0)
+    if at <= EDGE or at >= old.shape[0] - EDGE:
+        return Verdict(False, f"the new {word} is stuck on at the facade's edge, not put in between two", **figures)
+    if unchanged < keep:
+        return Verdict(False, f"{100 * (1 - unchanged):.1f} % of the facade around the new {word} changed "
+                              f"(at most {100 * (1 - keep):.0f} %)", **figures)
+    if copy < COPY:
+        return Verdict(False, f"the new {word} is like no {word} of the facade (at best {100 * copy:.0f} % alike, "
+                              f"{100 * COPY:.0f} % needed)", **figures)
+    held = band_lattice(new_windows, at, h, axis)
+    if not held:
+        return Verdict(False, f"the new {word} holds no windows", **figures)
+    if new_lattice[grows] != old_lattice[grows] + held or new_lattice[stays] != old_lattice[stays]:
+        what = ("rows", "columns") if axis == "y" else ("columns", "rows")
+        return Verdict(False, f"the windows went from {old_lattice[grows]} {what[0]} and {old_lattice[stays]} "
+                              f"{what[1]} to {new_lattice[grows]} and {new_lattice[stays]}", **figures)
+    return Verdict(True, f"one {word} like the others put in between two", **figures)
+
+
+def judge(before: Procedure, after: Procedure, name: str, change: int) -> Verdict:
+    """Whether ``after``, ``before`` with the count ``name`` ("floors" or "bays") changed by ``change`` (+1 or
+    -1), is the clean edit of the module's rule."""
+    axis = _AXIS[name]
+    keep = KEEP if name == "floors" else KEEP_BAY
+    old, new = (before, after) if change > 0 else (after, before)
+    new_rows = flat_rows(new)
+    out = judge_insert(label_map(old), label_map(new), lattice(flat_rows(old)), lattice(new_rows),
+                       window_boxes(new_rows), axis, keep)
+    if change < 0 and out.clean:
+        return Verdict(True, f"one {'floor' if name == 'floors' else 'bay'} like the others taken out",
+                       out.unchanged, out.copy, out.at)
+    return out
+
+
+def check_edits(proc: Procedure) -> dict[str, Verdict]:
+    """`floors` ± 1 and `bays` ± 1 tried on ``proc`` and judged, keyed "floors+1", "floors-1", "bays+1" and
+    "bays-1"; a count the procedure does not have, or cannot change that way, is left out."""
+    params = {p.name: p for p in named_parameters(proc)}
+    out = {}
+    for name, change in EDITS:
+        p = params.get(name)
+        if p is None or not p.min <= p.value + change <= p.max or p.min == p.max:
+            continue
+        key = f"{name}{change:+d}"
+        try:
+            edited = set_parameter(proc, name, p.value + change)
+        except ValueError as exc:
+            out[key] = Verdict(False, f"{name} {p.value + change:g} cannot be made: {exc}")
+            continue
+        out[key] = judge(proc, edited, name, change)
+    return out
+
+
+__all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "Verdict", "best_copy", "check_edits", "insertion", "judge",
+           "judge_insert", "kept", "label_map"]

@@ -1,0 +1,61 @@
+"""A facade's windows as a person counts them: connected window-or-blind regions (a window cut into pieces by its
+blind or sill counts once), in rows and columns.
+
+Window rows are the bands of window centres along y, split where the gap between neighbouring centres exceeds half
+the median window height; columns the same along x with the width.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from facaid.labels import GLASS
+from facaid.segmentation import Segmentation, flatten_array, region_boxes
+
+
+def window_boxes(rows: np.ndarray) -> np.ndarray:
+    """The windows of a flattened segmentation's rows (N, 5: label, x0, y0, x1, y1; a partition of the label map):
+    the bounding boxes (M, 4) of the connected regions of its window and blind pieces."""
+    return region_boxes(rows, GLASS)
+
+
+def centre_bands(centres: np.ndarray, sizes: np.ndarray) -> int:
+    """How many bands the centres make, split where neighbours are over half the median size apart."""
+    if len(centres) == 0:
+        return 0
+    c = np.sort(centres)
+    return int(1 + np.sum(np.diff(c) > 0.5 * np.median(sizes)))
+
+
+def pitch(centres: np.ndarray, sizes: np.ndarray) -> float | None:
+    """The median spacing of the bands of centres (each band at its median centre), None with fewer than 3 bands."""
+    if len(centres) == 0:
+        return None
+    order = np.argsort(centres)
+    c = centres[order]
+    cuts = np.flatnonzero(np.diff(c) > 0.5 * np.median(sizes)) + 1
+    middles = [float(np.median(band)) for band in np.split(c, cuts)]
+    return float(np.median(np.diff(middles))) if len(middles) >= 3 else None
+
+
+def pitches(rows: np.ndarray) -> tuple[float | None, float | None]:
+    """(floor pitch, bay pitch): the median spacing of the window rows and of the window columns of a flattened
+    segmentation's rows, each None with fewer than three."""
+    w = window_boxes(rows)
+    return (pitch((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]), pitch((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
+
+
+def lattice(rows: np.ndarray) -> tuple[int, int]:
+    """(window rows, window columns) of a flattened segmentation's rows."""
+    w = window_boxes(rows)
+    if len(w) == 0:
+        return 0, 0
+    return (centre_bands((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]),
+            centre_bands((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
+
+
+def segmentation_lattice(seg: Segmentation) -> tuple[int, int]:
+    return lattice(flatten_array(seg.width, seg.height, seg.to_array()))
+
+
+__all__ = ["centre_bands", "lattice", "pitch", "pitches", "segmentation_lattice", "window_boxes"]

@@ -1,0 +1,63 @@
+"""The edit check: an edit of a count judged from the facade before and after, as a person looks at it."""
+
+import numpy as np
+from grammar_helpers import example
+
+from facaid.editing.check import check_edits, insertion, judge, judge_insert, label_map
+from facaid.generator import generate_procedure
+from facaid.parameters import set_parameter
+
+
+def floors_map(n: int, odd: int | None = None) -> np.ndarray:
+    """A facade of n floors of 20 px, each a window row (label 2) on wall (1); floor ``odd`` has no windows."""
+    rows = []
+    for i in range(n):
+        floor = np.ones((20, 60), dtype=np.uint8)
+        if i != odd:
+            floor[5:15, 10:20] = floor[5:15, 40:50] = 2
+        rows.append(floor)
+    ground = np.full((15, 60), 3, dtype=np.uint8)
+    return np.concatenate([np.ones((10, 60), dtype=np.uint8), *rows, ground])
+
+
+def test_a_floor_put_in_between_two_is_clean():
+    old, new = floors_map(4), floors_map(5)
+    at, kept, copy = insertion(old, new, 0.98)
+    assert kept == 1.0 and copy == 1.0 and 10 <= at <= 90
+    windows = np.array([[10, 15 + 20 * i, 20, 25 + 20 * i] for i in range(5)] +
+                       [[40, 15 + 20 * i, 50, 25 + 20 * i] for i in range(5)])
+    assert judge_insert(old, new, (4, 2), (5, 2), windows, "y", 0.98).clean
+
+
+def test_a_band_stuck_on_at_the_edge_or_unlike_any_floor_is_not():
+    old = floors_map(4)
+    under = np.concatenate([old, old[10:30]])  # a floor under the shops, at the image's edge
+    verdict = judge_insert(old, under, (4, 2), (5, 2), np.zeros((0, 4)), "y", 0.98)
+    assert not verdict.clean and "edge" in verdict.reason
+    blank = floors_map(5, odd=2)  # a floor of bare wall: like no floor of the facade
+    verdict = judge_insert(old, blank, (4, 2), (4, 2), np.zeros((0, 4)), "y", 0.98)
+    assert not verdict.clean
+
+
+def test_a_blend_of_floors_is_not_a_copy():
+    old = floors_map(4)
+    new = floors_map(5)
+    new[50:70, :] = 1
+    new[55:65, 5:55] = 2  # the third floor a ribbon window: like no floor of the old facade
+    verdict = judge_insert(old, new, (4, 2), (5, 2), np.zeros((0, 4)), "y", 0.98)
+    assert not verdict.clean and verdict.copy < 0.9
+
+
+def test_edits_of_a_regular_facade_are_clean_both_ways():
+    proc = example()
+    checks = check_edits(proc)
+    assert set(checks) == {"floors+1", "floors-1", "bays+1", "bays-1"}
+    assert checks["floors+1"].clean and checks["floors-1"].clean, checks
+    more = set_parameter(proc, "floors", 5)
+    assert judge(proc, more, "floors", 1).clean and label_map(more).shape[0] > label_map(proc).shape[0]
+
+
+def test_fewer_floors_make_a_lower_facade():
+    proc = generate_procedure(5003)
+    fewer = set_parameter(proc, "floors", 2)
+    assert fewer.height < proc.height - 50
