@@ -12,9 +12,11 @@ the sampling is skipped. ``result.source`` says which kind of structure won.
 
 Two structures (``structure``): the model's, where it wins, is compact and editable already (a generated facade);
 where induction wins (a real facade, whose induced procedure copies the annotation as drawn: the *exact* one), the
-lattice reader (`facaid.reading.lattice`) reads the facade as floors of tiles with exceptions, and that sized is the
-*editable* one. ``structure="editable"`` (the default) returns it with the exact one as ``alternative``;
-``"exact"`` the other way round. Where there is no lattice to read, both are the one procedure.
+lattice reader (`facaid.reading.lattice`) reads the facade as floors of tiles with exceptions (candidate readings:
+its floors and bays one by one, else two by two; the first whose `floors` + 1 and `bays` + 1 are clean, else the
+most accurate: `best_reading`), and that sized is the *editable* one. ``structure="editable"`` (the default)
+returns it with the exact one as ``alternative``; ``"exact"`` the other way round. Where there is no lattice to
+read, both are the one procedure.
 
 A shortcut for annotations unlike the model's training data: when the decoded structure reproduces less than
 `FAR_OFF` of the pixels before sizing and the induced one at least `FAR_BEHIND` more, only the induced one is
@@ -35,6 +37,7 @@ import torch
 
 from facaid.decoding import Candidate, decode, ranked_candidates
 from facaid.defaults import DEFAULT_K, STRUCTURES
+from facaid.editing.check import check_edits
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.induce import induce_procedure
@@ -42,7 +45,7 @@ from facaid.labels import FACADE
 from facaid.metrics import element_leaves, procedure_accuracy, unexplained
 from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
-from facaid.reading.lattice import read_lattice
+from facaid.reading.lattice import readings
 from facaid.segmentation import Segmentation, flatten, flatten_array, rasterize
 from facaid.sizing import fit_sizes
 from facaid.tokenizer import Tokenizer
@@ -172,15 +175,33 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
                             "editable" if source == "model" else "exact")
     if sizing and source != "model" and prefix is None:
         tell(0.9, "reading the floors and bays")
-        read = read_lattice(flat)
-        if read is not None:
-            editable = fit_sizes(read, flat)
+        editable = best_reading(flat)
+        if editable is not None:
             editable.procedure.meta = {"source": "facaid.reconstruct", "structure": "lattice", "k": k,
-                                       "accuracy": round(editable.accuracy, 6)}
+                                       "accuracy": round(editable.accuracy, 6),
+                                       "group": editable.procedure.meta["group"]}
             result = _with_editable(result, editable, structure)
     t4 = time.perf_counter()
     timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, lattice=t4 - t3, total=t4 - t0)
     return result
+
+
+def best_reading(flat: Segmentation):
+    """Of the lattice readings of a flattened segmentation (`facaid.reading.lattice.readings`), sized, the first
+    whose `floors` + 1 and `bays` + 1 are clean (`facaid.editing.check`: the grid as read is tried first, the others
+    only where its edits fail), else the most accurate; a `SizingResult`, its procedure's meta naming its ``group``,
+    or None where there is no lattice."""
+    best, key = None, None
+    for group, proc in readings(flat):
+        fitted = fit_sizes(proc, flat)
+        checks = check_edits(fitted.procedure)
+        clean = all(checks[e].clean for e in ("floors+1", "bays+1") if e in checks)
+        fitted.procedure.meta["group"] = list(group)
+        if key is None or (clean, fitted.accuracy) > key:
+            best, key = fitted, (clean, fitted.accuracy)
+        if clean:
+            break
+    return best
 
 
 def _with_editable(exact: Reconstruction, editable, structure: str) -> Reconstruction:

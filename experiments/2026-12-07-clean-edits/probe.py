@@ -15,9 +15,8 @@ from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.grammar.execute import to_segmentation
 from facaid.metrics import pixel_accuracy
 from facaid.paths import DEFAULT_CMP
-from facaid.reading.lattice import read_lattice
+from facaid.pipeline import best_reading
 from facaid.segmentation import flatten, rasterize
-from facaid.sizing import fit_sizes
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--start", type=int, default=0)
@@ -32,14 +31,15 @@ for rid, seg in load_records(DEFAULT_CMP, args.limit, args.start):
     flat = flatten(seg)
     target = rasterize(flat)
     t0 = time.perf_counter()
-    read = read_lattice(flat)
-    if read is None:
+    best = best_reading(flat)
+    if best is None:
         out.append({"id": rid, "read": False})
         continue
-    proc = read if args.nosize else fit_sizes(read, flat).procedure
+    proc = read = best.procedure
     t1 = time.perf_counter()
     pred = rasterize(to_segmentation(proc))
-    rec = {"id": rid, "read": True, "seconds": t1 - t0, "accuracy": pixel_accuracy(pred, target),
+    rec = {"id": rid, "read": True, "group": read.meta.get("group"), "seconds": t1 - t0,
+           "accuracy": pixel_accuracy(pred, target),
            **editability(proc, segmentation_lattice(seg)), **describes(proc, flat.to_array())}
     rec["drawn"], rec["kept"] = kept_elements(flat.to_array(), target, pred)
     for k in ("floors", "bays"):

@@ -92,6 +92,7 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
                   "baseline": base[-1], "seconds": times[-1], "source": result.source, "shortcut": result.shortcut,
                   "denoised": result.denoised, "nodes": nodes[-1], "compression": compression(result.procedure, given),
                   "structure": result.structure, "lattice_seconds": result.timings.get("lattice", 0.0),
+                  "group": result.procedure.meta.get("group"),
                   **editability(result.procedure, segmentation_lattice(seg)),
                   **describes(result.procedure, flat.to_array())}
         record["drawn"], record["kept"] = kept_elements(flat.to_array(), target, pred)

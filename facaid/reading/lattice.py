@@ -14,8 +14,8 @@ Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013), in thre
 2. **The typical floor and bay** (`read_floors`). The typical floor is a real one, the medoid of the floors; the
    typical bay the medoid column; the typical tile is where they cross (`facaid.reading.units`). The typical floor
    is that floor as it is: a row of typical tiles with its own cells' deltas, so that a new floor is a copy of it.
-   A floor whose own typical tile (its medoid) differs is a floor of its own tiles (the balcony floor), so that a
-   new bay adds its own tile there; the attic and the ground floor are rows of their own cells on the same columns,
+   A floor whose own typical tile (its medoid) and whose cell in the typical column both differ is a floor of its
+   own tiles (the balcony floor), so that a new bay adds that cell there; the attic and the ground floor are rows of their own cells on the same columns,
    typical where the typical column's is (`_band`).
 3. **Exceptions**: every other cell's deltas from what the typical floor lays out there, and the lengths of floors
    and columns off the median by more than `JITTER`. Nothing drawn is priced away.
@@ -26,6 +26,7 @@ column. The result is an ordinary procedure: the pipeline sizes it (`facaid.sizi
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -176,19 +177,13 @@ def read_grid(label_map: np.ndarray, windows: np.ndarray) -> Grid | None:
     return Grid(label_map, ys, xs)
 
 
-def read_lattice(seg: Segmentation) -> Procedure | None:
+def read_lattice(seg: Segmentation, group: tuple[int, int] = (1, 1)) -> Procedure | None:
     """The editable procedure of a segmentation (see the module's docstring), or None where it has no lattice of
-    windows (fewer than two rows or two columns)."""
+    windows (fewer than two rows or two columns). ``group``: (floors, bays) of the grid read as one (`grouped`)."""
     flat = flatten(seg)
     label_map = rasterize(flat)
     height, width = label_map.shape
-    fx0, fx1 = footprint(label_map)
-    windows = region_boxes(flat.to_array(), GLASS)
-    if len(windows):  # the strips of a window a balcony or a sill left uncovered are not windows of the lattice
-        h, w = windows[:, 3] - windows[:, 1], windows[:, 2] - windows[:, 0]
-        windows = windows[(h >= WHOLE * np.median(h)) & (w >= WHOLE * np.median(w))]
-    centres = (windows[:, 0] + windows[:, 2]) / 2
-    grid = read_grid(label_map, windows[(centres >= fx0) & (centres < fx1)])
+    grid = grouped(_grid(flat, label_map), group)
     if grid is None:
         return None
     proc = Procedure(width, height, read_floors(grid), {"source": "facaid.lattice"})
@@ -196,6 +191,48 @@ def read_lattice(seg: Segmentation) -> Procedure | None:
         return Procedure.from_dict(proc.to_dict())
     except ProcedureError:  # a reading past the grammar's limits (more exceptions than a repeat holds): none
         return None
+
+
+def readings(seg: Segmentation) -> Iterator[tuple[tuple[int, int], Procedure]]:
+    """The candidate readings of a segmentation, each with its ``group``: the grid as read, and where they fit it,
+    its floors read two by two (a floor with a mezzanine: two rows of windows) and its columns two by two (a bay of
+    a pair of windows). The pipeline keeps the most accurate one whose edits pass."""
+    flat = flatten(seg)
+    label_map = rasterize(flat)
+    grid = _grid(flat, label_map)
+    for group in GROUPS:
+        g = grouped(grid, group)
+        if g is not None:
+            proc = Procedure(label_map.shape[1], label_map.shape[0], read_floors(g), {"source": "facaid.lattice"})
+            try:
+                yield group, Procedure.from_dict(proc.to_dict())
+            except ProcedureError:
+                continue
+
+
+GROUPS = ((1, 1), (2, 1), (1, 2))  # (floors, bays) read as one: the candidate readings
+
+
+def grouped(grid: Grid | None, group: tuple[int, int]) -> Grid | None:
+    """``grid`` with every ``group[0]`` floors one floor and every ``group[1]`` columns one bay, or None where the
+    counts do not divide by them or fewer than two of either would be left."""
+    if grid is None:
+        return None
+    (gy, gx), n, m = group, grid.rows, grid.columns
+    if n % gy or m % gx or n // gy < 2 or m // gx < 2:
+        return None
+    return Grid(grid.label_map, grid.ys[::gy], grid.xs[::gx])
+
+
+def _grid(flat: Segmentation, label_map: np.ndarray) -> Grid | None:
+    """The grid of a flattened segmentation: its windows, but strips, within the main building's footprint."""
+    fx0, fx1 = footprint(label_map)
+    windows = region_boxes(flat.to_array(), GLASS)
+    if len(windows):  # the strips of a window a balcony or a sill left uncovered are not windows of the lattice
+        h, w = windows[:, 3] - windows[:, 1], windows[:, 2] - windows[:, 0]
+        windows = windows[(h >= WHOLE * np.median(h)) & (w >= WHOLE * np.median(w))]
+    centres = (windows[:, 0] + windows[:, 2]) / 2
+    return read_grid(label_map, windows[(centres >= fx0) & (centres < fx1)])
 
 
 def read_floors(grid: Grid) -> Node:
@@ -232,9 +269,10 @@ def read_floors(grid: Grid) -> Node:
         if i == floor:
             continue
         mine = medoid([[cell] for cell in same[i]])  # the floor's own typical tile
-        if any(node is not None for _, _, node in deltas.of(tile, grid.cell(i, mine))):
-            # its tiles differ alike (the balcony floor): a floor of its own tiles, which a new bay adds one to
-            unit = Unit(grid.cell(i, mine), th, tw)
+        if all(any(node is not None for _, _, node in deltas.of(tile, grid.cell(i, j))) for j in {bay, mine}):
+            # its tiles differ alike (the balcony floor), in the typical column too: a floor of its own tiles, the
+            # typical column's its typical one, so that a new bay adds that column's cell to it
+            unit = Unit(grid.cell(i, bay), th, tw)
             variant = _row(unit, [deltas.of(unit, grid.cell(i, j)) for j in range(n_cols)], grid.widths, bay)
             floors.exceptions.append(Override(i, inside, node=variant))
         else:
@@ -310,5 +348,5 @@ def _role(node: Node, role: str) -> Node:
     return node
 
 
-__all__ = ["COLUMN_SUPPORT", "GROUND_SHARE", "JITTER", "WHOLE", "Grid", "footprint", "read_floors", "read_grid",
-           "read_lattice", "window_bands"]
+__all__ = ["COLUMN_SUPPORT", "GROUND_SHARE", "GROUPS", "JITTER", "WHOLE", "Grid", "footprint", "grouped",
+           "read_floors", "read_grid", "read_lattice", "readings", "window_bands"]

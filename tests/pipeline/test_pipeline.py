@@ -4,6 +4,7 @@ import pytest
 
 import facaid
 from facaid.cli import main
+from facaid.editing.check import check_edits
 from facaid.generator import generate
 from facaid.grammar import Procedure, validate
 from facaid.metrics import procedure_accuracy
@@ -55,6 +56,9 @@ def test_a_real_facade_comes_back_editable_with_the_exact_one_beside(tiny):
     assert editable.accuracy == procedure_accuracy(editable.procedure, flatten(seg)) > 0.94
     assert editable.alternative is not None and editable.alternative_accuracy > 0.97
     assert editable.to_dict()["alternative_accuracy"] == editable.alternative_accuracy
+    assert editable.procedure.meta["group"] == [1, 1]  # the grid as read: its edits are clean
+    checks = check_edits(editable.procedure)
+    assert checks["floors+1"].clean and checks["bays+1"].clean, checks
     exact = reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0, structure="exact")
     assert exact.structure == "exact" and exact.accuracy == editable.alternative_accuracy
     assert exact.alternative.to_json() == editable.procedure.to_json()

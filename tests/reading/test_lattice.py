@@ -106,3 +106,13 @@ def test_a_reading_past_the_grammars_limits_is_no_reading(monkeypatch):
     """Where the exceptions would overflow what a repeat may hold, the exact procedure stays the only one."""
     monkeypatch.setattr("facaid.grammar.procedure.MAX_EXCEPTIONS", 1)
     assert lattice.read_lattice(real_like()) is None
+
+
+def test_readings_come_as_read_first_then_two_by_two():
+    seg = real_like()
+    groups = [group for group, _ in lattice.readings(seg)]
+    assert groups[0] == (1, 1) and set(groups) <= set(lattice.GROUPS)
+    grid = lattice.read_grid(rasterize(flatten(seg)), window_array(seg))
+    assert lattice.grouped(grid, (2, 1)) is None  # 5 floors do not go two by two
+    pairs = lattice.grouped(grid, (1, 2))
+    assert pairs.columns == grid.columns // 2 and pairs.xs == grid.xs[::2]
