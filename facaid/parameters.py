@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
+import numpy as np
+
 from facaid.grammar.execute import parameter_lengths
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
@@ -62,12 +64,19 @@ class _Instances:
     def __init__(self, proc: Procedure):
         self.path: dict[int, str] = {}
         self.count: dict[int, int] = {}
-        self.extent: dict[int, tuple[float, float]] = {}
+        self.extent: dict[int, tuple[float, float]] = {}  # the first instance's
+        self.extents: dict[int, list[tuple[float, float]]] = {}  # every instance's
         self.parent_axis: dict[int, str | None] = {}
         self.outer: dict[int, bool] = {}  # no ancestor with the same role
         # an exception's node is named by its own path (root/1/!0), as `Node.walk` names it, wherever it is laid out
         self.own = {id(n): p for p, n in proc.nodes() if "!" in p}
         self._visit(proc.root, "root", float(proc.width), float(proc.height), None, frozenset())
+
+    def typical(self, key: int) -> tuple[float, float]:
+        """The median extents of a node's instances: a floor's height is the floors' typical height, not the top
+        floor's, which may have one of its own."""
+        ws, hs = zip(*self.extents[key], strict=True)
+        return float(np.median(ws)), float(np.median(hs))
 
     def _visit(self, node: Node, path: str, w: float, h: float, axis: str | None, roles: frozenset,
                pending: list | None = None) -> None:
@@ -76,6 +85,7 @@ class _Instances:
             self.path[key], self.extent[key], self.parent_axis[key] = path, (w, h), axis
             self.outer[key] = node.role not in roles
         self.count[key] = self.count.get(key, 0) + 1
+        self.extents.setdefault(key, []).append((w, h))
         if node.rule == "leaf":
             return
         length = w if node.axis == "x" else h
@@ -211,7 +221,7 @@ def named_parameters(proc: Procedure) -> list[Parameter]:
         nodes = [(p, n) for p, n in proc.nodes() if n.role == role and inst.outer.get(id(n))
                  and inst.parent_axis[id(n)] == axis]
         if nodes:  # the size of the most repeated (a floor's tile, not the attic's)
-            w, h = inst.extent[id(_most_laid_out(inst, nodes))]
+            w, h = inst.typical(id(_most_laid_out(inst, nodes)))
             out.append(Parameter(name, label, round(w if axis == "x" else h, 2), "px", False, 1.0, MAX_EXTENT,
                                  [p for p, _ in nodes]))
         if name == "ground_height" and (bays := _bays(proc, inst)):
@@ -356,7 +366,7 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             _grow(out, axis, {id(_along(nodes, path, axis)): value - p.value for path in p.nodes})
         else:
             side = 0 if axis == "x" else 1
-            _grow(out, axis, {id(n): value - inst.extent[id(n)][side] for n in (nodes[path] for path in p.nodes)
+            _grow(out, axis, {id(n): value - inst.typical(id(n))[side] for n in (nodes[path] for path in p.nodes)
                               if id(n) in inst.extent})  # a node an exception replaces everywhere has no length
     else:
         role, axis = ("floor", "y") if name == "floors" else ("tile", "x")

@@ -12,6 +12,8 @@ import numpy as np
 from facaid.labels import GLASS
 from facaid.segmentation import Segmentation, flatten_array, region_boxes
 
+STRIP = 0.35  # a window region under this share of the median window's height or width is a strip of one
+
 
 def window_boxes(rows: np.ndarray) -> np.ndarray:
     """The windows of a flattened segmentation's rows (N, 5: label, x0, y0, x1, y1; a partition of the label map):
@@ -42,6 +44,9 @@ def pitches(rows: np.ndarray) -> tuple[float | None, float | None]:
     """(floor pitch, bay pitch): the median spacing of the window rows and of the window columns of a flattened
     segmentation's rows, each None with fewer than three."""
     w = window_boxes(rows)
+    if len(w):  # the strips of a window a balcony or sill leaves uncovered are no window rows or columns of their own
+        h, wd = w[:, 3] - w[:, 1], w[:, 2] - w[:, 0]
+        w = w[(h >= STRIP * np.median(h)) & (wd >= STRIP * np.median(wd))]
     return (pitch((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]), pitch((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
 
 

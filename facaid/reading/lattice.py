@@ -15,8 +15,8 @@ Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013), in thre
    typical bay the medoid column; the typical tile is where they cross (`facaid.reading.units`). The typical floor
    is that floor as it is: a row of typical tiles with its own cells' deltas, so that a new floor is a copy of it.
    A floor whose own typical tile (its medoid) and whose cell in the typical column both differ is a floor of its
-   own tiles (the balcony floor), so that a new bay adds that cell there; the attic and the ground floor are rows of their own cells on the same columns,
-   typical where the typical column's is (`_band`).
+   own tiles (the balcony floor), so that a new bay adds that cell there; the attic and the ground floor are rows
+   of their own cells on the same columns, typical where the typical column's is (`_band`).
 3. **Exceptions**: every other cell's deltas from what the typical floor lays out there, and the lengths of floors
    and columns off the median by more than `JITTER`. Nothing drawn is priced away.
 
