@@ -22,7 +22,7 @@ from facaid.grammar.execute import parameter_lengths
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
-from facaid.grammar.repeats import copies_moved, recount
+from facaid.grammar.repeats import copies_moved, pattern_child, recount
 from facaid.resizing import copy_procedure, repeat_unit, resize
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
@@ -252,7 +252,7 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float], shrink: bool = Fals
 
     def has_target(node: Node) -> bool:
         if id(node) not in holds:
-            holds[id(node)] = id(node) in own or any(has_target(c) for c in node.children)
+            holds[id(node)] = id(node) in own or any(has_target(c) for c in _inner(node))
         return holds[id(node)]
 
     def pad(node: Node, extra: float) -> None:
@@ -301,6 +301,13 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float], shrink: bool = Fals
             else:
                 g = sum(parts)
         memo[key] = g
+        for o in node.exceptions:  # a node an exception puts in place grows too (its windows are windows), and
+            # is padded to what the node it replaces grew by, so that it fills the same place
+            if o.node is not None:
+                own_growth = grow(o.node)
+                replaced = _pattern_at(node, o.path)
+                if replaced is not None and memo.get(id(replaced), own_growth) > own_growth:  # (one that grew
+                    pad(o.node, memo[id(replaced)] - own_growth)  # more is laid out in its place as it is)
         return g
 
     g = grow(proc.root)
@@ -308,6 +315,22 @@ def _grow(proc: Procedure, axis: str, own: dict[int, float], shrink: bool = Fals
         proc.width = round(proc.width + g, 4)
     else:
         proc.height = round(proc.height + g, 4)
+
+
+def _inner(node: Node) -> list[Node]:
+    """A node's children and the nodes its exceptions put in place."""
+    return node.children + [o.node for o in node.exceptions if o.node is not None]
+
+
+def _pattern_at(node: Node, path: tuple[int, ...]) -> Node | None:
+    """The node of ``node``'s pattern that an exception's path names (a repeat's copies read as its pattern), or
+    None where the path goes below a leaf."""
+    target = node.children[path[0]]
+    for step in path[1:]:
+        if target.rule == "leaf":
+            return None
+        target = pattern_child(target, step)
+    return target
 
 
 def _pad_own_sizes(node: Node, item: int, extra: float) -> None:

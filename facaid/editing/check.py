@@ -11,7 +11,8 @@ floor is a blend of three floors or sits under the shops; looking at the picture
 2. the inserted band is a copy of a band of the old facade: at least `COPY` of its pixels equal those of the most
    alike band of its size;
 3. it holds windows, and the rows (columns) of windows grow by as many as it holds (one; two where a bay is a
-   pair of windows, or a floor has a mezzanine) while the columns (rows) stay as they were.
+   pair of windows, or a floor has a mezzanine) while the columns (rows) stay as they were; a shop window several
+   bays wide is in no column (`facaid.editing.windows.WIDE`).
 
 A removal (− 1) is judged as the insertion that would undo it: the old facade is the new one with a band put in.
 """
@@ -22,7 +23,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from facaid.editing.windows import centre_bands, lattice, window_boxes
+from facaid.editing.windows import WIDE, centre_bands, lattice, window_boxes
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
 from facaid.parameters import named_parameters, set_parameter
@@ -110,10 +111,12 @@ def best_copy(band: np.ndarray, old: np.ndarray) -> float:
 
 def band_lattice(windows: np.ndarray, at: int, h: int, axis: str) -> int:
     """How many rows (``axis`` "y") or columns ("x") of windows the band [at, at + h) holds: of ``windows`` (boxes
-    x0, y0, x1, y1), those whose centres lie in it, in bands of centres (`centre_bands`)."""
+    x0, y0, x1, y1), those whose centres lie in it, in bands of centres (`centre_bands`); a window over `WIDE` times
+    the median's size along the axis is in none."""
     lo, hi = (1, 3) if axis == "y" else (0, 2)
     centres = (windows[:, lo] + windows[:, hi]) / 2
-    inside = (centres >= at) & (centres < at + h)
+    sizes = windows[:, hi] - windows[:, lo]
+    inside = (centres >= at) & (centres < at + h) & (sizes <= WIDE * np.median(sizes) if len(sizes) else True)
     return centre_bands(centres[inside], (windows[:, hi] - windows[:, lo])[inside])
 
 
@@ -157,8 +160,8 @@ def judge(before: Procedure, after: Procedure, name: str, change: int) -> Verdic
     keep = KEEP if name == "floors" else KEEP_BAY
     old, new = (before, after) if change > 0 else (after, before)
     new_rows = flat_rows(new)
-    out = judge_insert(label_map(old), label_map(new), lattice(flat_rows(old)), lattice(new_rows),
-                       window_boxes(new_rows), axis, keep)
+    out = judge_insert(label_map(old), label_map(new), lattice(flat_rows(old), typical=True),
+                       lattice(new_rows, typical=True), window_boxes(new_rows), axis, keep)
     if change < 0 and out.clean:
         return Verdict(True, f"one {'floor' if name == 'floors' else 'bay'} like the others taken out",
                        out.unchanged, out.copy, out.at)

@@ -12,6 +12,7 @@ import numpy as np
 from facaid.labels import GLASS
 from facaid.segmentation import Segmentation, flatten_array, region_boxes
 
+WIDE = 2.0  # a window over this many times the median window's width (height) is in no column (row) of them
 STRIP = 0.35  # a window region under this share of the median window's height or width is a strip of one
 
 
@@ -50,13 +51,17 @@ def pitches(rows: np.ndarray) -> tuple[float | None, float | None]:
     return (pitch((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]), pitch((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
 
 
-def lattice(rows: np.ndarray) -> tuple[int, int]:
-    """(window rows, window columns) of a flattened segmentation's rows."""
+def lattice(rows: np.ndarray, typical: bool = False) -> tuple[int, int]:
+    """(window rows, window columns) of a flattened segmentation's rows. With ``typical``, a window over `WIDE` times
+    the median window's height (width) counts in no row (column): a shop window three bays wide is no column."""
     w = window_boxes(rows)
     if len(w) == 0:
         return 0, 0
-    return (centre_bands((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]),
-            centre_bands((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
+    h, wd = w[:, 3] - w[:, 1], w[:, 2] - w[:, 0]
+    tall = h > WIDE * np.median(h) if typical else np.zeros(len(w), dtype=bool)
+    wide = wd > WIDE * np.median(wd) if typical else np.zeros(len(w), dtype=bool)
+    return (centre_bands(((w[:, 1] + w[:, 3]) / 2)[~tall], h[~tall]),
+            centre_bands(((w[:, 0] + w[:, 2]) / 2)[~wide], wd[~wide]))
 
 
 def segmentation_lattice(seg: Segmentation) -> tuple[int, int]:

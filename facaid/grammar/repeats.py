@@ -65,7 +65,7 @@ def copies_moved(node: Node, count: int) -> dict[int, int]:
     """Where each copy of the repeat ``node`` goes when its count becomes ``count`` (a copy absent: removed; the
     tail, ``node.count``, goes to ``count``): new copies are typical and go after the last typical copy (one that no
     exception of ``node`` changes), between its like; removed copies are typical ones from the end first, then the
-    last."""
+    others from the end, but the last copy that lays out the pattern (with none, it would never be laid out)."""
     old = node.count
     changed = {o.copy for o in node.exceptions}
     typical = [c for c in range(old) if c not in changed]
@@ -73,10 +73,41 @@ def copies_moved(node: Node, count: int) -> dict[int, int]:
         at = typical[-1] + 1 if typical else old
         new = {c: c if c < at else c + count - old for c in range(old)}
     else:
-        gone = set((typical[::-1] + [c for c in range(old - 1, -1, -1) if c in changed])[: old - count])
+        # a copy that lays the pattern out (no exception puts a node in place of its items) stays while it is the
+        # last: without one, the pattern's own exceptions would never be laid out, which a tree may not hold
+        holders = list(_holders(node))
+        replaced = {o.copy for o in node.exceptions if o.node is not None
+                    and any(h[: len(o.path)] == o.path for h in holders)}
+        laying = {c for c in range(old) if c not in replaced}
+        gone: set[int] = set()
+        for c in typical[::-1] + [c for c in range(old - 1, -1, -1) if c in changed]:
+            if len(gone) == old - count:
+                break
+            if laying - gone != {c}:
+                gone.add(c)
+        if len(gone) < old - count:  # only that copy is left to take
+            gone |= laying
         new = {c: c - sum(1 for g in gone if g < c) for c in range(old) if c not in gone}
     new[old] = count  # the tail
     return new
+
+
+def _holders(node: Node) -> Iterator[tuple[int, ...]]:
+    """The paths (pattern item, then children of splits) of the nodes in a repeat's pattern that have exceptions of
+    their own, or the pattern items themselves where none has."""
+    def walk(n: Node, path: tuple[int, ...]) -> Iterator[tuple[int, ...]]:
+        if n.exceptions:
+            yield path
+        elif n.rule == "split":
+            for i, c in enumerate(n.children):
+                yield from walk(c, (*path, i))
+    found = False
+    for item, child in enumerate(node.children):
+        for path in walk(child, (item,)):
+            found = True
+            yield path
+    if not found:
+        yield from ((item,) for item in range(len(node.children)))
 
 
 def recount(root: Node, node: Node, count: int, new: dict[int, int] | None = None) -> None:

@@ -24,7 +24,7 @@ from facaid.grammar.procedure import (
     Size,
     validate,
 )
-from facaid.grammar.repeats import recount
+from facaid.grammar.repeats import copies_moved, recount
 from facaid.labels import LABEL_ID
 from facaid.native import rects
 from facaid.parameters import named_parameters, normalised, set_parameter
@@ -313,3 +313,20 @@ def test_exceptions_count_towards_the_node_limit():
     with pytest.raises(ProcedureError, match=f"too many nodes and exceptions \\(more than {MAX_NODES}\\)"):
         Procedure.from_dict(Procedure(4000, 4000, Node.split("x", [(Size("flt", 1), rows.copy())
                                                                     for _ in range(2)])).to_dict())
+
+
+def test_a_copy_fewer_keeps_a_copy_that_lays_out_the_pattern():
+    """Where the only typical copy is the one that lays the pattern's row out (the other puts its own row in place: a
+    lattice reading's balcony floor), one floor fewer takes the other away: without the typical one the pattern's
+    own exceptions would never be laid out, and the tree would be refused."""
+    row = Node.repeat("x", 2, [(Size("flt", 50), Node.leaf("window"))])
+    row.exceptions = [Override(1, (0,), node=Node.leaf("blind"))]
+    floor = Node.split("x", [(Size("flt", 100), row)])
+    floors = Node.repeat("y", 2, [(Size("flt", 50), floor)], role="floors")
+    floors.exceptions = [Override(0, (0, 0), node=Node.repeat("x", 2, [(Size("flt", 50), Node.leaf("shop"))]))]
+    proc = Procedure(100, 100, floors)
+    validate(proc)
+    assert copies_moved(floors, 1) == {1: 0, 2: 1}  # the typical copy stays, the one with its own row goes
+    recount(proc.root, floors, 1)
+    validate(proc)
+    assert floors.exceptions == []

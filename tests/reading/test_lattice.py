@@ -7,7 +7,7 @@ from grammar_helpers import real_like
 
 from facaid.evaluation.editability import editability, kept_elements, segmentation_lattice
 from facaid.generator import generate
-from facaid.grammar.execute import flat_rows, to_segmentation
+from facaid.grammar.execute import execute, flat_rows, to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.labels import GLASS, LABEL_ID
 from facaid.metrics import pixel_accuracy
@@ -116,3 +116,18 @@ def test_readings_come_as_read_first_then_two_by_two():
     assert lattice.grouped(grid, (2, 1)) is None  # 5 floors do not go two by two
     pairs = lattice.grouped(grid, (1, 2))
     assert pairs.columns == grid.columns // 2 and pairs.xs == grid.xs[::2]
+
+
+def test_a_shared_size_changes_every_copy_its_exceptions_too():
+    """window_width + 4 widens every window, those of the copies that are exceptions (their own trees) too, but
+    for a copy whose window has a width of its own (a size delta: it keeps it)."""
+    proc = lattice.read_lattice(real_like())
+    width = {p.name: p.value for p in named_parameters(proc)}["window_width"]
+    wider = set_parameter(proc, "window_width", width + 4)
+
+    def widths(p: Procedure) -> list[float]:
+        return sorted(x1 - x0 for label, x0, _, x1, _ in execute(p) if label == LABEL_ID["window"])
+
+    before, after = widths(proc), widths(wider)
+    assert len(before) == len(after) > 25
+    assert sum(b - a == pytest.approx(4, abs=0.6) for a, b in zip(before, after, strict=True)) >= len(before) - 1
