@@ -314,11 +314,14 @@ def gallery_page(where: tuple, build: Callable[[], Any]) -> Any:
 def fork_procedure(user, proc: Procedure) -> Procedure:
     """A private copy owned by ``user`` with ``proc`` as its parent. It keeps the links to the photo and the
     segmentation, which show (the overlay, the re-run) only while the photo is shared with the viewer
-    (`access.photo_visible_to`, checked on every view): once a private photo is shared, the fork shows it too."""
+    (`access.photo_visible_to`, checked on every view): once a private photo is shared, the fork shows it too. It
+    keeps the procedure's own scale (its metres per pixel, which all who may see the procedure are shown:
+    `disclosure`), so that it downloads at its parent's size."""
     title = proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}"
     return Procedure.objects.create(
         owner=user, title=title[:200], data=proc.data, parent=proc, accuracy=proc.accuracy, metrics=proc.metrics,
-        photo=proc.photo, segmentation_id=proc.segmentation_id)
+        photo=proc.photo, segmentation_id=proc.segmentation_id, metres_per_pixel=proc.metres_per_pixel,
+        scale_from=proc.scale_from)
 
 
 def rerun(user, proc: Procedure, nodes: int, k: int = DEFAULT_K) -> Job:
