@@ -165,11 +165,29 @@ def _overlay(proc: Procedure, tree: Tree, params: Params, viewer) -> bytes:
         return rendering.overlay_png(to_segmentation(tree), f, alpha)
 
 
+def picture_name(proc: Procedure, tree: Tree, viewer) -> str:
+    """The picture a procedure's annotations name: its photo (`Photo.file_name`: its title, as the site knows it),
+    the original image or the rectified one, whichever the procedure was drawn on and has the size of; to a viewer
+    who may not see the photo, a neutral name (``facaid-<code>-photo.jpg``: neither its title nor its ID,
+    `disclosure`); the label map downloaded beside them (``facaid-<code>-labels.png``) for a procedure without a
+    photo or of another size than it (a variation made larger)."""
+    photo = proc.photo
+    if photo is not None:
+        original = proc.drawn_on_original() or not photo.rectified
+        if (round(tree.width), round(tree.height)) == ((photo.width, photo.height) if original else
+                                                        photo.working_size()):
+            if disclosure.hidden(viewer, proc):
+                field = photo.image if original else photo.rectified
+                return f"{stem(proc)}-photo.{field.name.rsplit('.', 1)[-1].lower()}"
+            return photo.file_name(rectified=not original)
+    return f"{stem(proc)}-labels.png"
+
+
 def _annotations(fmt: str) -> Builder:
-    """The elements it draws as another tool's annotations, one box each (`annotation.written_as`), of the
-    label map downloaded beside them."""
+    """The elements it draws as another tool's annotations, one box each (`annotation.written_as`), naming the
+    picture they annotate (`picture_name`)."""
     return lambda proc, tree, params, viewer: interchange.write(written_as(to_segmentation(tree), fmt), fmt,
-                                                        image=f"{stem(proc)}-labels.png")
+                                                                image=picture_name(proc, tree, viewer))
 
 
 DOWNLOADS: dict[str, Download] = {

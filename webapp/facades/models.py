@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import uuid
 from dataclasses import dataclass
 
@@ -25,6 +26,9 @@ class Visibility(models.TextChoices):
 
 
 REAL_SIZE_M = (0.5, 1000.0)  # the real width or height of a facade a user may give, in metres: a shed to a tower
+
+
+UNSAFE_IN_NAMES = re.compile(r'[\x00-\x1f\x7f/\\:*?"<>|]+')  # what a file name may not hold: folders, and more
 
 
 def photo_path(photo: Photo, filename: str) -> str:
@@ -72,6 +76,15 @@ class Photo(models.Model):
 
     def working_size(self) -> tuple[int, int]:
         return (self.rectified.width, self.rectified.height) if self.rectified else (self.width, self.height)
+
+    def file_name(self, rectified: bool = False) -> str:
+        """The photo as an annotation file names its picture: its title where it has one (as a file name: no
+        folders, no characters a file system refuses), else ``facaid-photo-<code>``; ``-rectified`` for the
+        rectified image; the extension of the image stored."""
+        base = UNSAFE_IN_NAMES.sub("-", self.title).strip(" .-")[:100] or f"facaid-photo-{str(self.code)[:8]}"
+        rectified = rectified and bool(self.rectified)
+        field = self.rectified if rectified else self.image
+        return f"{base}{'-rectified' if rectified else ''}.{field.name.rsplit('.', 1)[-1].lower()}"
 
     def metres_per_pixel(self, size: tuple[float, float] | None = None) -> float | None:
         """The real size over the pixels of an image of the facade of ``size`` (by default the working image's):

@@ -210,11 +210,8 @@ def segmentation_file(photo: Photo, format: str, version: str | None = None) -> 
     seg = SegmentationData.from_dict(row.data)
     # the picture it was drawn on: one drawn before rectification has the original's size
     rectified = bool(photo.rectified) and (seg.width, seg.height) != (photo.width, photo.height)
-    field = photo.rectified if rectified else photo.image
-    stem = f"facaid-photo-{str(photo.code)[:8]}"
-    picture = f"{stem}{'-rectified' if rectified else ''}.{field.name.rsplit('.', 1)[-1]}"
-    name = f"{stem}-v{row.version}{interchange.SUFFIXES[format]}"
-    return name, interchange.CONTENT_TYPES[format], interchange.write(seg, format, image=picture)
+    name = f"facaid-photo-{str(photo.code)[:8]}-v{row.version}{interchange.SUFFIXES[format]}"
+    return name, interchange.CONTENT_TYPES[format], interchange.write(seg, format, image=photo.file_name(rectified))
 
 
 def complete_segmentation(photo: Photo, data) -> list[dict]:

@@ -211,8 +211,8 @@ def render_preview(request):
                                                         "size, else a storey is 3 m)")],
                responses={(200, "application/octet-stream"): bytes},
                summary="Downloads: procedure.json, segmentation.json (executed; segmentation.coco.json, "
-                       "segmentation.labelme.json and segmentation.cvat.xml the same as another tool's annotations of "
-                       "labels.png), labels.png, labels.svg (one group "
+                       "segmentation.labelme.json and segmentation.cvat.xml its elements as another tool's "
+                       "annotations of its photo), labels.png, labels.svg (one group "
                        "of rectangles per class), procedure.cga (CityEngine CGA rules), mesh.zip (a relief mesh: "
                        "facade.obj and facade.mtl), facade.glb and facade.gltf (glTF), facade-photo.glb (with the "
                        "photo), facade.ifc (IFC4), facade.city.json (CityJSON 2.0), overlay.png")
