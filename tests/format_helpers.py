@@ -3,8 +3,11 @@
 from facaid.grammar.procedure import Node, Procedure, Size
 
 
-def window_grid(columns: int, rows: int, size: int = 2000) -> Procedure:
+def window_grid(columns: int, rows: int, size: int = 2000, apart: bool = False) -> Procedure:
     """``rows`` rows of ``columns`` windows, each beside a piece of wall: ``2 * columns * rows`` rectangles;
-    window_grid(200, 60) draws 24,000, past every 3D export's cap."""
+    window_grid(200, 60) draws 24,000, past every 3D export's cap. The windows of a column touch, so they are one
+    element each column (one window, to an annotator); ``apart``: a band of wall under each row, so that each window
+    is one (``rows`` rectangles more)."""
     row = Node.repeat("x", columns, [(Size("flt", 1), Node.leaf("window")), (Size("flt", 1), Node.leaf("facade"))])
-    return Procedure(width=size, height=size, root=Node.repeat("y", rows, [(Size("flt", 1), row)]))
+    band = [(Size("flt", 1), Node.leaf("facade"))] if apart else []
+    return Procedure(width=size, height=size, root=Node.repeat("y", rows, [(Size("flt", 1), row), *band]))

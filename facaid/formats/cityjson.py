@@ -3,7 +3,8 @@
 One `Building` whose LoD3 `MultiSurface` is the relief (`facaid.formats.relief`): every element's front and the sides
 that join it to the wall plane, each a rectangle wound counter-clockwise seen from outside. Each window and shop
 front is a `Window` semantic surface of its own and each door a `Door` (its label, and its node's path in the
-tree, beside its type); everything else, reveals included, is a `WallSurface`, one per label. Coordinates are local
+tree, beside its type; the front of an element drawn in parts is several rings of the one surface); everything
+else, reveals included, is a `WallSurface`, one per label. Coordinates are local
 metres (no reference system: place the facade in your model), x along the facade, y into the building, z up,
 written as millimetres by the file's transform; the building's attributes say the scale.
 """
@@ -32,7 +33,6 @@ def procedure_cityjson(proc: Procedure, scale: float | None = None, scale_from: 
         raise ValueError(f"CityJSON version must be one of {', '.join(VERSIONS)}, got {version!r}")
     relief = procedure_relief(proc, scale, scale_from)
     labels = relief.labels()
-    boxes = relief.boxes()
     corners, semantics, values = [], [], []
     walls: dict[str, int] = {}  # label -> its WallSurface
 
@@ -42,15 +42,18 @@ def procedure_cityjson(proc: Procedure, scale: float | None = None, scale_from: 
             semantics.append({"type": "WallSurface", "label": label})
         return walls[label]
 
-    for i, (label, box) in enumerate(zip(labels, boxes, strict=True)):
-        quads, _ = box_quads(box[None], DEPTHS[label])  # (1, k, 4, 3): the front first
-        corners.append(quads[0])
+    parts = relief.boxes(relief.parts)
+    starts = np.searchsorted(relief.parts[:, 0], np.arange(len(labels) + 1))  # each row's parts, in row order
+    for i, label in enumerate(labels):
+        quads, _ = box_quads(parts[starts[i]:starts[i + 1]], DEPTHS[label])
+        corners.append(quads.reshape(-1, 4, 3))  # (parts x k, 4, 3): each part's front first
         if label in OPENINGS:
-            values.append(len(semantics))
+            opening = len(semantics)
             semantics.append({"type": OPENINGS[label], "label": label, "path": relief.paths[i]})
-            values += [wall(label)] * (len(quads[0]) - 1)
+            for _ in range(len(quads)):
+                values += [opening] + [wall(label)] * (quads.shape[1] - 1)
         else:
-            values += [wall(label)] * len(quads[0])
+            values += [wall(label)] * (quads.shape[0] * quads.shape[1])
     quads = np.concatenate(corners) if corners else np.zeros((0, 4, 3))
     unit = min(UNIT, 10.0 ** math.floor(math.log10(relief.scale / 10)))  # a tenth of a pixel at least
     # relief x right, y up, z towards the viewer -> x along the facade, y into the building, z up (a rotation:

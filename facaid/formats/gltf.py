@@ -1,11 +1,12 @@
 """A procedure as glTF 2.0 (a binary .glb, or a .gltf text with its data inline): the relief facade for 3D tools,
 game engines and the web.
 
-The scene's root node ``facade`` holds one child node per element of the relief (`facaid.formats.relief`), named for its
-label and numbered, its ``extras`` carrying the label, its node's path in the tree (``root/1/0``) and its rectangle
-in the procedure's pixels. Elements of one label and size are instances of one mesh (a repeat's windows: one mesh
-and many nodes, each moved into place); a mesh is the element's front and, where it sits back or stands out, the
-four sides that join it to the wall plane. One material per label in the palette's colour. With the rectified
+The scene's root node ``facade`` holds one child node per element of the relief (`facaid.formats.relief`: the
+elements the annotations hold, and the pieces of wall), named for its label and numbered, its ``extras`` carrying
+the label, its node's path in the tree (``root/1/0``) and its rectangle in the procedure's pixels. Elements of one
+label and size are instances of one mesh (a repeat's windows: one mesh and many nodes, each moved into place); a
+mesh is the element's front and, where it sits back or stands out, the four sides that join it to the wall plane
+(for each of its parts, where it is drawn in parts). One material per label in the palette's colour. With the rectified
 photo, the fronts show it (a material ``photo``) and each element has its own mesh for its own texture coordinates,
 the vertices still shared by the elements of one shape. Metres, x right, y up, z towards the viewer (glTF's own
 axes); the scale is in the root node's and the asset's ``extras``.
@@ -88,13 +89,18 @@ def procedure_gltf(proc: Procedure, scale: float | None = None, *, binary: bool 
     gltf.nodes.append(root)
     gltf.scenes.append(gl.Scene(name=name or "facade", nodes=[0]))
     gltf.scene = 0
-    shapes: dict[tuple[int, int, int], _Shape] = {}  # (label, width, height) in pixels
+    shapes: dict[tuple[int, int, int], _Shape] = {}  # (label, width, height) in pixels: the elements of one box
+    starts = np.searchsorted(relief.parts[:, 0], np.arange(len(relief.rows) + 1))  # each row's parts
     for i, (row, box, path) in enumerate(zip(relief.rows.tolist(), relief.boxes(), relief.paths, strict=True)):
         label, x0, y0, x1, y1 = row
-        key = (label, x1 - x0, y1 - y0)
-        if key not in shapes:
-            shapes[key] = _shape(data, relief, *key)
-        shape = shapes[key]
+        parts = relief.parts[starts[i]:starts[i + 1]]
+        if len(parts) == 1:
+            key = (label, x1 - x0, y1 - y0)
+            if key not in shapes:
+                shapes[key] = _shape(data, relief, label, np.array([[0.0, x1 - x0, 0.0, y1 - y0]]) * relief.scale)
+            shape = shapes[key]
+        else:  # drawn in parts, around what is painted over it: a mesh of its own
+            shape = _shape(data, relief, label, relief.boxes(parts) - [box[0], box[0], box[2], box[2]])
         mesh = shape.mesh
         if mesh is None:
             mesh = _mesh(gltf, data, relief, shape, box, materials, photo is not None)
@@ -114,10 +120,9 @@ def procedure_gltf(proc: Procedure, scale: float | None = None, *, binary: bool 
     return gltf.gltf_to_json(indent=None, separators=(",", ":")).encode("utf-8")
 
 
-def _triangles(first: int, quads: int) -> np.ndarray:
-    """The indices of ``quads`` quads from quad ``first`` on, two triangles each, wound as the quads are."""
-    q = 4 * np.arange(first, first + quads)[:, None]
-    return (q + np.array([0, 1, 2, 0, 2, 3])).reshape(-1)
+def _triangles(quads: np.ndarray) -> np.ndarray:
+    """The indices of the quads numbered ``quads``, two triangles each, wound as the quads are."""
+    return (4 * np.asarray(quads)[:, None] + np.array([0, 1, 2, 0, 2, 3])).reshape(-1)
 
 
 @dataclass
@@ -135,14 +140,16 @@ class _Shape:
     mesh: int | None = None
 
 
-def _shape(data: _Data, relief: Relief, label: int, width: int, height: int) -> _Shape:
-    box = np.array([[0.0, width, 0.0, height]]) * relief.scale
-    quads, normals = box_quads(box, DEPTHS[LABELS[label]])
+def _shape(data: _Data, relief: Relief, label: int, boxes: np.ndarray) -> _Shape:
+    """The shape of an element drawn as ``boxes`` (left, right, bottom, top in metres from its node's origin)."""
+    quads, normals = box_quads(boxes, DEPTHS[LABELS[label]])
     corners = quads.reshape(-1, 3)
-    normal = np.repeat(np.array([NORMALS[n] for n in normals], dtype=np.float32), 4, axis=0)
-    whole = data.accessor(_triangles(0, len(normals)))
-    front = data.accessor(_triangles(0, 1)) if len(normals) > 1 else whole
-    sides = data.accessor(_triangles(1, len(normals) - 1)) if len(normals) > 1 else None
+    k = len(normals)
+    normal = np.tile(np.repeat(np.array([NORMALS[n] for n in normals], dtype=np.float32), 4, axis=0), (len(boxes), 1))
+    numbers = np.arange(len(boxes) * k).reshape(len(boxes), k)  # each part's quads, its front first
+    whole = data.accessor(_triangles(numbers.reshape(-1)))
+    front = data.accessor(_triangles(numbers[:, 0])) if k > 1 else whole
+    sides = data.accessor(_triangles(numbers[:, 1:].reshape(-1))) if k > 1 else None
     return _Shape(label, data.accessor(corners, bounds=True), data.accessor(normal), whole, front, sides, corners)
 
 

@@ -160,7 +160,7 @@ def test_every_ring_faces_out_of_the_building(proc):
             fronts += 1
         else:
             assert normal[1] == pytest.approx(0)
-    assert fronts == len(procedure_relief(proc, SCALE).rows)
+    assert fronts == len(procedure_relief(proc, SCALE).parts)  # a front per part of each element
 
 
 def test_bad_input_is_refused(proc):

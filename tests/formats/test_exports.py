@@ -12,9 +12,10 @@ from format_helpers import window_grid
 from PIL import Image
 
 from facaid.cli import main
-from facaid.formats.annotation import as_annotated
+from facaid.formats.annotation import as_annotated, elements
 from facaid.formats.exports import EXPORTS, export_for
 from facaid.formats.interchange import read as read_annotations
+from facaid.formats.relief import procedure_relief
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
@@ -62,10 +63,13 @@ def read_back(path, proc):
 
 def test_every_extension_writes_its_format(tmp_path, source, proc, capsys):
     rects = len(to_segmentation(proc).rects)
-    windows = sum(r.label in (LABEL_ID["window"], LABEL_ID["shop"]) for r in to_segmentation(proc).rects)
-    boxes = len(as_annotated(to_segmentation(proc)).rects)  # one box per element, the wall under them
-    assert boxes < rects
-    expected = {".json": rects, ".png": (444, 797), ".svg": rects, ".obj": True, ".glb": rects, ".gltf": rects,
+    found = elements(to_segmentation(proc))  # one box per element: what the annotations and the 3D exports hold
+    windows = sum(r.label in (LABEL_ID["window"], LABEL_ID["shop"]) for r in found)
+    boxes = len(as_annotated(to_segmentation(proc)).rects)  # those, the wall under them
+    relief = len(procedure_relief(proc, 0.02).rows)  # those, and the wall's pieces
+    assert len(found) == sum(label != "facade" for label in procedure_relief(proc, 0.02).labels())
+    assert len(found) < boxes < rects
+    expected = {".json": rects, ".png": (444, 797), ".svg": rects, ".obj": True, ".glb": relief, ".gltf": relief,
                 ".ifc": windows, ".city.json": windows, ".overlay.png": (444, 797), ".coco.json": boxes,
                 ".labelme.json": boxes, ".cvat.xml": boxes}
     photo = tmp_path / "photo.png"

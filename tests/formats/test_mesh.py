@@ -1,23 +1,29 @@
-"""The relief mesh: read back as OBJ, its front faces paint the procedure's label map, every face is wound as its
-normal says, and a recess's sides face into it."""
+"""The relief mesh: read back as OBJ, its front faces, seen from the front, paint the label map of the elements the
+annotations hold (one object each), every face is wound as its normal says, and a recess's sides face into it."""
 
 import numpy as np
 import pytest
 from format_helpers import window_grid
 
+from facaid.formats.annotation import as_annotated
 from facaid.formats.mesh import DEPTHS, procedure_mesh
+from facaid.formats.relief import procedure_relief
 from facaid.generator import generate
 from facaid.grammar.execute import to_segmentation
-from facaid.labels import LABEL_ID, PALETTE
+from facaid.labels import FACADE, LABEL_ID, LABELS, PALETTE
 from facaid.segmentation import rasterize
 
 
 def read_obj(text: str) -> tuple[np.ndarray, np.ndarray, list[tuple[str, list[int], int]], str]:
     """Vertices, normals, faces (material, 0-based vertex indices, 0-based normal index) and the mtllib."""
     vertices, normals, faces, material, mtllib = [], [], [], None, None
+    objects = read_obj.objects = []  # the objects' names, in order
     for line in text.splitlines():
         parts = line.split()
         if not parts or parts[0] in ("#", "g"):
+            continue
+        if parts[0] == "o":
+            objects.append(parts[1])
             continue
         if parts[0] == "v":
             vertices.append([float(p) for p in parts[1:]])
@@ -41,8 +47,7 @@ def check_mesh(proc, scale: float) -> None:
     vertices, normals, faces, mtllib = read_obj(obj)
     assert mtllib == "facade.mtl"
     w, h = round(proc.width), round(proc.height)
-    painted = np.zeros((h, w), dtype=np.uint8)
-    front = 0
+    fronts = []  # (depth, label, y0, y1, x0, x1)
     for material, corners, n in faces:
         quad = vertices[corners]
         normal = normals[n]
@@ -50,13 +55,11 @@ def check_mesh(proc, scale: float) -> None:
         assert np.dot(winding, normal) > 0, (material, quad)  # counter-clockwise seen from its normal
         assert np.allclose((quad - quad[0]) @ normal, 0)  # flat, across the normal
         if tuple(normal) == (0, 0, 1):
-            front += 1
             assert np.allclose(quad[:, 2], DEPTHS[material])
             x0, x1 = np.rint(quad[:, 0].min() / scale).astype(int), np.rint(quad[:, 0].max() / scale).astype(int)
             y0, y1 = (np.rint(h - quad[:, 1].max() / scale).astype(int),
                       np.rint(h - quad[:, 1].min() / scale).astype(int))
-            assert not painted[y0:y1, x0:x1].any(), "front faces overlap"
-            painted[y0:y1, x0:x1] = LABEL_ID[material]
+            fronts.append((DEPTHS[material], LABEL_ID[material], y0, y1, x0, x1))
             centre = quad.mean(axis=0)
         else:  # a side (after its front) joins the wall plane to the front at the label's depth, facing out of a
             # protrusion and into a recess
@@ -64,8 +67,19 @@ def check_mesh(proc, scale: float) -> None:
             assert sorted(set(np.round(quad[:, 2], 6))) == sorted({0.0, depth})
             away = np.dot(normal, quad.mean(axis=0) - centre)
             assert not normal[2] and (away > 0 if depth > 0 else away < 0), (material, quad, normal)
-    assert np.array_equal(painted, rasterize(to_segmentation(proc)))
-    assert front == len(to_segmentation(proc).rects)
+    painted = np.zeros((h, w), dtype=np.uint8)
+    for depth in sorted({f[0] for f in fronts}):  # seen from the front, the nearest hides what is behind it
+        layer = np.zeros((h, w), dtype=np.uint8)
+        for _, label, y0, y1, x0, x1 in (f for f in fronts if f[0] == depth):
+            assert not layer[y0:y1, x0:x1].any(), "front faces at one depth overlap"
+            layer[y0:y1, x0:x1] = label
+        painted = np.where(layer > 0, layer, painted)
+    assert np.array_equal(painted, rasterize(as_annotated(to_segmentation(proc))))
+    relief = procedure_relief(proc, scale)
+    assert len(fronts) == len(relief.parts)
+    found = [name for name in read_obj.objects if name != "facade"]
+    assert sorted(found) == sorted(f"{LABELS[r[0]]}_{i}" for i, r in enumerate(relief.rows.tolist()) if r[0] != FACADE)
+    assert found == [e for e in found if e.rsplit("_", 1)[0] in LABEL_ID]
     for name in {m for m, _, _ in faces}:
         r, g, b = PALETTE[name]
         assert f"newmtl {name}\nKd {r / 255:.4f} {g / 255:.4f} {b / 255:.4f}" in mtl

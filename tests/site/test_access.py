@@ -201,8 +201,8 @@ def test_sharing_a_procedure_asks_about_its_photo_and_says_what_viewers_see(obje
     # the question and the answer say plainly that the procedure itself redraws the annotation (issue 66)
     assert (r["photo_shared"], r["viewers_see"]) == (False, (
         "Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the photo is "
-        "private. The procedure itself redraws the annotation (an exact version reproduces it as drawn); the "
-        "photo's title, its real size and the accuracy against it are not shown."))
+        "private. The procedure itself redraws the annotation (an exact version reproduces it as drawn) at its "
+        "size in metres; the photo's title and the accuracy against it are not shown."))
     assert as_charlie.get(url).json()["photo"] is None
     page = html.unescape(as_alice.get(f"/procedures/{proc.code}").content.decode())
     assert 'id="share-photo"' in page and r["viewers_see"] in page

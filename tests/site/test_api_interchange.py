@@ -128,7 +128,7 @@ def test_the_photos_segmentation_downloads_in_each_format(facade_photo, as_alice
     loaded = interchange.load(r.content)
     assert loaded.format == fmt and loaded.segmentation == Segmentation.from_dict(first["data"])
     if fmt != "segmentation":
-        assert loaded.image == f"facaid-photo-{photo['code'][:8]}.png"  # the photo it was drawn on
+        assert loaded.image == "Generated facade.png"  # the photo it was drawn on, by its title
 
 
 def test_segmentation_download_versions_and_access(facade_photo, as_alice, as_bob, as_charlie):
@@ -172,6 +172,34 @@ def test_a_procedures_rectangles_download_in_each_format(as_alice, alice):
         loaded = interchange.load(r.content)
         assert loaded.segmentation == as_annotated(to_segmentation(sample.procedure))  # one box per element
         assert loaded.image == f"facaid-{str(proc.code)[:8]}-labels.png"
+
+
+def test_a_procedures_annotations_name_its_photo_and_only_to_who_may_see_it(facade_photo, alice, as_alice,
+                                                                           as_charlie):
+    """Issue 67: COCO's file_name, LabelMe's imagePath and CVAT's image name are the photo the procedure was drawn
+    on, by its title (made a file name), not labels.png; to a viewer who may not see the photo, a neutral name."""
+    from webapp.facades.models import Photo, Procedure
+
+    photo, _ = facade_photo
+    stored = Photo.objects.get(code=photo["code"])
+    stored.title = "Rue de Rivoli 12 / east: side*"
+    stored.save()
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), photo=stored,
+                                    visibility="public")  # facade_png draws seed 3: the photo's size
+    for client, name in ((as_alice, "Rue de Rivoli 12 - east- side.png"),
+                         (as_charlie, f"facaid-{str(proc.code)[:8]}-photo.png")):
+        for download in ("segmentation.coco.json", "segmentation.labelme.json", "segmentation.cvat.xml"):
+            r = client.get(f"/api/v1/procedures/{proc.code}/download/{download}")
+            assert r.status_code == 200 and interchange.load(r.content).image == name, (download, name)
+            assert "Rivoli" not in r.content.decode() or client is as_alice
+    stored.title = ""
+    stored.save()
+    r = as_alice.get(f"/api/v1/procedures/{proc.code}/download/segmentation.coco.json")
+    assert interchange.load(r.content).image == f"facaid-photo-{photo['code'][:8]}.png"  # untitled: the site's name
+    proc.data = generate(4).procedure.to_dict()  # another size than the photo's: the label map beside it
+    proc.save()
+    r = as_alice.get(f"/api/v1/procedures/{proc.code}/download/segmentation.labelme.json")
+    assert interchange.load(r.content).image == f"facaid-{str(proc.code)[:8]}-labels.png"
 
 
 def test_convert_reads_other_tools_files_for_the_editor(as_charlie):

@@ -118,12 +118,15 @@ def test_downloads_take_the_photos_scale_and_say_so(procedure_of_photo, as_alice
     # asked for another scale, the download takes it
     width, header = obj_extent(as_alice.get(base + "mesh.zip?metres_per_pixel=0.01").content)
     assert width == pytest.approx(0.01 * width_px, abs=0.01) and "(given)" in header
-    # the procedure's page says which scale its downloads take: the photo's to who may see the photo (issue 66)
+    # the procedure's page says which scale its downloads take: the procedure's own, which the real size gave it,
+    # to all who may see the procedure (issue 67; the photo itself stays private)
+    proc.refresh_from_db()
+    assert proc.metres_per_pixel == pytest.approx(24 / width_px)
     proc.visibility = "public"
     proc.save()
-    for client, sees in ((as_alice, True), (as_charlie, False)):
+    for client in (as_alice, as_charlie):
         page = client.get(f"/procedures/{proc.code}").content.decode().replace("&#x27;", "'")
-        assert ("the photo's real width, 24 m" in page) == sees and ("a storey is 3 m tall" in page) != sees
+        assert "the photo's real width, 24 m" in page and "a storey is 3 m tall" not in page
 
 
 def test_the_photo_page_sets_the_real_size(facade_photo, as_alice, as_bob):

@@ -142,28 +142,35 @@ def _download(client, proc, name: str) -> str:
     return r.content.decode()
 
 
-def test_no_real_size_or_title_of_a_private_photo_in_the_downloads_and_the_page(shared, as_alice, as_bob, as_charlie):
-    """The photo's real width (12.3 m) is the photo's: to who may not see it, every file in metres and the page take
-    a storey 3 m tall (the procedure keeps no scale of its own), or the metres_per_pixel they ask for, and no file
-    names the facade by the photo's title. Alice, who owns both, still has the photo's scale."""
+def test_the_procedures_scale_but_no_title_of_a_private_photo_in_the_downloads_and_the_page(shared, as_alice,
+                                                                                            as_bob, as_charlie):
+    """The procedure keeps the scale its photo's real width (12.3 m) gave it when it was made (issue 67): every file
+    in metres is at that size for alice, who owns both, and for those who may see the procedure but not the photo
+    (they are shown its size in metres, as its owner was told when sharing it), or at the metres_per_pixel they ask
+    for; and no file names the facade by the photo's title but alice's."""
     photo, seg, proc = shared
     scale = f"{12.3 / photo['width']:.6g}"
+    proc.refresh_from_db()
+    assert proc.metres_per_pixel == pytest.approx(12.3 / photo["width"])
+    assert proc.scale_from == "the photo's real width, 12.3 m"
     for name in DOWNLOADS:
         text = _download(as_alice, proc, name)
         assert "12.3 m" in text or scale in text, name
     assert TITLE in _download(as_alice, proc, "procedure.cga")
     assert "the photo's real width, 12.3 m" in as_alice.get(f"/procedures/{proc.code}").content.decode().replace(
         "&#x27;", "'")
-    secrets = [*_secrets(photo, seg, proc), "12.3", scale, "real width"]
+    secrets = _secrets(photo, seg, proc)
     for client in (as_bob, as_charlie):
         for name in DOWNLOADS:
             text = _download(client, proc, name)
             assert not _found(secrets, text), name
-            assert "storey" in text or name == "procedure.json", name
-        assert "scale" not in json.loads(_download(client, proc, "procedure.json"))["meta"]
+            assert ("12.3 m" in text or scale in text) and "storey" not in text, name
+        own = json.loads(_download(client, proc, "procedure.json"))["meta"]["scale"]
+        assert own == {"metres_per_pixel": proc.metres_per_pixel, "from": "the photo's real width, 12.3 m"}
         asked = client.get(f"/api/v1/procedures/{proc.code}/download/procedure.json?metres_per_pixel=0.02")
         assert json.loads(asked.content)["meta"]["scale"] == {"metres_per_pixel": 0.02, "from": "given"}
         page = client.get(f"/procedures/{proc.code}").content.decode()
-        assert "(left empty, a storey is 3 m tall: " in page and not [s for s in secrets if s in page]
+        assert "(left empty, the photo&#x27;s real width, 12.3 m: " in page and not [s for s in secrets if s in page]
+        assert client.get(f"/api/v1/procedures/{proc.code}/").json()["metres_per_pixel"] == proc.metres_per_pixel
         r = client.get(f"/api/v1/procedures/{proc.code}/download/procedure.cga")
         assert r["Cache-Control"] == "private"  # another viewer is given another file

@@ -388,8 +388,8 @@ def test_sharing_asks_whether_to_share_the_photo_and_the_overlay_follows(live_se
         page.text_content("#share-photo"))
     assert page.text_content("#viewers-will-see") == (
         "Once saved: Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the "
-        "photo is private. The procedure itself redraws the annotation (an exact version reproduces it as drawn); "
-        "the photo's title, its real size and the accuracy against it are not shown.")
+        "photo is private. The procedure itself redraws the annotation (an exact version reproduces it as drawn) "
+        "at its size in metres; the photo's title and the accuracy against it are not shown.")
     page.check("#share-photo input")
     assert page.text_content("#viewers-will-see") == (
         "Once saved: Anyone sees the procedure with its photo and the overlay.")

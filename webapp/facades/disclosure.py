@@ -1,10 +1,17 @@
 """What a procedure shows a viewer who may not see its photo (anyone but the photo's owner while it is private, a
 fork's owner included): the procedure itself, its tree, pictures and 3D models, which redraw the annotation (an
-exact version reproduces it as drawn), and nothing more of the photo or its segmentation. No figure measured
-against the segmentation (pixel accuracy, per-class IoU, a re-run's warning, the accuracy a reconstruction writes
-into the tree's meta), no title or note that repeats the photo's title, no real size in metres (`downloads`), no
-photo or segmentation ID (`serializers`). The procedure's owner sees it all where the photo is theirs or shared with
-them, and everyone does once it is shared: the rule is checked on every request."""
+exact version reproduces it as drawn), its own scale (metres per pixel: the size in metres its 3D models have, which
+a fork keeps), and nothing more of the photo or its segmentation. No figure measured against the segmentation (pixel
+accuracy, per-class IoU, a re-run's warning, the accuracy a reconstruction writes into the tree's meta), no title or
+note that repeats the photo's title, no photo or segmentation ID (`serializers`), and of a procedure without a scale
+of its own, not the photo's real size (`downloads`). The procedure's owner sees it all where the photo is theirs or
+shared with them, and everyone does once it is shared: the rule is checked on every request.
+
+The scale is the procedure's, not the photo's (issue 67): set from the photo's real size when the procedure is made
+by one who may see it, it is one number about how large the building is, which the tree already draws to the pixel,
+not what the photo shows, where it was taken or what it is called; a fork keeps it, so that it downloads at its
+parent's size, and its owner may change or clear it (``metres_per_pixel`` on the API). Whoever shares a procedure is
+told that its size in metres is shown with it (`sharing.REDRAWS`)."""
 
 from __future__ import annotations
 

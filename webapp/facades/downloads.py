@@ -44,34 +44,21 @@ class Download:
 
 
 def drawn_on_original(proc: Procedure) -> bool:
-    """Whether the procedure was drawn on its photo's original image, not the rectified one (it has the original's
-    size, drawn before rectification)."""
-    photo = proc.photo
-    size = (proc.data.get("width", 0), proc.data.get("height", 0))
-    return bool(photo.rectified) and (round(size[0]), round(size[1])) == (photo.width, photo.height)
+    """Whether the procedure was drawn on its photo's original image, not the rectified one."""
+    return proc.drawn_on_original()
 
 
 def photo_scale(proc: Procedure, viewer) -> tuple[float, str] | None:
-    """The scale the procedure's photo gives (its real width or height over the pixels of the image the procedure
-    was drawn on) and a line saying so; None without a photo or a real size, or where ``viewer`` may not see the
-    photo: its real size is the photo's, not the procedure's, which keeps no scale of its own (a public procedure
-    of a private photo, a fork of one not shared with its owner)."""
-    photo = proc.photo
-    if photo is None or (photo.real_width_m is None and photo.real_height_m is None):
+    """The scale the procedure's photo gives (`Procedure.photo_scale`) where ``viewer`` may see the photo: for a
+    procedure without a scale of its own (one made before procedures kept theirs, migration 0009); None otherwise."""
+    if not access.photo_visible_to(viewer, proc.photo):
         return None
-    if not access.photo_visible_to(viewer, photo):
-        return None
-    scale = photo.metres_per_pixel((photo.width, photo.height) if drawn_on_original(proc) else None)
-    if scale is None:
-        return None
-    what = (f"the photo's real width, {photo.real_width_m:g} m" if photo.real_width_m is not None
-            else f"the photo's real height, {photo.real_height_m:g} m")
-    return scale, what
+    return proc.photo_scale()
 
 
 def download_scale(proc: Procedure, tree: Tree, viewer) -> tuple[float, str]:
     """The scale the metric downloads take for ``viewer`` without ``metres_per_pixel`` and where it comes from: the
-    photo's real size where they may see the photo, else a storey 3 m tall."""
+    procedure's own (`_scale`), else a storey 3 m tall."""
     scale, source = _scale(proc, tree, {}, viewer)
     if scale is None:
         return default_scale(tree), f"a storey is {STOREY_M:g} m tall"
@@ -79,16 +66,19 @@ def download_scale(proc: Procedure, tree: Tree, viewer) -> tuple[float, str]:
 
 
 def _scale(proc: Procedure, tree: Tree, params: Params, viewer) -> tuple[float | None, str]:
-    """The scale of a download and where it came from: ``metres_per_pixel`` if asked, else the photo's real size
-    (`photo_scale`), else None (the writers' default: a storey 3 m tall, which they say)."""
+    """The scale of a download and where it came from: ``metres_per_pixel`` if asked, else the procedure's own scale
+    (`Procedure.metres_per_pixel`: its photo's real size when it was made, kept by edits and forks, and shown to all
+    who may see the procedure), else the photo's real size where ``viewer`` may see the photo (`photo_scale`), else
+    None (the writers' default: a storey 3 m tall, which they say)."""
     raw = params.get("metres_per_pixel")
     if raw is None:
-        given = photo_scale(proc, viewer)
-        if given is not None:
-            try:
-                return checked_scale(tree, given[0]), given[1]
-            except ValueError:  # a real size over an image of a few pixels: the default rather than a 400
-                pass
+        own = (proc.metres_per_pixel, proc.scale_from) if proc.metres_per_pixel is not None else None
+        for given in (own, photo_scale(proc, viewer)):
+            if given is not None:
+                try:
+                    return checked_scale(tree, given[0]), given[1] or "the procedure's own scale"
+                except ValueError:  # a real size over an image of a few pixels: the default rather than a 400
+                    pass
         return None, ""
     try:
         return checked_scale(tree, float(raw)), ""  # the writers say "given"
@@ -124,8 +114,9 @@ def _metric(write: Callable[[Procedure, Tree, float | None, str, str], bytes | s
 
 
 def _procedure_json(proc: Procedure, tree: Tree, params: Params, viewer) -> str:
-    """The tree in pixels; where a real scale is known (the photo's real size, or ``metres_per_pixel``), its meta
-    names it, ``"scale": {"metres_per_pixel": .., "from": ..}``, so that a tool reading it can measure in metres."""
+    """The tree in pixels; where a real scale is known (the procedure's own, its photo's real size, or
+    ``metres_per_pixel``), its meta names it, ``"scale": {"metres_per_pixel": .., "from": ..}``, so that a tool
+    reading it can measure in metres."""
     scale, source = _scale(proc, tree, params, viewer)
     tree.meta = {k: v for k, v in tree.meta.items() if k != "scale"}  # never a scale of another download
     if disclosure.hidden(viewer, proc):  # nor the accuracy against a segmentation the viewer may not see
@@ -174,17 +165,35 @@ def _overlay(proc: Procedure, tree: Tree, params: Params, viewer) -> bytes:
         return rendering.overlay_png(to_segmentation(tree), f, alpha)
 
 
+def picture_name(proc: Procedure, tree: Tree, viewer) -> str:
+    """The picture a procedure's annotations name: its photo (`Photo.file_name`: its title, as the site knows it),
+    the original image or the rectified one, whichever the procedure was drawn on and has the size of; to a viewer
+    who may not see the photo, a neutral name (``facaid-<code>-photo.jpg``: neither its title nor its ID,
+    `disclosure`); the label map downloaded beside them (``facaid-<code>-labels.png``) for a procedure without a
+    photo or of another size than it (a variation made larger)."""
+    photo = proc.photo
+    if photo is not None:
+        original = proc.drawn_on_original() or not photo.rectified
+        if (round(tree.width), round(tree.height)) == ((photo.width, photo.height) if original else
+                                                        photo.working_size()):
+            if disclosure.hidden(viewer, proc):
+                field = photo.image if original else photo.rectified
+                return f"{stem(proc)}-photo.{field.name.rsplit('.', 1)[-1].lower()}"
+            return photo.file_name(rectified=not original)
+    return f"{stem(proc)}-labels.png"
+
+
 def _annotations(fmt: str) -> Builder:
-    """The elements it draws as another tool's annotations, one box each (`annotation.written_as`), of the
-    label map downloaded beside them."""
+    """The elements it draws as another tool's annotations, one box each (`annotation.written_as`), naming the
+    picture they annotate (`picture_name`)."""
     return lambda proc, tree, params, viewer: interchange.write(written_as(to_segmentation(tree), fmt), fmt,
-                                                        image=f"{stem(proc)}-labels.png")
+                                                                image=picture_name(proc, tree, viewer))
 
 
 DOWNLOADS: dict[str, Download] = {
     "procedure.json": Download("the procedure: the tree with its sizes in pixels, to edit or reconstruct from; its "
-                               "meta names the metres per pixel where the photo's real size (or metres_per_pixel) "
-                               "gives them", "application/json", _procedure_json),
+                               "meta names the metres per pixel where the procedure's own scale (or "
+                               "metres_per_pixel) gives them", "application/json", _procedure_json),
     "segmentation.json": Download("the labelled rectangles it draws", "application/json",
                                   lambda proc, tree, params, viewer: to_segmentation(tree).to_json(), per_leaf=5),
     "segmentation.coco.json": Download("its elements as COCO object detection annotations, one box each (pieces of "
@@ -217,8 +226,8 @@ DOWNLOADS: dict[str, Download] = {
 
 
 def build(name: str, proc: Procedure, params: Params, viewer) -> bytes | str:
-    """The download ``name`` of a procedure (one with a builder) as ``viewer`` may have it (no real size or title of
-    a photo they may not see); a `ValidationError` names a bad parameter."""
+    """The download ``name`` of a procedure (one with a builder) as ``viewer`` may have it (no title of a photo they
+    may not see); a `ValidationError` names a bad parameter."""
     download, tree = DOWNLOADS[name], parse_procedure(proc.data)  # the tree's own units charged as it is read
     if download.per_leaf:  # and what writing its rectangles costs, before any of it is written (the 3D formats
         # refuse more than MAX_MESH_RECTS once they are laid out, so no more are charged: those say how many)

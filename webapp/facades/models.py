@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import uuid
 from dataclasses import dataclass
 
@@ -25,6 +26,9 @@ class Visibility(models.TextChoices):
 
 
 REAL_SIZE_M = (0.5, 1000.0)  # the real width or height of a facade a user may give, in metres: a shed to a tower
+
+
+UNSAFE_IN_NAMES = re.compile(r'[\x00-\x1f\x7f/\\:*?"<>|]+')  # what a file name may not hold: folders, and more
 
 
 def photo_path(photo: Photo, filename: str) -> str:
@@ -73,6 +77,15 @@ class Photo(models.Model):
     def working_size(self) -> tuple[int, int]:
         return (self.rectified.width, self.rectified.height) if self.rectified else (self.width, self.height)
 
+    def file_name(self, rectified: bool = False) -> str:
+        """The photo as an annotation file names its picture: its title where it has one (as a file name: no
+        folders, no characters a file system refuses), else ``facaid-photo-<code>``; ``-rectified`` for the
+        rectified image; the extension of the image stored."""
+        base = UNSAFE_IN_NAMES.sub("-", self.title).strip(" .-")[:100] or f"facaid-photo-{str(self.code)[:8]}"
+        rectified = rectified and bool(self.rectified)
+        field = self.rectified if rectified else self.image
+        return f"{base}{'-rectified' if rectified else ''}.{field.name.rsplit('.', 1)[-1].lower()}"
+
     def metres_per_pixel(self, size: tuple[float, float] | None = None) -> float | None:
         """The real size over the pixels of an image of the facade of ``size`` (by default the working image's):
         None when no real size is given."""
@@ -85,6 +98,21 @@ class Photo(models.Model):
 
     def latest_segmentation(self) -> Segmentation | None:
         return self.segmentations.order_by("-version").first()
+
+    def rescale_procedures(self) -> int:
+        """After its real size changed: its owner's procedures made from it take the scale it now gives (others'
+        forks keep the one they were made with). The number changed."""
+        changed = 0
+        for proc in self.procedures.filter(owner_id=self.owner_id).only("id", "data", "photo_id", "metres_per_pixel",
+                                                                        "scale_from"):
+            proc.photo = self
+            before = (proc.metres_per_pixel, proc.scale_from)
+            proc.take_photo_scale()
+            if (proc.metres_per_pixel, proc.scale_from) != before:
+                Procedure.objects.filter(id=proc.id).update(metres_per_pixel=proc.metres_per_pixel,
+                                                            scale_from=proc.scale_from)
+                changed += 1
+        return changed
 
 
 class Segmentation(models.Model):
@@ -175,6 +203,10 @@ class Procedure(models.Model):
     parent = models.ForeignKey("self", on_delete=models.SET_NULL, null=True, blank=True, related_name="forks")
     accuracy = models.FloatField(null=True, blank=True)  # pixel accuracy against the segmentation
     metrics = models.JSONField(default=dict, blank=True)
+    # its own scale: metres per pixel of its tree and where they came from (its photo's real size when it was made,
+    # its parent's for a fork, or its owner's); the metric downloads' scale, kept across edits (migration 0009)
+    metres_per_pixel = models.FloatField(null=True, blank=True)
+    scale_from = models.CharField(max_length=200, blank=True)
     # names the tree in `data` (tree_digest): its kept pictures' names and ETags, read without `data`
     digest = models.CharField(max_length=16, blank=True, editable=False)
     data_size = models.PositiveIntegerField(default=0, editable=False)  # bytes of `data` (`json_size`): the quota's
@@ -226,6 +258,31 @@ class Procedure(models.Model):
     def current_version(self) -> ProcedureVersion | None:
         """The latest version: the one whose tree the procedure holds."""
         return self.versions.defer("data").order_by("-version").first()
+
+    def drawn_on_original(self) -> bool:
+        """Whether the procedure was drawn on its photo's original image, not the rectified one (it has the
+        original's size, drawn before rectification)."""
+        photo = self.photo
+        size = (self.data.get("width", 0), self.data.get("height", 0))
+        return bool(photo.rectified) and (round(size[0]), round(size[1])) == (photo.width, photo.height)
+
+    def photo_scale(self) -> tuple[float, str] | None:
+        """The scale its photo's real size gives (the real width or height over the pixels of the image the
+        procedure was drawn on) and a line saying so; None without a photo or a real size."""
+        photo = self.photo
+        if photo is None or (photo.real_width_m is None and photo.real_height_m is None):
+            return None
+        scale = photo.metres_per_pixel((photo.width, photo.height) if self.drawn_on_original() else None)
+        if scale is None:
+            return None
+        what = (f"the photo's real width, {photo.real_width_m:g} m" if photo.real_width_m is not None
+                else f"the photo's real height, {photo.real_height_m:g} m")
+        return scale, what
+
+    def take_photo_scale(self) -> None:
+        """Its own scale set to its photo's (`photo_scale`), or none where the photo has no real size (not saved)."""
+        given = self.photo_scale()
+        self.metres_per_pixel, self.scale_from = given if given else (None, "")
 
     def lineage(self) -> list[Procedure]:
         """Ancestors, nearest first (forks of forks), stopping at a cycle or a deleted parent."""

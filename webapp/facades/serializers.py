@@ -13,6 +13,7 @@ from rest_framework import serializers
 
 from facaid.defaults import DEFAULT_K, MAX_K, STRUCTURES
 from facaid.formats import interchange
+from facaid.formats.cga import MAX_SCALE
 from facaid.grammar.procedure import MAX_NODES
 from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
@@ -128,6 +129,14 @@ class PhotoSerializer(serializers.ModelSerializer):
     def get_metres_per_pixel(self, photo: Photo) -> float | None:
         return photo.metres_per_pixel()
 
+    def update(self, photo: Photo, validated_data: dict) -> Photo:
+        """The photo changed; where its real size did, its owner's procedures made from it take the new scale."""
+        resized = {"real_width_m", "real_height_m"} & validated_data.keys()
+        photo = super().update(photo, validated_data)
+        if resized:
+            photo.rescale_procedures()
+        return photo
+
     def get_image(self, photo: Photo) -> str:
         return f"/api/v1/photos/{photo.code}/image"
 
@@ -190,10 +199,11 @@ class ProcedureSerializer(serializers.ModelSerializer):
 
     class Meta:
         model = Procedure
-        fields = ["code", "owner", "title", "visibility", "version", "accuracy", "metrics", "parent", "photo",
-                  "segmentation", "photo_shared", "viewers_see", "data", "created", "updated"]
-        read_only_fields = ["code", "owner", "version", "accuracy", "metrics", "parent", "photo", "segmentation",
-                            "photo_shared", "viewers_see", "created", "updated"]
+        fields = ["code", "owner", "title", "visibility", "version", "accuracy", "metrics", "metres_per_pixel",
+                  "scale_from", "parent", "photo", "segmentation", "photo_shared", "viewers_see", "data", "created",
+                  "updated"]
+        read_only_fields = ["code", "owner", "version", "accuracy", "metrics", "metres_per_pixel", "scale_from",
+                            "parent", "photo", "segmentation", "photo_shared", "viewers_see", "created", "updated"]
 
     def get_version(self, proc: Procedure) -> int | None:
         current = proc.current_version()
@@ -296,6 +306,21 @@ class SaveAsNewSerializer(serializers.Serializer):
 
 class ProcedureWriteSerializer(SaveAsNewSerializer):
     visibility = serializers.ChoiceField(Visibility.choices, required=False)
+    metres_per_pixel = NumberField(
+        required=False, allow_null=True,
+        help_text=f"the procedure's own scale, metres per pixel (> 0, at most {MAX_SCALE:g}; null: none), the scale "
+                  "of its metric downloads; kept across edits, and by its forks")
+
+    def validate_metres_per_pixel(self, value):
+        if value is not None and not 0 < value <= MAX_SCALE:
+            raise serializers.ValidationError(f"metres_per_pixel must be a number > 0 and at most {MAX_SCALE:g}, "
+                                              "or null for none")
+        return value
+
+    def validate(self, attrs):
+        if "metres_per_pixel" in attrs:  # where it came from, said in the files
+            attrs["scale_from"] = "given by its owner" if attrs["metres_per_pixel"] is not None else ""
+        return attrs
 
 
 class ProcedureEditSerializer(ProcedureWriteSerializer):

@@ -210,11 +210,8 @@ def segmentation_file(photo: Photo, format: str, version: str | None = None) -> 
     seg = SegmentationData.from_dict(row.data)
     # the picture it was drawn on: one drawn before rectification has the original's size
     rectified = bool(photo.rectified) and (seg.width, seg.height) != (photo.width, photo.height)
-    field = photo.rectified if rectified else photo.image
-    stem = f"facaid-photo-{str(photo.code)[:8]}"
-    picture = f"{stem}{'-rectified' if rectified else ''}.{field.name.rsplit('.', 1)[-1]}"
-    name = f"{stem}-v{row.version}{interchange.SUFFIXES[format]}"
-    return name, interchange.CONTENT_TYPES[format], interchange.write(seg, format, image=picture)
+    name = f"facaid-photo-{str(photo.code)[:8]}-v{row.version}{interchange.SUFFIXES[format]}"
+    return name, interchange.CONTENT_TYPES[format], interchange.write(seg, format, image=photo.file_name(rectified))
 
 
 def complete_segmentation(photo: Photo, data) -> list[dict]:
@@ -314,11 +311,14 @@ def gallery_page(where: tuple, build: Callable[[], Any]) -> Any:
 def fork_procedure(user, proc: Procedure) -> Procedure:
     """A private copy owned by ``user`` with ``proc`` as its parent. It keeps the links to the photo and the
     segmentation, which show (the overlay, the re-run) only while the photo is shared with the viewer
-    (`access.photo_visible_to`, checked on every view): once a private photo is shared, the fork shows it too."""
+    (`access.photo_visible_to`, checked on every view): once a private photo is shared, the fork shows it too. It
+    keeps the procedure's own scale (its metres per pixel, which all who may see the procedure are shown:
+    `disclosure`), so that it downloads at its parent's size."""
     title = proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}"
     return Procedure.objects.create(
         owner=user, title=title[:200], data=proc.data, parent=proc, accuracy=proc.accuracy, metrics=proc.metrics,
-        photo=proc.photo, segmentation_id=proc.segmentation_id)
+        photo=proc.photo, segmentation_id=proc.segmentation_id, metres_per_pixel=proc.metres_per_pixel,
+        scale_from=proc.scale_from)
 
 
 def rerun(user, proc: Procedure, nodes: int, k: int = DEFAULT_K) -> Job:

@@ -16,8 +16,8 @@ from webapp.facades.models import Procedure, Visibility
 
 REACH = {Visibility.PRIVATE: 0, Visibility.UNLISTED: 1, Visibility.PUBLIC: 2}
 # what a procedure shared without its photo still tells of it (`disclosure`): the sharing question says so plainly
-REDRAWS = ("The procedure itself redraws the annotation (an exact version reproduces it as drawn); the photo's "
-           "title, its real size and the accuracy against it are not shown.")
+REDRAWS = ("The procedure itself redraws the annotation (an exact version reproduces it as drawn) at its size in "
+           "metres; the photo's title and the accuracy against it are not shown.")
 
 
 def _shared_as(photo_visibility: str, visibility: str) -> str:

@@ -146,7 +146,9 @@ def _store(job: Job, result: dict) -> None:
             if params.get("prefix_nodes"):  # told apart from the procedure it continued
                 title = f"{parent or title or 'Procedure'} · re-run keeping {params['prefix_nodes']} nodes"
             proc = Procedure(owner=job.owner, title=title[:200], photo=photo, segmentation=job.segmentation,
-                             parent=parent, visibility=params.get("visibility", Visibility.PRIVATE))
+                             parent=parent, visibility=params.get("visibility", Visibility.PRIVATE),
+                             data=result["procedure"])
+            proc.take_photo_scale()  # its own from now on: a fork keeps it, an edit leaves it
             other = result.get("alternative")
             if other:  # a real facade's other procedure: its first version, one revert away
                 proc.data, proc.accuracy = other["procedure"], other["accuracy"]

@@ -207,11 +207,12 @@ def render_preview(request):
 @extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),
                            OpenApiParameter("metres_per_pixel", float,
                                             description="the scale of procedure.cga, mesh.zip and the 3D models "
-                                                        "(default: the photo's real size, else a storey is 3 m)")],
+                                                        "(default: the procedure's own scale, from its photo's real "
+                                                        "size, else a storey is 3 m)")],
                responses={(200, "application/octet-stream"): bytes},
                summary="Downloads: procedure.json, segmentation.json (executed; segmentation.coco.json, "
-                       "segmentation.labelme.json and segmentation.cvat.xml the same as another tool's annotations of "
-                       "labels.png), labels.png, labels.svg (one group "
+                       "segmentation.labelme.json and segmentation.cvat.xml its elements as another tool's "
+                       "annotations of its photo), labels.png, labels.svg (one group "
                        "of rectangles per class), procedure.cga (CityEngine CGA rules), mesh.zip (a relief mesh: "
                        "facade.obj and facade.mtl), facade.glb and facade.gltf (glTF), facade-photo.glb (with the "
                        "photo), facade.ifc (IFC4), facade.city.json (CityJSON 2.0), overlay.png")
@@ -232,7 +233,7 @@ def procedure_download(request, code, name):
                                             "may see"})
         resp = HttpResponse(downloads.build(name, proc, request.query_params, request.user),
                             content_type=download.content_type)
-        resp["Cache-Control"] = "private"  # what it holds depends on who asks (the photo's real size and title)
+        resp["Cache-Control"] = "private"  # what it holds depends on who asks (the photo's title, its real size)
     resp["Content-Disposition"] = f'attachment; filename="{downloads.stem(proc)}-{name}"'
     return resp
 
