@@ -102,23 +102,34 @@ def swap(proc: Procedure, role: str, rng: random.Random, style: str | None = Non
 
 
 def vary(proc: Procedure, n: int = 8, seed: int = 0,
-         ranges: dict[str, tuple[float, float]] | None = None) -> list[Procedure]:
+         ranges: dict[str, tuple[float, float]] | None = None, hold: tuple[str, ...] = ()) -> list[Procedure]:
     """``n`` variants: counts of floors and tiles changed, the facade resized with its repeats adapting,
     tiles or floors swapped within the style. Deterministic by seed; every variant is valid. A draw that would
     cross the grammar's limits (a count past them, a facade at its largest made larger) is drawn again, so fewer
     than ``n`` come back only when that keeps happening.
 
+    ``hold`` names counts ("floors", "bays") that these variants keep as they are: no repeat that lays them out
+    changes its count, the facade is not resized along their axis (a resize recounts the repeats: a taller facade
+    holds more floors), with both held it is not resized, and a variant that changed one anyway (a floor swapped
+    for one of another facade, with other tiles) is drawn again. Without ``hold`` the draws are as they were.
+
     With ``ranges`` (named parameter → (low, high), see `facaid.parameters`), each variant instead draws every
-    named parameter uniformly from its range (whole numbers for counts) and sets them: ``{"floors": (4, 7)}``."""
+    named parameter uniformly from its range (whole numbers for counts) and sets them: ``{"floors": (4, 7)}``
+    (``hold`` does not apply: the ranges say what changes)."""
     if not 1 <= n <= 64:
         raise ValueError(f"n must be between 1 and 64, got {n}")
     rng = random.Random(f"facaid-vary:{seed}")
     if ranges:
         return _vary_ranges(proc, n, seed, rng, ranges)
-    repeats = [p for p, node in proc.nodes() if node.rule == "repeat" and node.count != "fill"]
+    held = _held_repeats(proc, hold)
+    repeats = [p for p, node in proc.nodes() if node.rule == "repeat" and node.count != "fill" and p not in held]
     roles = [r for r in ("tile", "floor") if any(node.role == r for _, node in proc.nodes())]
     style = proc.meta.get("style")
-    kinds = ["resize"] + (["count"] if repeats else []) + (["swap"] if roles else [])
+    kinds = ([] if {"floors", "bays"} <= set(hold) else ["resize"]) + (["count"] if repeats else []) + \
+        (["swap"] if roles else [])
+    if not kinds:
+        raise ValueError(f"nothing to vary while {' and '.join(hold)} stay as they are")
+    counts = _counts(proc, hold) if hold else {}
     out = []
     for attempt in range(4 * n):  # a variant past the grammar's limits (a facade at its largest) is drawn again
         if len(out) == n:
@@ -133,12 +144,44 @@ def vary(proc: Procedure, n: int = 8, seed: int = 0,
             elif kind == "swap":
                 variant = swap(proc, rng.choice(roles), rng, style)
             else:
-                variant = resize(proc, min(MAX_EXTENT, round(proc.width * rng.uniform(0.7, 1.5))),
-                                 min(MAX_EXTENT, round(proc.height * rng.uniform(0.8, 1.3))))
+                width = min(MAX_EXTENT, round(proc.width * rng.uniform(0.7, 1.5)))
+                height = min(MAX_EXTENT, round(proc.height * rng.uniform(0.8, 1.3)))
+                variant = resize(proc, proc.width if "bays" in hold else width,
+                                 proc.height if "floors" in hold else height)
         except (ProcedureError, ValueError):
+            continue
+        if hold and _counts(variant, hold) != counts:  # a swapped floor of another facade holds other tiles
             continue
         variant.meta = {**proc.meta, "variation": kind, "variation_seed": seed, "variation_index": i}
         out.append(variant)
+    return out
+
+
+def _counts(proc: Procedure, names: tuple[str, ...]) -> dict[str, float]:
+    return {p.name: p.value for p in named_parameters(proc) if p.name in names}
+
+
+def _held_repeats(proc: Procedure, hold: tuple[str, ...]) -> set[str]:
+    """The paths of the repeats with a count that lay out the held counts' nodes: above a floor along y (``floors``),
+    above a tile along x (``bays``)."""
+    unknown = set(hold) - {"floors", "bays"}
+    if unknown:
+        raise ValueError(f"only the counts floors and bays can be held, not {', '.join(sorted(unknown))}")
+    if not hold:
+        return set()
+    params = {p.name: p for p in named_parameters(proc)}
+    nodes = dict(proc.nodes())
+    out = set()
+    for name, axis in (("floors", "y"), ("bays", "x")):
+        if name not in hold or name not in params:
+            continue
+        for path in params[name].nodes:
+            parts = path.split("/")
+            for k in range(len(parts) - 1, 0, -1):
+                above = "/".join(parts[:k])
+                node = nodes.get(above)
+                if node is not None and node.rule == "repeat" and node.axis == axis and node.count != "fill":
+                    out.add(above)
     return out
 
 

@@ -93,3 +93,33 @@ def test_cli_vary(tmp_path, capsys):
         "variant-00.json", "variant-01.json", "variant-02.json", "variant-03.json", "variants.png"]
     for i in range(4):
         Procedure.from_json((tmp_path / "v" / f"variant-0{i}.json").read_text())
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 2**32), st.sampled_from(STYLE_NAMES), st.integers(0, 1000),
+       st.sampled_from([("floors",), ("bays",), ("floors", "bays")]))
+def test_held_counts_stay_as_they_are(seed, style, vseed, hold):
+    """A held count (its edits are not clean, say) is the same in every variant: no repeat that lays it out is
+    recounted, and the facade is not resized along its axis; the other kinds still vary."""
+    from facaid.parameters import named_parameters
+
+    proc = generate_procedure(seed, style)
+    before = {p.name: p.value for p in named_parameters(proc)}
+    try:
+        variants = vary(proc, 6, vseed, hold=hold)
+    except ValueError as exc:  # nothing else to vary: said so
+        assert "nothing to vary" in str(exc)
+        return
+    for v in variants:
+        after = {p.name: p.value for p in named_parameters(v)}
+        for name in hold:
+            if name in before:
+                assert after.get(name) == before[name], (name, v.meta["variation"])
+        if v.meta["variation"] == "resize":  # not along a held count's axis, which would recount it
+            assert ("floors" not in hold or v.height == proc.height) and ("bays" not in hold or v.width == proc.width)
+    assert [v.to_json() for v in vary(proc, 6, vseed, hold=())] == [v.to_json() for v in vary(proc, 6, vseed)]
+
+
+def test_only_counts_can_be_held():
+    with pytest.raises(ValueError, match="only the counts floors and bays"):
+        vary(generate_procedure(1, STYLE_NAMES[0]), 2, 0, hold=("floor_height",))
