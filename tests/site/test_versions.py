@@ -270,7 +270,8 @@ def test_migration_0005_gives_every_procedure_its_tree_as_version_1(alice):
     importlib.import_module("webapp.facades.migrations.0006_procedure_versions").first_versions(apps, None)
     [v1] = ProcedureVersion.objects.filter(procedure=proc)
     assert (v1.version, v1.data, v1.digest, v1.accuracy, v1.metrics) == (1, data, proc.digest, 0.93,
-                                                                         {"source": "model"})
+                                                                         proc.metrics)
+    assert proc.metrics["source"] == "model"  # (and its edits checked as it was saved)
     assert v1.kind == "created" and v1.created == proc.updated
 
 
@@ -363,6 +364,9 @@ def test_a_real_facade_gets_both_procedures_the_editable_one_current(as_alice, m
     assert (v1["metrics"]["structure"], v2["metrics"]["structure"]) == ("exact", "editable")
     assert v2["metrics"]["source"] == "lattice" and v1["accuracy"] > v2["accuracy"] > 0.94
     assert v2["note"].startswith("editable: floors of tiles") and v1["note"] == "exact: the annotation as drawn"
+    # the worker checked both trees' edits as it stored them (issue 67), each record naming its own tree
+    assert [v["metrics"]["edits"]["digest"] for v in (v1, v2)] == [v1["digest"], v2["digest"]]
+    assert v2["metrics"]["edits"]["verdicts"].keys() == {"floors+1", "floors-1", "bays+1", "bays-1"}
     names = {p["name"]: p["value"] for p in as_alice.get(_url(proc, "parameters")).json()["parameters"]}
     assert names["floors"] == 5 and names["bays"] == 6
     page = as_alice.get(f"/procedures/{proc.code}").content.decode()

@@ -16,6 +16,7 @@ from django.db import models, transaction
 from django.urls import reverse
 from django.utils import timezone
 
+from webapp.facades import editcheck
 from webapp.facades.fields import CompressedJSONField, pack
 
 
@@ -226,13 +227,16 @@ class Procedure(models.Model):
     def save(self, *args, change: Change | None = None, **kwargs) -> None:
         """Save, and record the tree as a new version (`_record_version`): when it differs from the latest
         version's, or when ``change`` is more than an edit (a revert, a re-run); so a save of the title or visibility
-        alone, or of the same tree again, records none."""
+        alone, or of the same tree again, records none. A tree written has its edits checked (`editcheck.checked`:
+        ``metrics["edits"]``), unless its metrics hold the verdicts of this very tree already (a fork, a revert)."""
         fields = kwargs.get("update_fields")
         writes_tree = "data" in fields if fields is not None else "data" not in self.get_deferred_fields()
         if writes_tree:
             self.digest, self.data_size = tree_digest(self.data), json_size(self.data)
+            # its edits checked (or kept, where its metrics judged this tree already), before any row is locked
+            self.metrics = editcheck.checked(self.metrics, self.data, self.digest)
             if fields is not None:
-                kwargs["update_fields"] = {*fields, "digest", "data_size"}
+                kwargs["update_fields"] = {*fields, "digest", "data_size", "metrics"}
         with transaction.atomic(using=kwargs.get("using")):
             super().save(*args, **kwargs)  # first: the row's write lock orders racing saves' version numbers
             if writes_tree:

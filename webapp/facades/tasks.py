@@ -14,8 +14,8 @@ from django.utils import timezone
 
 from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
-from webapp.facades import access, jobs, versions
-from webapp.facades.models import Change, Job, Photo, Procedure, ProcedureVersion, Visibility
+from webapp.facades import access, editcheck, jobs, versions
+from webapp.facades.models import Change, Job, Photo, Procedure, ProcedureVersion, Visibility, tree_digest
 from worker import compute
 from worker.app import RUN_JOB, app
 
@@ -126,7 +126,14 @@ def _store(job: Job, result: dict) -> None:
     that procedure's next version (`versions.add_rerun`); nothing, and the job failed, where its owner may no longer
     see the photo."""
     photo, params = job.segmentation.photo, job.params or {}
-    metrics = {k: result[k] for k in JOB_METRICS if k in result}
+    # the edits of each tree checked here, before any row is locked (the saves below find them and keep them)
+    metrics = editcheck.checked({k: result[k] for k in JOB_METRICS if k in result}, result["procedure"],
+                                tree_digest(result["procedure"]))
+    other = result.get("alternative")
+    if other:
+        other_metrics = {"source": "induced" if other["structure"] == "exact" else "lattice",
+                         "structure": other["structure"]}
+        other_metrics = editcheck.checked(other_metrics, other["procedure"], tree_digest(other["procedure"]))
     with transaction.atomic():
         if Job.objects.select_for_update().filter(id=job.id, status=Job.Status.RUNNING).count() != 1:
             return  # recovered and given to another worker meanwhile
@@ -149,11 +156,8 @@ def _store(job: Job, result: dict) -> None:
                              parent=parent, visibility=params.get("visibility", Visibility.PRIVATE),
                              data=result["procedure"])
             proc.take_photo_scale()  # its own from now on: a fork keeps it, an edit leaves it
-            other = result.get("alternative")
             if other:  # a real facade's other procedure: its first version, one revert away
-                proc.data, proc.accuracy = other["procedure"], other["accuracy"]
-                proc.metrics = {"source": "induced" if other["structure"] == "exact" else "lattice",
-                                "structure": other["structure"]}
+                proc.data, proc.accuracy, proc.metrics = other["procedure"], other["accuracy"], other_metrics
                 proc.save(change=Change(ProcedureVersion.Kind.CREATED, STRUCTURE_NOTES[other["structure"]]))
             proc.data, proc.accuracy, proc.metrics = result["procedure"], result["accuracy"], metrics
             proc.save(change=Change(ProcedureVersion.Kind.CREATED, STRUCTURE_NOTES.get(result.get("structure"), "")

@@ -13,8 +13,8 @@ from rest_framework.exceptions import ValidationError
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
-from webapp.facades import access, rendering, services, sharing
-from webapp.facades.models import Change, Procedure, ProcedureVersion
+from webapp.facades import access, editcheck, rendering, services, sharing
+from webapp.facades.models import Change, Procedure, ProcedureVersion, tree_digest
 from webapp.facades.parsing import parse_procedure
 
 # figures of the job that made a tree (its timings, the decoded candidate's accuracy, how it searched): true of that
@@ -160,12 +160,15 @@ def save_as_new(user, proc: Procedure, data: dict | None = None, title: str = ""
     current = proc.current_version()
     note = f"saved as a new procedure from version {current.version if current else 1} of {proc}"
     title = title or new_title(user, proc, tree)
+    # its edits checked before the transaction writes (SQLite's one writer is not held for them)
+    checks = editcheck.checked(None, tree, tree_digest(tree))[editcheck.KEY]
     with transaction.atomic():
         copy = services.fork_procedure(user, proc)
         copy.title = title
         if data is None:
             copy.save(update_fields=["title"])
         else:
+            copy.metrics = {**(copy.metrics or {}), editcheck.KEY: checks}
             save_tree(copy, data, Change(ProcedureVersion.Kind.EDIT, note))
     return copy
 

@@ -1,0 +1,161 @@
+"""The product checks its own edits (issue 67, item 4): every tree the site writes keeps the verdicts of floors ± 1
+and bays ± 1 with its digest (`webapp.facades.editcheck`); a tree too costly to check, a request without the budget
+for it and a check that fails are "not checked" with the reason, never a 500; a record of another tree is never
+kept."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from grammar_helpers import doc
+
+from facaid.editing.check import Verdict
+from facaid.generator import generate
+from facaid.grammar import Procedure as Tree
+from facaid.grammar.layout import count_expansion
+from facaid.variation import vary
+from webapp.facades import editcheck
+from webapp.facades.models import Procedure
+
+pytestmark = pytest.mark.django_db
+
+UNCLEAN = "the new floor is like no floor of the facade (at best 82 % alike, 90 % needed)"
+
+
+def fake_verdicts() -> dict[str, Verdict]:
+    return {"floors+1": Verdict(False, UNCLEAN, 0.99, 0.82, 120),
+            "floors-1": Verdict(True, "one floor like the others taken out", 0.99, 0.97, 120),
+            "bays+1": Verdict(True, "one bay like the others put in between two", 0.97, 0.95, 60),
+            "bays-1": Verdict(True, "one bay like the others taken out", 0.97, 0.95, 60)}
+
+
+@pytest.fixture
+def unclean_floors(monkeypatch) -> list:
+    """Every check finds floors + 1 not clean and the rest clean; the list holds each tree checked."""
+    checked = []
+
+    def fake(tree):
+        checked.append(tree)
+        return fake_verdicts()
+
+    monkeypatch.setattr(editcheck, "check_edits", fake)
+    return checked
+
+
+def _url(proc, rest: str = "") -> str:
+    return f"/api/v1/procedures/{proc.code}/{rest}"
+
+
+def _record(proc: Procedure) -> dict:
+    proc.refresh_from_db()
+    return proc.metrics["edits"]
+
+
+def test_every_tree_the_site_writes_keeps_its_edits_checked(as_alice, as_bob, alice, bob, unclean_floors):
+    """Stored, edited, reverted, forked, saved as new: each tree's verdicts are kept with its digest, in the
+    procedure and its version; a tree whose verdicts are kept already (a revert, a fork) is not checked again, nor is
+    a save of the title alone."""
+    r = as_alice.post("/api/v1/procedures/", {"data": generate(3).procedure.to_dict(), "visibility": "public"},
+                      format="json")
+    assert r.status_code == 201, r.content
+    proc = Procedure.objects.get(code=r.json()["code"])
+    first = _record(proc)
+    assert first["digest"] == proc.digest and first["verdicts"]["floors+1"]["reason"] == UNCLEAN
+    assert r.json()["metrics"]["edits"] == first and proc.current_version().metrics["edits"] == first
+    assert len(unclean_floors) == 1
+
+    r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": 6}, "save": True}, format="json")
+    assert r.status_code == 200 and r.json()["version"] == 2, r.content
+    second = _record(proc)
+    assert second["digest"] == proc.digest != first["digest"] and len(unclean_floors) == 2  # no second check
+    assert r.json()["metrics"]["edits"] == second
+
+    assert as_alice.post(_url(proc, "versions/1/revert")).status_code == 201
+    assert _record(proc) == first and proc.digest == first["digest"] and len(unclean_floors) == 2
+    assert as_alice.patch(_url(proc), {"title": "Rivoli"}, format="json").status_code == 200
+    assert len(unclean_floors) == 2
+
+    fork = Procedure.objects.get(code=as_bob.post(_url(proc, "fork")).json()["code"])
+    assert _record(fork) == first and len(unclean_floors) == 2
+    variant = vary(Tree.from_dict(proc.data), 1, 3)[0].to_dict()
+    r = as_bob.post(_url(proc, "save-as-new"), {"data": variant}, format="json")
+    assert r.status_code == 201, r.content
+    copy = Procedure.objects.get(code=r.json()["code"])
+    assert _record(copy)["digest"] == copy.digest != proc.digest and len(unclean_floors) == 3
+    assert [v.metrics["edits"]["digest"] for v in copy.versions.order_by("version")] == [proc.digest, copy.digest]
+
+
+def _two_floors(side: int) -> dict:
+    wall = {"rule": "leaf", "label": "facade"}
+    tile = {"rule": "split", "axis": "x", "role": "tile", "sizes": [["flt", 1], ["flt", 2], ["flt", 1]],
+            "children": [wall, {"rule": "leaf", "label": "window", "role": "window"}, wall]}
+    row = {"rule": "repeat", "axis": "x", "count": 2, "role": "floor", "sizes": [["flt", 1]], "children": [tile]}
+    return doc({"rule": "repeat", "axis": "y", "count": 2, "role": "floors", "sizes": [["flt", 1]],
+                "children": [row]}, side)
+
+
+def test_a_tree_too_costly_to_check_is_stored_not_checked_and_says_why(as_alice, monkeypatch):
+    """Two floors of two windows, 4,096 px square: 19 node instances, but the check compares its 2,048 px bands
+    (40 s here): it is not run, and the procedure says so and why, at once."""
+    def never(tree):
+        raise AssertionError("checked a tree too costly to check")
+
+    monkeypatch.setattr(editcheck, "check_edits", never)
+    data = _two_floors(4096)
+    seconds, units = editcheck.estimate(Tree.from_dict(data))
+    assert seconds > 20 * editcheck.CHECK_SECONDS and units < 50
+    start = time.perf_counter()
+    r = as_alice.post("/api/v1/procedures/", {"data": data}, format="json")
+    assert r.status_code == 201, r.content
+    assert time.perf_counter() - start < 5
+    proc = Procedure.objects.get(code=r.json()["code"])
+    record = _record(proc)
+    assert record["verdicts"] is None and record["again"] is False
+    assert record["reason"].startswith("not checked: checking its edits would take about ")
+    assert f"more than the {editcheck.CHECK_SECONDS:g} s a check may take" in record["reason"]
+    small = Procedure.objects.create(owner=proc.owner, data=_two_floors(256))  # the same tree, small: checked
+    assert "check failed" in _record(small)["reason"]  # (by the spy above)
+
+
+def test_a_request_without_the_budget_for_the_check_saves_and_says_so(as_alice, settings, unclean_floors):
+    """The check is reserved from the request's work budget: a save that cannot pay for it is stored, not checked,
+    and checked when next asked for (a save of it, with a budget of its own)."""
+    data = generate(3).procedure.to_dict()
+    tree = Tree.from_dict(data)
+    settings.FACAID_REQUEST_WORK = 4 * count_expansion(tree.root, tree.width, tree.height).instances
+    r = as_alice.post("/api/v1/procedures/", {"data": data}, format="json")
+    assert r.status_code == 201, r.content
+    proc = Procedure.objects.get(code=r.json()["code"])
+    record = _record(proc)
+    assert record["verdicts"] is None and record["again"] is True and unclean_floors == []
+    assert "too little of its work budget left for the check" in record["reason"]
+    settings.FACAID_REQUEST_WORK = 2_000_000
+    proc.save()  # the same tree: checked again, as its record asks
+    assert _record(proc)["verdicts"]["floors+1"]["reason"] == UNCLEAN and len(unclean_floors) == 1
+
+
+def test_a_check_that_fails_is_said_and_never_a_500(as_alice, monkeypatch):
+    def broken(tree):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(editcheck, "check_edits", broken)
+    r = as_alice.post("/api/v1/procedures/", {"data": generate(3).procedure.to_dict()}, format="json")
+    assert r.status_code == 201, r.content
+    proc = Procedure.objects.get(code=r.json()["code"])
+    assert _record(proc)["reason"] == "not checked: the check failed (RuntimeError: boom)"
+    r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": 6}, "save": True}, format="json")
+    assert r.status_code == 200 and r.json()["metrics"]["edits"]["reason"].endswith("(RuntimeError: boom)")
+
+
+def test_verdicts_of_another_tree_are_never_kept(as_alice, alice, unclean_floors):
+    """The verdicts are keyed by the digest of the tree they judged: a save whose metrics hold those of another tree
+    checks its own."""
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
+    stale = {"digest": "0" * 16, "verdicts": {"floors+1": {"clean": True, "reason": "STALE"}}, "seconds": 0.1}
+    assert editcheck.current({"edits": stale}, proc.digest) is None
+    assert editcheck.current({"edits": _record(proc)}, proc.digest) == _record(proc)
+    proc.refresh_from_db()
+    proc.metrics = {"edits": stale}
+    proc.save()
+    assert _record(proc)["digest"] == proc.digest and len(unclean_floors) == 2

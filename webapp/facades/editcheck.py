@@ -1,0 +1,123 @@
+"""The product checks its own edits (issue 67): every tree the site saves has `floors` ± 1 and `bays` ± 1 tried on it
+and judged as a person looks at the picture before and after (`facaid.editing.check.check_edits`), and the verdicts
+are kept in the procedure's metrics under ``"edits"`` with the digest of the tree they judged, so that a record of
+another tree (a stale one) is never shown: it is checked again, or said to be not checked.
+
+A check executes four edited trees at full resolution and compares their label maps band by band, so it costs
+what the tree's node instances and its pixels cost (`estimate`): about 0.2 s for a CMP facade, but 40 s for a
+4,096 px square of two floors. A tree whose check would cost more than `CHECK_SECONDS` is not checked, and the
+record says so and why; inside a request the check is reserved from its work budget first (`CHECK_WORK` units of
+the tree's), and one the request cannot pay is not checked either (``again``: checked when next asked for). Nothing
+about a check ever fails the save or the request that asked for it.
+
+The record, ``metrics["edits"]``: ``{"digest", "verdicts": {"floors+1": Verdict.to_dict(), ...}, "seconds"}`` where
+it ran (a count the tree lacks or cannot change that way has no verdict), ``{"digest", "verdicts": None, "reason",
+"again"}`` where it did not."""
+
+from __future__ import annotations
+
+import logging
+import math
+from time import perf_counter
+
+from facaid.editing.check import SAMPLE, TRIES, check_edits
+from facaid.grammar.budget import WorkLimitError, reserve
+from facaid.grammar.layout import count_expansion
+from facaid.parameters import Parameter, named_parameters
+from webapp.facades.parsing import parse_procedure
+
+log = logging.getLogger(__name__)
+
+KEY = "edits"  # where a procedure's metrics keep the record
+COUNTS = {"floors": ("floor_height", "height", "width"), "bays": ("tile_width", "width", "height")}  # the counts
+# judged: the length of the band an edit puts in, the side it grows along and the other side
+CHECK_SECONDS = 1.0  # the most a check may be estimated to take at worst (`estimate`): past it, not checked
+# what a check costs, measured on this project's 2-core machine (docs/site.md): per node instance of the tree (its
+# four edited trees laid out, executed and flattened: 14 us a unit on trees of 6,000 to 58,000 units), per pixel (the
+# label maps drawn and compared: 0.07 us) and per pixel compared in the search for the band's likeness (1 ns, at most
+# `TRIES` places tried for each edit)
+UNIT_SECONDS, PIXEL_SECONDS, COMPARE_SECONDS = 14e-6, 7e-8, 1e-9
+CHECK_WORK = 14  # work units reserved per unit of the tree's (a unit of the budget is about a microsecond)
+
+
+def current(metrics: dict | None, digest: str) -> dict | None:
+    """The record of ``metrics`` when it judged the tree named ``digest`` (else None: there is none, or it is of
+    another tree)."""
+    found = (metrics or {}).get(KEY) if isinstance(metrics, dict) else None
+    return found if isinstance(found, dict) and found.get("digest") == digest else None
+
+
+def _band(params: dict[str, Parameter], name: str, side: float) -> float:
+    """The length of the band ``name`` ± 1 puts in or takes out: the floor height (tile width), else the side over
+    the count."""
+    length = COUNTS[name][0]
+    return params[length].value if length in params else side / max(1.0, params[name].value)
+
+
+def estimate(tree, params: list[Parameter] | None = None) -> tuple[float, int]:
+    """(seconds, units): what checking ``tree``'s edits would take at worst here, and its node instances."""
+    params = {p.name: p for p in (named_parameters(tree) if params is None else params)}
+    units = count_expansion(tree.root, tree.width, tree.height).instances
+    sides = {"width": tree.width, "height": tree.height}
+    compared = 0.0
+    sy, sx = SAMPLE
+    for name, (_, along, across) in COUNTS.items():
+        if name not in params or params[name].min == params[name].max:
+            continue
+        band, side, other = _band(params, name, sides[along]), sides[along], sides[across]
+        # each of its two edits tries up to TRIES places, each against every band of the old facade
+        compared += 2 * TRIES * math.ceil(band / sy) * math.ceil(other / sx) * max(1.0, side - band + 1)
+    seconds = UNIT_SECONDS * units + PIXEL_SECONDS * tree.width * tree.height + COMPARE_SECONDS * compared
+    return seconds, units
+
+
+def _not_checked(digest: str, reason: str, again: bool = False) -> dict:
+    return {"digest": digest, "verdicts": None, "reason": f"not checked: {reason}", "again": again}
+
+
+def record(tree, digest: str) -> dict:
+    """Check ``tree``'s edits (a parsed procedure, named ``digest``) and return the record; never raises."""
+    try:
+        params = named_parameters(tree)
+        if not any(p.name in COUNTS and p.min < p.max for p in params):
+            return {"digest": digest, "verdicts": {}, "seconds": 0.0}  # no count to change: nothing to judge
+        seconds, units = estimate(tree, params)
+        if seconds > CHECK_SECONDS:
+            return _not_checked(digest, f"checking its edits would take about {seconds:.1f} s here (the facade is "
+                                        f"{tree.width:g} x {tree.height:g} px and lays out {units:,} node "
+                                        f"instances), more than the {CHECK_SECONDS:g} s a check may take")
+        try:
+            reserve(CHECK_WORK * units)
+        except WorkLimitError:
+            return _not_checked(digest, f"the request had too little of its work budget left for the check (about "
+                                        f"{CHECK_WORK * units:,} units); it is checked when next asked for", True)
+        start = perf_counter()
+        verdicts = check_edits(tree)
+        return {"digest": digest, "verdicts": {k: _rounded(v.to_dict()) for k, v in verdicts.items()},
+                "seconds": round(perf_counter() - start, 3)}
+    except WorkLimitError:
+        return _not_checked(digest, "the request ran out of its computing time during the check; it is checked when "
+                                    "next asked for", True)
+    except Exception as exc:  # a check is a figure about the tree: it never fails what saves or shows it
+        log.exception("could not check the edits of tree %s", digest)
+        return _not_checked(digest, f"the check failed ({type(exc).__name__}: {str(exc)[:200]})")
+
+
+def _rounded(verdict: dict) -> dict:
+    return {k: round(v, 4) if isinstance(v, float) else v for k, v in verdict.items()}
+
+
+def checked(metrics: dict | None, data: dict, digest: str) -> dict:
+    """``metrics`` with a record of the tree ``data`` (named ``digest``): the one it holds where that judged this tree
+    and needs no second try, else a new one (`record`). A copy: the dict given is left as it is."""
+    out = dict(metrics) if isinstance(metrics, dict) else {}
+    kept = current(out, digest)
+    if kept is not None and not kept.get("again"):
+        return out
+    try:
+        tree = parse_procedure(data, sent=False)
+    except Exception as exc:  # (a tree the site stored is valid; one that is not is said so, not raised)
+        out[KEY] = _not_checked(digest, f"the tree could not be read ({str(exc)[:200]})")
+        return out
+    out[KEY] = record(tree, digest)
+    return out
