@@ -1,7 +1,7 @@
 """The product checks its own edits (issue 67, item 4): every tree the site writes keeps the verdicts of floors ± 1
-and bays ± 1 with its digest (`webapp.facades.editcheck`); a tree too costly to check, a request without the budget
-for it and a check that fails are "not checked" with the reason, never a 500; a record of another tree is never
-kept."""
+and bays ± 1 with its digest (`webapp.facades.editcheck`); the API says of each named parameter whether it is
+checked; a tree too costly to check, a request without the budget for it and a check that fails are "not checked"
+with the reason, never a 500; a record of another tree is never shown."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import time
 import pytest
 from grammar_helpers import doc
 
-from facaid.editing.check import Verdict
+from facaid.editing.check import Verdict, check_edits
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
 from facaid.grammar.layout import count_expansion
@@ -52,6 +52,12 @@ def _record(proc: Procedure) -> dict:
     return proc.metrics["edits"]
 
 
+def _params(client, proc, **post) -> dict[str, dict]:
+    r = client.post(_url(proc, "parameters"), post, format="json") if post else client.get(_url(proc, "parameters"))
+    assert r.status_code == 200, r.content
+    return {p["name"]: p for p in r.json()["parameters"]}
+
+
 def test_every_tree_the_site_writes_keeps_its_edits_checked(as_alice, as_bob, alice, bob, unclean_floors):
     """Stored, edited, reverted, forked, saved as new: each tree's verdicts are kept with its digest, in the
     procedure and its version; a tree whose verdicts are kept already (a revert, a fork) is not checked again, nor is
@@ -86,6 +92,47 @@ def test_every_tree_the_site_writes_keeps_its_edits_checked(as_alice, as_bob, al
     assert [v.metrics["edits"]["digest"] for v in copy.versions.order_by("version")] == [proc.digest, copy.digest]
 
 
+def test_the_api_says_which_named_parameters_are_checked(as_alice, alice, unclean_floors):
+    """A count is checked where its + 1 and − 1 are clean, and says each edit in words; a length is not judged (null).
+    The page's unsaved tree is checked as it is sent, and nothing of it is stored."""
+    proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
+    assert len(unclean_floors) == 1
+    params = _params(as_alice, proc)
+    floors, bays = params["floors"], params["bays"]
+    assert floors["checked"] is False and bays["checked"] is True
+    assert floors["check"] == (f"floors + 1 is not clean: {UNCLEAN}; "
+                               "floors \u2212 1 is clean: one floor like the others taken out")
+    assert [(e["edit"], e["clean"]) for e in floors["edits"]] == [("+1", False), ("-1", True)]
+    assert floors["edits"][0]["said"] == f"floors + 1 is not clean: {UNCLEAN}"
+    for name in ("floor_height", "tile_width", "window_width", "width", "height"):
+        assert params[name]["checked"] is None and params[name]["check"].startswith("not judged"), name
+    assert len(unclean_floors) == 1  # the kept verdicts, not a new check
+
+    same = _params(as_alice, proc, values={}, data=proc.data)  # the page, as it opens: the saved tree
+    assert same["floors"]["check"] == floors["check"] and len(unclean_floors) == 1
+    edited = _params(as_alice, proc, values={"floors": 6})  # a tree not saved: checked now, not stored
+    assert edited["floors"]["value"] == 6 and edited["floors"]["checked"] is False and len(unclean_floors) == 2
+    assert _record(proc)["digest"] == proc.digest and proc.versions.count() == 1
+
+
+def test_a_real_check_is_reported_as_it_judged(as_alice, alice):
+    """No verdict made up: what the library judges of a generated facade is what the procedure keeps and the API
+    says, count by count."""
+    tree = generate(5).procedure
+    proc = Procedure.objects.create(owner=alice, data=tree.to_dict())
+    verdicts = check_edits(tree)
+    kept = _record(proc)["verdicts"]
+    assert {k: (v["clean"], v["reason"]) for k, v in kept.items()} == {
+        k: (v.clean, v.reason) for k, v in verdicts.items()}
+    params = _params(as_alice, proc)
+    for name in ("floors", "bays"):
+        mine = [v for k, v in verdicts.items() if k.startswith(name)]
+        assert params[name]["checked"] == (all(v.clean for v in mine) if mine else None), name
+        for v in mine:
+            assert v.reason in params[name]["check"]
+    assert 0 < _record(proc)["seconds"] < editcheck.CHECK_SECONDS
+
+
 def _two_floors(side: int) -> dict:
     wall = {"rule": "leaf", "label": "facade"}
     tile = {"rule": "split", "axis": "x", "role": "tile", "sizes": [["flt", 1], ["flt", 2], ["flt", 1]],
@@ -114,13 +161,15 @@ def test_a_tree_too_costly_to_check_is_stored_not_checked_and_says_why(as_alice,
     assert record["verdicts"] is None and record["again"] is False
     assert record["reason"].startswith("not checked: checking its edits would take about ")
     assert f"more than the {editcheck.CHECK_SECONDS:g} s a check may take" in record["reason"]
+    floors = _params(as_alice, proc)["floors"]
+    assert floors["checked"] is None and floors["check"] == record["reason"]
     small = Procedure.objects.create(owner=proc.owner, data=_two_floors(256))  # the same tree, small: checked
     assert "check failed" in _record(small)["reason"]  # (by the spy above)
 
 
 def test_a_request_without_the_budget_for_the_check_saves_and_says_so(as_alice, settings, unclean_floors):
     """The check is reserved from the request's work budget: a save that cannot pay for it is stored, not checked,
-    and checked when next asked for (a save of it, with a budget of its own)."""
+    and checked when next asked for (the parameters' request, with its own budget)."""
     data = generate(3).procedure.to_dict()
     tree = Tree.from_dict(data)
     settings.FACAID_REQUEST_WORK = 4 * count_expansion(tree.root, tree.width, tree.height).instances
@@ -130,9 +179,9 @@ def test_a_request_without_the_budget_for_the_check_saves_and_says_so(as_alice, 
     record = _record(proc)
     assert record["verdicts"] is None and record["again"] is True and unclean_floors == []
     assert "too little of its work budget left for the check" in record["reason"]
+    assert _params(as_alice, proc)["floors"]["checked"] is None  # this request cannot pay for it either
     settings.FACAID_REQUEST_WORK = 2_000_000
-    proc.save()  # the same tree: checked again, as its record asks
-    assert _record(proc)["verdicts"]["floors+1"]["reason"] == UNCLEAN and len(unclean_floors) == 1
+    assert _params(as_alice, proc)["floors"]["checked"] is False and len(unclean_floors) == 1
 
 
 def test_a_check_that_fails_is_said_and_never_a_500(as_alice, monkeypatch):
@@ -144,18 +193,24 @@ def test_a_check_that_fails_is_said_and_never_a_500(as_alice, monkeypatch):
     assert r.status_code == 201, r.content
     proc = Procedure.objects.get(code=r.json()["code"])
     assert _record(proc)["reason"] == "not checked: the check failed (RuntimeError: boom)"
-    r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": 6}, "save": True}, format="json")
-    assert r.status_code == 200 and r.json()["metrics"]["edits"]["reason"].endswith("(RuntimeError: boom)")
+    assert _params(as_alice, proc)["floors"]["check"] == "not checked: the check failed (RuntimeError: boom)"
+    assert as_alice.post(_url(proc, "variations"), {"n": 2}, format="json").status_code == 200
 
 
-def test_verdicts_of_another_tree_are_never_kept(as_alice, alice, unclean_floors):
-    """The verdicts are keyed by the digest of the tree they judged: a save whose metrics hold those of another tree
-    checks its own."""
+def test_verdicts_of_another_tree_are_never_shown(as_alice, alice, unclean_floors):
+    """The verdicts are keyed by the digest of the tree they judged: a record of another tree is not shown (the tree
+    is checked again), one of this tree is shown as kept."""
     proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
     stale = {"digest": "0" * 16, "verdicts": {"floors+1": {"clean": True, "reason": "STALE"}}, "seconds": 0.1}
-    assert editcheck.current({"edits": stale}, proc.digest) is None
-    assert editcheck.current({"edits": _record(proc)}, proc.digest) == _record(proc)
+    Procedure.objects.filter(pk=proc.pk).update(metrics={"edits": stale})
+    body = as_alice.get(_url(proc, "parameters")).content.decode()
+    assert "STALE" not in body and UNCLEAN in body and len(unclean_floors) == 2
+    kept = {"digest": proc.digest, "verdicts": {"floors+1": {"clean": False, "reason": "KEPT"}}, "seconds": 0.1}
+    Procedure.objects.filter(pk=proc.pk).update(metrics={"edits": kept})
+    floors = _params(as_alice, proc)["floors"]
+    assert floors["check"] == "floors + 1 is not clean: KEPT" and len(unclean_floors) == 2
+    assert editcheck.current({"edits": stale}, proc.digest) is None  # (and a save checks its own tree again)
     proc.refresh_from_db()
     proc.metrics = {"edits": stale}
     proc.save()
-    assert _record(proc)["digest"] == proc.digest and len(unclean_floors) == 2
+    assert _record(proc)["digest"] == proc.digest and len(unclean_floors) == 3

@@ -367,8 +367,10 @@ def test_a_real_facade_gets_both_procedures_the_editable_one_current(as_alice, m
     # the worker checked both trees' edits as it stored them (issue 67), each record naming its own tree
     assert [v["metrics"]["edits"]["digest"] for v in (v1, v2)] == [v1["digest"], v2["digest"]]
     assert v2["metrics"]["edits"]["verdicts"].keys() == {"floors+1", "floors-1", "bays+1", "bays-1"}
-    names = {p["name"]: p["value"] for p in as_alice.get(_url(proc, "parameters")).json()["parameters"]}
-    assert names["floors"] == 5 and names["bays"] == 6
+    params = {p["name"]: p for p in as_alice.get(_url(proc, "parameters")).json()["parameters"]}
+    assert params["floors"]["value"] == 5 and params["bays"]["value"] == 6
+    assert params["floors"]["checked"] == all(v["clean"] for k, v in v2["metrics"]["edits"]["verdicts"].items()
+                                              if k.startswith("floors"))
     page = as_alice.get(f"/procedures/{proc.code}").content.decode()
     assert "editable structure: floors of tiles with exceptions" in page
     assert 'id="other-structure"' in page and "The exact procedure (pixel accuracy" in page

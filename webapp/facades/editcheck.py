@@ -38,6 +38,7 @@ CHECK_SECONDS = 1.0  # the most a check may be estimated to take at worst (`esti
 # `TRIES` places tried for each edit)
 UNIT_SECONDS, PIXEL_SECONDS, COMPARE_SECONDS = 14e-6, 7e-8, 1e-9
 CHECK_WORK = 14  # work units reserved per unit of the tree's (a unit of the budget is about a microsecond)
+MINUS = "\u2212"
 
 
 def current(metrics: dict | None, digest: str) -> dict | None:
@@ -121,3 +122,40 @@ def checked(metrics: dict | None, data: dict, digest: str) -> dict:
         return out
     out[KEY] = record(tree, digest)
     return out
+
+
+def for_tree(tree, digest: str, metrics: dict | None) -> dict:
+    """The record of ``tree`` to show: the one kept in ``metrics`` when it judged this very tree (``digest``) and
+    needs no second try, else one made now (not stored)."""
+    kept = current(metrics, digest)
+    return kept if kept is not None and not kept.get("again") else record(tree, digest)
+
+
+def _said(name: str, key: str, verdict: dict) -> str:
+    sign = "+" if key.endswith("+1") else MINUS
+    return f"{name} {sign} 1 is {'clean' if verdict.get('clean') else 'not clean'}: {verdict.get('reason', '')}"
+
+
+def judged(name: str, rec: dict | None) -> dict:
+    """``{"checked", "check"}`` of the named parameter ``name`` by the record ``rec``: true where its + 1 and − 1
+    (those that exist) are clean, false where one is not, null where no check applies (a length) or none ran; the
+    words say why, and for a count what each edit did. A count judged has ``edits`` too: each edit (``"+1"``,
+    ``"-1"``), whether it is clean and what was said of it."""
+    if name not in COUNTS:
+        return {"checked": None, "check": "not judged: only edits of the counts (floors, bays) are checked"}
+    if rec is None:
+        return {"checked": None, "check": "not checked: this tree has not been checked yet"}
+    if rec.get("verdicts") is None:
+        return {"checked": None, "check": rec.get("reason", "not checked")}
+    mine = {k: v for k, v in rec["verdicts"].items() if k in (f"{name}+1", f"{name}-1")}
+    if not mine:
+        return {"checked": None, "check": f"no edit of {name} to judge: it cannot change here"}
+    clean = all(v.get("clean") for v in mine.values())
+    return {"checked": clean, "check": "; ".join(_said(name, k, v) for k, v in sorted(mine.items())),
+            "edits": [{"edit": k[len(name):], "clean": bool(v.get("clean")), "said": _said(name, k, v)}
+                      for k, v in sorted(mine.items())]}
+
+
+def annotate(parameters: list[dict], rec: dict | None) -> list[dict]:
+    """The named parameters (their dicts), each with ``checked`` and ``check`` (`judged`)."""
+    return [{**p, **judged(p["name"], rec)} for p in parameters]

@@ -24,7 +24,7 @@ from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
 from facaid.parameters import named_parameters, set_parameters
 from facaid.variation import vary
-from webapp.facades import access, disclosure, downloads, rendering, services, versions
+from webapp.facades import access, disclosure, downloads, editcheck, rendering, services, versions
 from webapp.facades.api.common import (
     page,
     stored_picture,
@@ -33,6 +33,7 @@ from webapp.facades.downloads import DOWNLOADS
 from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import (
     Procedure,
+    tree_digest,
 )
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers import (
@@ -148,6 +149,13 @@ def _units(tree) -> int:
     return count_expansion(tree.root, tree.width, tree.height).instances
 
 
+def _judged(tree, digest: str, metrics: dict | None) -> list[dict]:
+    """The tree's named parameters, each with ``checked`` and ``check`` (`editcheck.judged`): by the verdicts kept in
+    ``metrics`` where they judged this very tree (``digest``), else by a check made now."""
+    params = named_parameters(tree)
+    return editcheck.annotate([p.to_dict() for p in params], editcheck.for_tree(tree, digest, metrics))
+
+
 def _leaves(tree) -> list | None:
     """Where the tree draws each leaf, for the page's picture-to-tree selection: [label, x0, y0, x1, y1, node path]
     in whole pixels; None past `MAX_MESH_RECTS` rectangles (a real facade draws a few hundred)."""
@@ -158,7 +166,8 @@ def _leaves(tree) -> list | None:
 
 
 @extend_schema(methods=["GET"], request=None, responses={200: dict},
-               summary="The named parameters (floors, floor height, bays, ...) and where each leaf is drawn: "
+               summary="The named parameters (floors, floor height, bays, ...), each checked or not (its edits "
+                       "judged: checked, check), and where each leaf is drawn: "
                        "{'parameters': [...], 'leaves': [[label, x0, y0, x1, y1, node path], ...]}")
 @extend_schema(methods=["POST"], request=ParametersSerializer, responses={200: dict},
                summary="Set named parameters: {'data', 'parameters', 'leaves', 'accuracy', 'metrics', 'version'}; "
@@ -171,7 +180,7 @@ def procedure_parameters(request, code):
     proc = access.get_procedure_for_user(request.user, code)
     if request.method == "GET":
         tree = parse_procedure(proc.data)
-        return Response({"parameters": [p.to_dict() for p in named_parameters(tree)], "leaves": _leaves(tree)})
+        return Response({"parameters": _judged(tree, proc.digest, proc.metrics), "leaves": _leaves(tree)})
     form = ParametersSerializer(data=request.data)
     form.is_valid(raise_exception=True)
     if form.validated_data["save"]:  # refused before the work, not after it
@@ -182,12 +191,13 @@ def procedure_parameters(request, code):
         edited = set_parameters(tree, form.validated_data["values"])
     except (ProcedureError, ValueError) as exc:
         raise ValidationError({"values": str(exc)}) from None
-    answer = {"data": edited.to_dict(), "parameters": [p.to_dict() for p in named_parameters(edited)],
-              "leaves": _leaves(edited), "accuracy": None, "metrics": None, "version": None}
-    if form.validated_data["save"]:
+    answer = {"data": edited.to_dict(), "leaves": _leaves(edited), "accuracy": None, "metrics": None,
+              "version": None}
+    if form.validated_data["save"]:  # (its edits checked as it is saved)
         versions.save_parameters(proc, answer["data"], form.validated_data["values"])
         shown = disclosure.figures(request.user, proc, proc.accuracy, proc.metrics)
         answer.update(accuracy=shown["accuracy"], metrics=shown["metrics"], version=proc.current_version().version)
+    answer["parameters"] = _judged(edited, tree_digest(answer["data"]), proc.metrics)
     if disclosure.hidden(request.user, proc):  # the tree's meta: no accuracy of a photo not shared with the viewer
         answer["data"] = disclosure.tree(answer["data"])
     return Response(answer)
