@@ -198,9 +198,25 @@ function drawNamed(parameters) {
     unit.className = "meta"; unit.textContent = p.unit === "px" ? "px" : "";
     const td = document.createElement("td");
     td.append(input);
-    tr.append(th, td, unit);
+    tr.append(th, td, unit, checkNote(p));
     return tr;
   }));
+}
+
+// Beside a count, in words, what the server's check of its edits found (checked false: an edit of it is not clean,
+// as a person would see it; null: not checked, and why); a length is not judged, and says nothing.
+function checkNote(p) {
+  const note = document.createElement("td");
+  note.className = "check-note";
+  if (p.checked === false) {
+    note.classList.add("failed");
+    note.textContent = (p.edits || []).filter((e) => !e.clean).map((e) => e.said).join("; ") || p.check;
+  } else if (p.checked === null && p.unit === "count" && p.check) {
+    note.classList.add("meta");
+    note.textContent = p.check;
+  }
+  if (p.check && p.unit === "count") note.title = p.check;  // both edits' words
+  return note;
 }
 
 class Throttled extends Error {
