@@ -334,13 +334,21 @@ document.getElementById("vary").addEventListener("click", async () => {
   if (typeof ranges === "string") { status.textContent = ranges; return; }
   const body = {n: 8, seed};
   if (Object.keys(ranges).length) body.ranges = ranges;
+  if (document.getElementById("include-unchecked")?.checked) body.include_unchecked = true;
   const [r, answer] = await send(`/api/v1/procedures/${code}/variations`, "POST", body);
   const grid = document.getElementById("variants");
   if (!r.ok) {
     status.textContent = `no variations: ${answer.ranges || answer.data || answer.detail || JSON.stringify(answer)}`;
+    document.getElementById("vary-left-out").hidden = true;
     return;
   }
   status.textContent = "";
+  // what was not varied, and why: the counts whose edits are not clean (unless asked for)
+  const leftOut = document.getElementById("vary-left-out");
+  leftOut.hidden = !(answer.left_out || []).length;
+  leftOut.textContent = leftOut.hidden ? "" : "Left out: " + answer.left_out.map((o) =>
+    `${parameters.find((q) => q.name === o.name)?.label || o.name} (${o.reason})`).join("; ") +
+    ". Tick \"vary those too\" to vary them anyway.";
   const {variants} = answer;
   grid.replaceChildren();
   for (const v of variants) {

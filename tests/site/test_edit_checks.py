@@ -1,10 +1,12 @@
 """The product checks its own edits (issue 67, item 4): every tree the site writes keeps the verdicts of floors ± 1
 and bays ± 1 with its digest (`webapp.facades.editcheck`); the API says of each named parameter whether it is
-checked; a tree too costly to check, a request without the budget for it and a check that fails are "not checked"
-with the reason, never a 500; a record of another tree is never shown."""
+checked; variations leave out the counts whose edits are not clean unless asked; a tree too costly to check, a
+request without the budget for it and a check that fails are "not checked" with the reason, never a 500; a record of
+another tree is never shown."""
 
 from __future__ import annotations
 
+import json
 import time
 
 import pytest
@@ -14,6 +16,7 @@ from facaid.editing.check import Verdict, check_edits
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
 from facaid.grammar.layout import count_expansion
+from facaid.parameters import named_parameters
 from facaid.variation import vary
 from webapp.facades import editcheck
 from webapp.facades.models import Procedure
@@ -214,3 +217,38 @@ def test_verdicts_of_another_tree_are_never_shown(as_alice, alice, unclean_floor
     proc.metrics = {"edits": stale}
     proc.save()
     assert _record(proc)["digest"] == proc.digest and len(unclean_floors) == 3
+
+
+def test_variations_leave_out_unclean_counts_unless_asked(as_alice, alice, unclean_floors):
+    tree = generate(3).procedure
+    proc = Procedure.objects.create(owner=alice, data=tree.to_dict())
+    floors = {p.name: p.value for p in named_parameters(tree)}["floors"]
+    r = as_alice.post(_url(proc, "variations"), {"n": 8, "seed": 0}, format="json")
+    assert r.status_code == 200, r.content
+    body = r.json()
+    assert [o["name"] for o in body["left_out"]] == ["floors"]
+    assert body["left_out"][0]["reason"] == f"floors + 1 is not clean: {UNCLEAN}"  # the edit that did not pass
+    assert len(body["variants"]) == 8
+    for v in body["variants"]:  # the floors as they are: no floor added by a count, a resize or a swap
+        assert {p.name: p.value for p in named_parameters(Tree.from_dict(v))}["floors"] == floors, v["meta"]
+
+    r = as_alice.post(_url(proc, "variations"), {"n": 8, "seed": 0, "include_unchecked": True}, format="json")
+    assert r.status_code == 200 and r.json()["left_out"] == []
+    assert r.json()["variants"] == [v.to_dict() for v in vary(tree, 8, 0)]  # as before the check
+    assert any({p.name: p.value for p in named_parameters(Tree.from_dict(v))}["floors"] != floors
+               for v in r.json()["variants"])
+
+    ranges = {"floors": [4, 6], "floor_height": [80, 90], "height": [700, 900]}
+    body = as_alice.post(_url(proc, "variations"), {"n": 4, "ranges": ranges}, format="json").json()
+    assert [o["name"] for o in body["left_out"]] == ["floors", "height"]
+    assert "recounts the floors, whose edits are not clean" in body["left_out"][1]["reason"]
+    assert all(set(v["meta"]["parameters"]) == {"floor_height"} for v in body["variants"])
+    r = as_alice.post(_url(proc, "variations"), {"n": 4, "ranges": {"floors": [4, 6]}}, format="json")
+    said = str(r.json()["ranges"])
+    assert r.status_code == 400 and "ask with include_unchecked to vary them" in said and UNCLEAN in said
+    body = as_alice.post(_url(proc, "variations"), {"n": 4, "ranges": {"floors": [4, 6]}, "include_unchecked": True},
+                         format="json").json()
+    assert body["left_out"] == [] and {v["meta"]["parameters"]["floors"] for v in body["variants"]} <= {4, 5, 6}
+    for bad in ("yes", 1, None):
+        r = as_alice.post(_url(proc, "variations"), {"include_unchecked": bad}, format="json")
+        assert r.status_code == 400 and "include_unchecked" in json.dumps(r.json()), bad

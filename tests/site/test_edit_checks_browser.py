@@ -1,5 +1,6 @@
-"""The procedure page says, beside a count, that an edit of it is not clean (issue 67, item 4); in Debian's
-Chromium through Playwright. (`FACAID_SCREENSHOT_DIR=docs/img` writes docs/img/procedure-checks.png.)"""
+"""The procedure page says, beside a count, that an edit of it is not clean (issue 67, item 4), and its variations
+leave that count out unless "vary those too" is ticked, saying what was left out and why; in Debian's Chromium
+through Playwright. (`FACAID_SCREENSHOT_DIR=docs/img` writes docs/img/procedure-checks.png.)"""
 
 from __future__ import annotations
 
@@ -17,7 +18,8 @@ pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
 
 
-def test_a_count_whose_edit_is_not_clean_is_marked_in_words(live_server, alice, browser, monkeypatch, tmp_path):
+def test_a_count_whose_edit_is_not_clean_is_marked_and_left_out_of_variations(live_server, alice, browser,
+                                                                             monkeypatch, tmp_path):
     monkeypatch.setattr(editcheck, "check_edits", lambda tree: fake_verdicts())  # floors + 1 not clean
     proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), visibility="private")
     page = browser.new_page(viewport={"width": 1280, "height": 900})
@@ -31,4 +33,17 @@ def test_a_count_whose_edit_is_not_clean_is_marked_in_words(live_server, alice, 
     assert page.text_content("#named tr[data-name=bays] td.check-note") == ""  # clean: nothing said
     assert page.text_content("#named tr[data-name=floor_height] td.check-note") == ""  # a length: not judged
     screenshot(page.locator("#named"), "procedure-checks.png", tmp_path)
+
+    page.click("#vary")
+    page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
+    assert page.text_content("#vary-left-out") == (f"Left out: upper floors (floors + 1 is not clean: {UNCLEAN}). "
+                                                   'Tick "vary those too" to vary them anyway.')
+    captions = page.eval_on_selector_all("#variants .card .meta", "els => els.map(e => e.textContent)")
+    screenshot(page.locator("#vary").locator("xpath=ancestor::div[contains(@class, 'panel')]"),
+               "procedure-checks-variations.png", tmp_path)
+    page.check("#include-unchecked")
+    page.click("#vary")
+    page.wait_for_function("document.getElementById('vary-left-out').hidden")
+    page.wait_for_function("(c => c.length === 8)([...document.querySelectorAll('#variants .card .meta')])")
+    assert page.eval_on_selector_all("#variants .card .meta", "els => els.map(e => e.textContent)") != captions
     assert errors == []

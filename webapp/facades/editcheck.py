@@ -159,3 +159,13 @@ def judged(name: str, rec: dict | None) -> dict:
 def annotate(parameters: list[dict], rec: dict | None) -> list[dict]:
     """The named parameters (their dicts), each with ``checked`` and ``check`` (`judged`)."""
     return [{**p, **judged(p["name"], rec)} for p in parameters]
+
+
+def unclean(rec: dict | None) -> dict[str, str]:
+    """The counts whose edits did not pass (``checked`` false), each with the words of the edits that did not."""
+    out = {}
+    for name in COUNTS:
+        said = judged(name, rec)
+        if said["checked"] is False:
+            out[name] = "; ".join(e["said"] for e in said["edits"] if not e["clean"])
+    return out

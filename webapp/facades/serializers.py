@@ -403,6 +403,9 @@ class VariationsSerializer(serializers.Serializer):
     ranges = serializers.DictField(
         child=serializers.ListField(child=NumberField(), min_length=2, max_length=2), required=False,
         help_text="named parameter -> [low, high], e.g. {\"floors\": [4, 7]}: each variant draws them instead")
+    include_unchecked = StrictBooleanField(
+        default=False, help_text="vary the counts whose edits are not clean too (a parameter's checked false); by "
+                                 "default they are left out, and the answer's left_out says which and why")
 
 
 class ParametersSerializer(serializers.Serializer):

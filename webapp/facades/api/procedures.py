@@ -118,7 +118,9 @@ def procedure_save_as_new(request, code):
 
 
 @extend_schema(request=VariationsSerializer, responses={200: dict},
-               summary="Variants of a procedure (counts, resizes, swaps), deterministic by seed; not stored")
+               summary="Variants of a procedure (counts, resizes, swaps), deterministic by seed; not stored: "
+                       "{'variants': [...], 'left_out': [{'name', 'reason'}]}, by default without the counts whose "
+                       "edits are not clean (include_unchecked: those too)")
 @api_view(["POST"])
 @throttle_classes(HEAVY)
 @permission_classes([AllowAny])
@@ -127,16 +129,48 @@ def procedure_variations(request, code):
     proc = access.get_procedure_for_user(request.user, code)
     form = VariationsSerializer(data=request.data)
     form.is_valid(raise_exception=True)
+    asked = {k: tuple(v) for k, v in form.validated_data.get("ranges", {}).items()}
     try:
-        ranges = {k: tuple(v) for k, v in form.validated_data.get("ranges", {}).items()} or None
         tree = parse_procedure(proc.data)
+        # by default only parameters whose edits are not known to be unclean vary (`editcheck`); the rest are said
+        held = {} if form.validated_data["include_unchecked"] else \
+            editcheck.unclean(editcheck.for_tree(tree, proc.digest, proc.metrics))
+        ranges, left_out = _checked_ranges(asked, held)
+        if asked and not ranges:
+            raise ValueError("every range names a parameter whose edits are not clean (" + "; ".join(
+                f"{o['name']}: {o['reason']}" for o in left_out) + "): ask with include_unchecked to vary them")
         reserve(VARIANT_WORK * form.validated_data["n"] * _units(tree))  # the variants, refused before they are made
-        variants = vary(tree, form.validated_data["n"], form.validated_data["seed"], ranges)
+        variants = vary(tree, form.validated_data["n"], form.validated_data["seed"], ranges or None,
+                        hold=() if ranges else tuple(held))
     except (ProcedureError, ValueError) as exc:
         field = "ranges" if form.validated_data.get("ranges") else "data"
         raise ValidationError({field: f"no variations of this procedure: {exc}"}) from None
     shown = disclosure.tree if disclosure.hidden(request.user, proc) else dict  # no accuracy of a private photo's
-    return Response({"variants": [shown(v.to_dict()) for v in variants]})
+    return Response({"variants": [shown(v.to_dict()) for v in variants], "left_out": left_out})
+
+
+# the side a count's repeats lie along: a range of it recounts them (a taller facade holds more floors)
+RECOUNTED_BY = {"floors": "height", "bays": "width"}
+
+
+def _checked_ranges(asked: dict, held: dict[str, str]) -> tuple[dict, list[dict]]:
+    """The ranges to draw, of those ``asked``, and those left out with why (``{"name", "reason"}``): none of a
+    count ``held`` (its edits are not clean: its words), nor of the side it lies along. Without ranges, the held
+    counts themselves are what is left out."""
+    if not asked:
+        return {}, [{"name": name, "reason": reason} for name, reason in held.items()]
+    ranges, left_out = {}, []
+    side_of = {side: count for count, side in RECOUNTED_BY.items()}
+    for name, bounds in asked.items():
+        if name in held:
+            left_out.append({"name": name, "reason": held[name]})
+        elif side_of.get(name) in held:
+            count = side_of[name]
+            left_out.append({"name": name, "reason": f"a new {name} recounts the {count}, whose edits are not "
+                                                     f"clean: {held[count]}"})
+        else:
+            ranges[name] = bounds
+    return ranges, left_out
 
 
 # what making a variant, or setting a named parameter, costs per unit of its tree's (`count_expansion`), measured on
