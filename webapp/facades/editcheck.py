@@ -56,9 +56,14 @@ def _band(params: dict[str, Parameter], name: str, side: float) -> float:
 
 
 def estimate(tree, params: list[Parameter] | None = None) -> tuple[float, int]:
-    """(seconds, units): what checking ``tree``'s edits would take at worst here, and its node instances."""
-    params = {p.name: p for p in (named_parameters(tree) if params is None else params)}
+    """(seconds, units): what checking ``tree``'s edits would take at worst here, and its node instances. Without
+    ``params`` (its named parameters), where the tree alone costs more than `CHECK_SECONDS`, that is the estimate:
+    its named parameters are not read."""
     units = count_expansion(tree.root, tree.width, tree.height).instances
+    seconds = UNIT_SECONDS * units + PIXEL_SECONDS * tree.width * tree.height
+    if params is None and seconds > CHECK_SECONDS:
+        return seconds, units
+    params = {p.name: p for p in (named_parameters(tree) if params is None else params)}
     sides = {"width": tree.width, "height": tree.height}
     compared = 0.0
     sy, sx = SAMPLE
@@ -68,8 +73,7 @@ def estimate(tree, params: list[Parameter] | None = None) -> tuple[float, int]:
         band, side, other = _band(params, name, sides[along]), sides[along], sides[across]
         # each of its two edits tries up to TRIES places, each against every band of the old facade
         compared += 2 * TRIES * math.ceil(band / sy) * math.ceil(other / sx) * max(1.0, side - band + 1)
-    seconds = UNIT_SECONDS * units + PIXEL_SECONDS * tree.width * tree.height + COMPARE_SECONDS * compared
-    return seconds, units
+    return seconds + COMPARE_SECONDS * compared, units
 
 
 def _not_checked(digest: str, reason: str, again: bool = False) -> dict:
@@ -79,14 +83,16 @@ def _not_checked(digest: str, reason: str, again: bool = False) -> dict:
 def record(tree, digest: str) -> dict:
     """Check ``tree``'s edits (a parsed procedure, named ``digest``) and return the record; never raises."""
     try:
-        params = named_parameters(tree)
-        if not any(p.name in COUNTS and p.min < p.max for p in params):
-            return {"digest": digest, "verdicts": {}, "seconds": 0.0}  # no count to change: nothing to judge
-        seconds, units = estimate(tree, params)
+        seconds, units = estimate(tree)  # a tree too costly on its nodes and pixels alone: its parameters not read
+        if seconds <= CHECK_SECONDS:
+            params = named_parameters(tree)
+            if not any(p.name in COUNTS and p.min < p.max for p in params):
+                return {"digest": digest, "verdicts": {}, "seconds": 0.0}  # no count to change: nothing to judge
+            seconds, units = estimate(tree, params)
         if seconds > CHECK_SECONDS:
-            return _not_checked(digest, f"checking its edits would take about {seconds:.1f} s here (the facade is "
-                                        f"{tree.width:g} x {tree.height:g} px and lays out {units:,} node "
-                                        f"instances), more than the {CHECK_SECONDS:g} s a check may take")
+            return _not_checked(digest, f"checking its edits would take more than the {CHECK_SECONDS:g} s a check "
+                                        f"may take here (the facade is {tree.width:g} x {tree.height:g} px and lays "
+                                        f"out {units:,} node instances)")
         try:
             reserve(CHECK_WORK * units)
         except WorkLimitError:
