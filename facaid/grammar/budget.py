@@ -65,6 +65,14 @@ def _past(budget: list[float]) -> WorkLimitError:
         "smaller tree")
 
 
+def seconds_left() -> float | None:
+    """The CPU seconds the current budget has left (never below 0; inf where it bounds none; None outside one): what
+    optional work (a check of a saved tree's edits) measures itself against, so as not to leave the request that
+    asked for it without the time for its own work."""
+    budget = _budget.get()
+    return None if budget is None else max(0.0, budget[2] - (thread_time() - budget[3]))
+
+
 def spent() -> int | None:
     """The instances charged so far in the current budget (None outside one)."""
     budget = _budget.get()

@@ -301,3 +301,18 @@ def test_a_work_budget_bounds_the_trees_one_request_makes():
         sum(range(10**5))  # some CPU time
         validate(proc)
     assert spent() is None
+
+
+def test_a_work_budget_says_how_much_cpu_time_it_has_left():
+    from facaid.grammar.budget import seconds_left, work_budget
+
+    assert seconds_left() is None
+    with work_budget(10):
+        assert seconds_left() == float("inf")
+    with work_budget(10, seconds=5.0):
+        first = seconds_left()
+        sum(range(10**6))
+        assert 0 < seconds_left() < first <= 5.0
+    with work_budget(10, seconds=0.0):
+        sum(range(10**5))
+        assert seconds_left() == 0.0

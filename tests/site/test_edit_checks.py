@@ -190,6 +190,19 @@ def test_a_request_without_the_budget_for_the_check_saves_and_says_so(as_alice, 
     assert _params(as_alice, proc)["floors"]["checked"] is False and len(unclean_floors) == 1
 
 
+def test_a_check_leaves_the_request_the_time_for_its_own_work(as_alice, monkeypatch, unclean_floors):
+    """A check estimated to take more than half the CPU time its request has left is not run: the save goes on,
+    and the tree is checked when next asked for."""
+    monkeypatch.setattr(editcheck, "seconds_left", lambda: 0.02)
+    r = as_alice.post("/api/v1/procedures/", {"data": generate(3).procedure.to_dict()}, format="json")
+    assert r.status_code == 201, r.content
+    record = r.json()["metrics"]["edits"]
+    assert record["verdicts"] is None and record["again"] is True and unclean_floors == []
+    assert record["reason"].startswith("not checked: the request had too little of its computing time left for "
+                                       "the check (it may take ")
+    assert record["reason"].endswith(" s, and 0.02 s were left); it is checked when next asked for")
+
+
 def test_a_check_that_fails_is_said_and_never_a_500(as_alice, monkeypatch):
     def broken(tree):
         raise RuntimeError("boom")

@@ -7,8 +7,9 @@ A check executes four edited trees at full resolution and compares their label m
 what the tree's node instances and its pixels cost (`estimate`): about 0.2 s for a CMP facade, but 40 s for a
 4,096 px square of two floors. A tree whose check would cost more than `CHECK_SECONDS` is not checked, and the
 record says so and why; inside a request the check is reserved from its work budget first (`CHECK_WORK` units of
-the tree's), and one the request cannot pay is not checked either (``again``: checked when next asked for). Nothing
-about a check ever fails the save or the request that asked for it.
+the tree's, and at most `LEAVE` of the CPU time it has left), and one the request cannot pay is not checked either
+(``again``: checked when next asked for). Nothing about a check ever fails the save or the request that asked for
+it.
 
 The record, ``metrics["edits"]``: ``{"digest", "verdicts": {"floors+1": Verdict.to_dict(), ...}, "seconds"}`` where
 it ran (a count the tree lacks or cannot change that way has no verdict), ``{"digest", "verdicts": None, "reason",
@@ -21,7 +22,7 @@ import math
 from time import perf_counter
 
 from facaid.editing.check import SAMPLE, TRIES, check_edits
-from facaid.grammar.budget import WorkLimitError, reserve
+from facaid.grammar.budget import WorkLimitError, reserve, seconds_left
 from facaid.grammar.layout import count_expansion
 from facaid.parameters import Parameter, named_parameters
 from webapp.facades.parsing import parse_procedure
@@ -38,6 +39,7 @@ CHECK_SECONDS = 1.0  # the most a check may be estimated to take at worst (`esti
 # `TRIES` places tried for each edit)
 UNIT_SECONDS, PIXEL_SECONDS, COMPARE_SECONDS = 14e-6, 7e-8, 1e-9
 CHECK_WORK = 14  # work units reserved per unit of the tree's (a unit of the budget is about a microsecond)
+LEAVE = 0.5  # the share of a request's CPU time left that a check may be estimated to take: the rest is the request's
 MINUS = "\u2212"
 
 
@@ -93,6 +95,11 @@ def record(tree, digest: str) -> dict:
             return _not_checked(digest, f"checking its edits would take more than the {CHECK_SECONDS:g} s a check "
                                         f"may take here (the facade is {tree.width:g} x {tree.height:g} px and lays "
                                         f"out {units:,} node instances)")
+        left = seconds_left()
+        if left is not None and seconds > LEAVE * left:
+            return _not_checked(digest, f"the request had too little of its computing time left for the check (it "
+                                        f"may take {seconds:.2f} s, and {left:.2f} s were left); it is checked when "
+                                        "next asked for", True)
         try:
             reserve(CHECK_WORK * units)
         except WorkLimitError:
