@@ -154,6 +154,17 @@ def _grow(mask: np.ndarray, r: int, axis: int) -> np.ndarray:
     return (np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)) > 0
 
 
+def appears(label_map: np.ndarray, label: int, box: tuple[int, int, int, int], area: int,
+            share: float = 0.5) -> bool:
+    """Whether ``label_map`` paints ``label`` on at least ``share`` of ``area`` pixels within ``box`` (x0, y0, x1,
+    y1: an element's) or off it by up to half its thinner side: a 3 px sill drawn 2 px lower is there."""
+    x0, y0, x1, y1 = box
+    height, width = label_map.shape
+    r = max(1, (min(x1 - x0, y1 - y0) + 1) // 2)
+    near = label_map[max(0, y0 - r) : min(height, y1 + r), max(0, x0 - r) : min(width, x1 + r)]
+    return bool((near == label).sum() >= share * area)
+
+
 def near_edges(label_map: np.ndarray, rx: int, ry: int) -> np.ndarray:
     """The pixels of a label map within ``rx`` (along x) and ``ry`` (along y) of an edge between two labels: where a
     hand-drawn edge may be off by that much."""

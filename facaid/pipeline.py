@@ -37,7 +37,7 @@ import torch
 
 from facaid.decoding import Candidate, decode, ranked_candidates
 from facaid.defaults import DEFAULT_K, STRUCTURES
-from facaid.editing.check import check_edits
+from facaid.editing.check import MORE, check_edits
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.induce import induce_procedure
@@ -194,8 +194,7 @@ def best_reading(flat: Segmentation):
     best, key = None, None
     for group, proc in readings(flat):
         fitted = fit_sizes(proc, flat)
-        checks = check_edits(fitted.procedure)
-        clean = all(checks[e].clean for e in ("floors+1", "bays+1") if e in checks)
+        clean = all(v.clean for v in check_edits(fitted.procedure, MORE).values())
         fitted.procedure.meta["group"] = list(group)
         if key is None or (clean, fitted.accuracy) > key:
             best, key = fitted, (clean, fitted.accuracy)

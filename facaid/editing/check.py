@@ -37,6 +37,7 @@ NEAR = 0.01  # rows that keep this much less than the most kept are as good a pl
 TRIES = 8  # of those, this many (evenly spaced) are tried for the band's likeness
 SAMPLE = (2, 4)  # the band's rows and columns compared in the copy search: every 2nd row, every 4th column
 EDITS = (("floors", 1), ("floors", -1), ("bays", 1), ("bays", -1))
+MORE = (("floors", 1), ("bays", 1))  # the edits a reading is chosen by
 _AXIS = {"floors": "y", "bays": "x"}
 
 
@@ -117,7 +118,7 @@ def band_lattice(windows: np.ndarray, at: int, h: int, axis: str) -> int:
     centres = (windows[:, lo] + windows[:, hi]) / 2
     sizes = windows[:, hi] - windows[:, lo]
     inside = (centres >= at) & (centres < at + h) & (sizes <= WIDE * np.median(sizes) if len(sizes) else True)
-    return centre_bands(centres[inside], (windows[:, hi] - windows[:, lo])[inside])
+    return centre_bands(centres[inside], sizes[inside])
 
 
 def judge_insert(old: np.ndarray, new: np.ndarray, old_lattice: tuple[int, int], new_lattice: tuple[int, int],
@@ -168,12 +169,12 @@ def judge(before: Procedure, after: Procedure, name: str, change: int) -> Verdic
     return out
 
 
-def check_edits(proc: Procedure) -> dict[str, Verdict]:
-    """`floors` ± 1 and `bays` ± 1 tried on ``proc`` and judged, keyed "floors+1", "floors-1", "bays+1" and
-    "bays-1"; a count the procedure does not have, or cannot change that way, is left out."""
+def check_edits(proc: Procedure, edits: tuple[tuple[str, int], ...] = EDITS) -> dict[str, Verdict]:
+    """`floors` ± 1 and `bays` ± 1 (or those of ``edits``) tried on ``proc`` and judged, keyed "floors+1",
+    "floors-1", "bays+1" and "bays-1"; a count the procedure does not have, or cannot change that way, is left out."""
     params = {p.name: p for p in named_parameters(proc)}
     out = {}
-    for name, change in EDITS:
+    for name, change in edits:
         p = params.get(name)
         if p is None or not p.min <= p.value + change <= p.max or p.min == p.max:
             continue
@@ -187,5 +188,5 @@ def check_edits(proc: Procedure) -> dict[str, Verdict]:
     return out
 
 
-__all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "Verdict", "best_copy", "check_edits", "insertion", "judge",
+__all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "MORE", "Verdict", "best_copy", "check_edits", "insertion", "judge",
            "judge_insert", "kept", "label_map"]

@@ -30,6 +30,15 @@ def centre_bands(centres: np.ndarray, sizes: np.ndarray) -> int:
     return int(1 + np.sum(np.diff(c) > 0.5 * np.median(sizes)))
 
 
+def whole_windows(boxes: np.ndarray) -> np.ndarray:
+    """The windows (boxes x0, y0, x1, y1) but the strips of one that a balcony or sill leaves uncovered: those under
+    `STRIP` of the median window's height or width."""
+    if not len(boxes):
+        return boxes
+    h, w = boxes[:, 3] - boxes[:, 1], boxes[:, 2] - boxes[:, 0]
+    return boxes[(h >= STRIP * np.median(h)) & (w >= STRIP * np.median(w))]
+
+
 def pitch(centres: np.ndarray, sizes: np.ndarray) -> float | None:
     """The median spacing of the bands of centres (each band at its median centre), None with fewer than 3 bands."""
     if len(centres) == 0:
@@ -44,10 +53,7 @@ def pitch(centres: np.ndarray, sizes: np.ndarray) -> float | None:
 def pitches(rows: np.ndarray) -> tuple[float | None, float | None]:
     """(floor pitch, bay pitch): the median spacing of the window rows and of the window columns of a flattened
     segmentation's rows, each None with fewer than three."""
-    w = window_boxes(rows)
-    if len(w):  # the strips of a window a balcony or sill leaves uncovered are no window rows or columns of their own
-        h, wd = w[:, 3] - w[:, 1], w[:, 2] - w[:, 0]
-        w = w[(h >= STRIP * np.median(h)) & (wd >= STRIP * np.median(wd))]
+    w = whole_windows(window_boxes(rows))
     return (pitch((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]), pitch((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
 
 
@@ -68,4 +74,4 @@ def segmentation_lattice(seg: Segmentation) -> tuple[int, int]:
     return lattice(flatten_array(seg.width, seg.height, seg.to_array()))
 
 
-__all__ = ["centre_bands", "lattice", "pitch", "pitches", "segmentation_lattice", "window_boxes"]
+__all__ = ["centre_bands", "lattice", "pitch", "pitches", "segmentation_lattice", "whole_windows", "window_boxes"]

@@ -16,6 +16,7 @@ from facaid.editing.windows import lattice, pitches, segmentation_lattice, windo
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE
+from facaid.metrics import appears
 from facaid.parameters import named_parameters, set_parameter
 from facaid.segmentation import region_boxes
 
@@ -28,16 +29,14 @@ def kept_elements(rows: np.ndarray, target: np.ndarray, pred: np.ndarray) -> tup
     of their area, where they were drawn or off by up to half their thinner side (a 3 px sill drawn 2 px lower is
     still there)."""
     drawn = kept = 0
-    height, width = target.shape
     for label in sorted({int(v) for v in rows[:, 0]} - {FACADE}):
-        for x0, y0, x1, y1 in region_boxes(rows, (label,)):
+        for box in region_boxes(rows, (label,)):
+            x0, y0, x1, y1 = box
             area = int((target[y0:y1, x0:x1] == label).sum())
             if not area:
                 continue
             drawn += 1
-            r = max(1, (min(x1 - x0, y1 - y0) + 1) // 2)
-            near = pred[max(0, y0 - r) : min(height, y1 + r), max(0, x0 - r) : min(width, x1 + r)]
-            kept += int((near == label).sum() >= KEPT * area)
+            kept += appears(pred, label, tuple(box), area, KEPT)
     return drawn, kept
 
 

@@ -6,11 +6,12 @@ Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013), in thre
 
 1. **The grid** (`read_grid`). Windows: connected window-or-blind regions of the building (the longest run of
    columns that are mostly not background: a neighbour's strip is left out), but for the strips a balcony or sill
-   leaves uncovered (`WHOLE`); their rows and columns (`window_bands`: bands of centres split where the gap is over
-   half the median window height, width; bands whose extents overlap are one; a column needs windows in
-   `COLUMN_SUPPORT` of the floors). Floors: horizontal bands that each hold one row of windows with its companions,
-   cut between two rows where the label map is most wall; the last rows whose bands hold doors or shops are the
-   ground floor. Tiles: the columns within the floors, cut the same way; the side margins; the attic above.
+   leaves uncovered (`facaid.editing.windows.whole_windows`); their rows and columns (`window_bands`: bands of
+   centres split where the gap is over half the median window height, width; bands whose extents overlap are one;
+   a column needs windows in `COLUMN_SUPPORT` of the floors). Floors: horizontal bands that each hold one row of
+   windows with its companions, cut between two rows where the label map is most wall; the last rows whose bands
+   hold doors or shops are the ground floor. Tiles: the columns within the floors, cut the same way; the side
+   margins; the attic above.
 2. **The typical floor and bay** (`read_floors`). The typical floor is a real one, the medoid of the floors; the
    typical bay the medoid column; the typical tile is where they cross (`facaid.reading.units`). The typical floor
    is that floor as it is: a row of typical tiles with its own cells' deltas, so that a new floor is a copy of it.
@@ -31,13 +32,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from facaid.editing.windows import whole_windows
 from facaid.grammar.procedure import MAX_COUNT, Node, Override, Procedure, ProcedureError, Size
 from facaid.labels import BACKGROUND, FACADE, GLASS, LABEL_ID
 from facaid.reading.units import Delta, Deltas, Unit, exact_tree, medoid, resample
 from facaid.segmentation import Segmentation, flatten, rasterize, region_boxes
 
 JITTER = 0.08  # a floor or column length off the median by more than this share is its own
-WHOLE = 0.35  # a window region smaller than this share of the median window's height or width is a strip of one
 COLUMN_SUPPORT = 0.5  # a column of windows needs windows in this share of the floors
 GROUND_SHARE = 0.05  # a last row of windows whose band is this much door or shop belongs to the ground floor
 
@@ -227,10 +228,7 @@ def grouped(grid: Grid | None, group: tuple[int, int]) -> Grid | None:
 def _grid(flat: Segmentation, label_map: np.ndarray) -> Grid | None:
     """The grid of a flattened segmentation: its windows, but strips, within the main building's footprint."""
     fx0, fx1 = footprint(label_map)
-    windows = region_boxes(flat.to_array(), GLASS)
-    if len(windows):  # the strips of a window a balcony or a sill left uncovered are not windows of the lattice
-        h, w = windows[:, 3] - windows[:, 1], windows[:, 2] - windows[:, 0]
-        windows = windows[(h >= WHOLE * np.median(h)) & (w >= WHOLE * np.median(w))]
+    windows = whole_windows(region_boxes(flat.to_array(), GLASS))  # a strip of a window is no window of the lattice
     centres = (windows[:, 0] + windows[:, 2]) / 2
     return read_grid(label_map, windows[(centres >= fx0) & (centres < fx1)])
 
@@ -348,5 +346,5 @@ def _role(node: Node, role: str) -> Node:
     return node
 
 
-__all__ = ["COLUMN_SUPPORT", "GROUND_SHARE", "GROUPS", "JITTER", "WHOLE", "Grid", "footprint", "grouped",
+__all__ = ["COLUMN_SUPPORT", "GROUND_SHARE", "GROUPS", "JITTER", "Grid", "footprint", "grouped",
            "read_floors", "read_grid", "read_lattice", "readings", "window_bands"]

@@ -22,7 +22,7 @@ from facaid.grammar.execute import execute
 from facaid.grammar.procedure import Node, Procedure, Size
 from facaid.grammar.shapes import elements, leaf_paths, shape
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS
-from facaid.metrics import near_edges
+from facaid.metrics import appears, near_edges
 from facaid.segmentation import decompose_grid, region_boxes
 
 EDGE = 0.06  # a copy that differs only this close (a share of the unit's shorter side) to an edge differs by jitter
@@ -94,13 +94,10 @@ def missing(drawn: np.ndarray, crop: np.ndarray) -> np.ndarray:
     out = np.zeros(crop.shape, dtype=bool)
     rows = decompose_grid(crop.astype(np.int64) + 1)
     rows[:, 0] -= 1
-    h, w = crop.shape
     for label in {int(v) for v in rows[:, 0]} - {FACADE, BACKGROUND}:
         for x0, y0, x1, y1 in region_boxes(rows, (label,)):
             own = crop[y0:y1, x0:x1] == label
-            r = max(1, (min(x1 - x0, y1 - y0) + 1) // 2)
-            near = drawn[max(0, y0 - r) : min(h, y1 + r), max(0, x0 - r) : min(w, x1 + r)]
-            if (near == label).sum() < 0.5 * own.sum():
+            if not appears(drawn, label, (x0, y0, x1, y1), int(own.sum())):
                 out[y0:y1, x0:x1] |= own
     return out
 
