@@ -5,7 +5,9 @@ readings, its estimate against its time, and what it adds to a save.
 
 1. ``webapp.facades.editcheck.record`` of the editable reading (`facaid.reading.read_lattice`) of CMP facades
    ``--start`` to ``--start + --limit``: seconds (median, 90th percentile, most), how many were not checked (their
-   estimate past `CHECK_SECONDS`) and the estimate over the time it took (at least 1 is an upper bound).
+   estimate past `CHECK_SECONDS`), the estimate over the time it took (at least 1 is an upper bound), and on how
+   many the self-check agrees with the rule applied offline (`facaid.editing.check.check_edits`: the same verdict
+   on floors + 1 and bays + 1; a tree not checked disagrees).
 2. A save through the API (``PATCH procedures/<code>/`` with a new tree: two trees in turn, so each save is a new
    version whose edits are checked) on a scratch SQLite database, in this process, with the check and without it
    (`CHECK_SECONDS` 0: the estimate alone), for a generated facade and the CMP reading whose check took the median
@@ -46,14 +48,19 @@ def readings(start: int, limit: int) -> list:
 def the_check(trees: list) -> tuple:
     """Times the check of each tree; returns the (name, tree) whose check took the median time of those with every
     edit judged (four verdicts)."""
+    from facaid.editing.check import MORE, check_edits
     from webapp.facades import editcheck
 
-    times, ratios, refused, judged = [], [], 0, []
+    times, ratios, refused, judged, agree = [], [], 0, [], 0
     for name, tree in trees:
         estimate, _ = editcheck.estimate(tree)
         start = time.perf_counter()
         rec = editcheck.record(tree, "bench")
         took = time.perf_counter() - start
+        # the self-check agrees with the rule where it gives floors + 1 and bays + 1 the rule's verdicts
+        rule = {key: v.clean for key, v in check_edits(tree, MORE).items()}
+        mine = {key: v["clean"] for key, v in (rec["verdicts"] or {}).items() if key in rule}
+        agree += mine == rule
         if rec["verdicts"] is None:
             refused += 1
             continue
@@ -65,7 +72,8 @@ def the_check(trees: list) -> tuple:
     print(f"the check, {len(trees)} CMP readings: median {statistics.median(times):.3f} s, 90th percentile "
           f"{times[int(0.9 * (len(times) - 1))]:.3f} s, most {times[-1]:.3f} s; not checked (estimate past "
           f"{editcheck.CHECK_SECONDS:g} s): {refused}; estimate / time: least {min(ratios):.2f}, median "
-          f"{statistics.median(ratios):.2f}; every edit judged on {len(judged)}")
+          f"{statistics.median(ratios):.2f}; every edit judged on {len(judged)}; the self-check agrees with the "
+          f"rule (floors + 1, bays + 1) on {agree} of {len(trees)} ({100 * agree / len(trees):.1f} %)")
     judged.sort(key=lambda t: t[0])
     _, name, tree = judged[len(judged) // 2]
     return name, tree

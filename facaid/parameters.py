@@ -18,12 +18,24 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from facaid.grammar.execute import parameter_lengths
+from facaid.editing.floors import as_floors_repeat, plain_floor, unrepeated_floors
+from facaid.editing.growth import grow
+from facaid.editing.rows import (
+    aligned_rows,
+    building_of,
+    holds_door,
+    open_wall,
+    opening,
+    step_cells,
+    unmirrored,
+    wall_rows,
+)
+from facaid.grammar.execute import first_boxes, parameter_lengths
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
-from facaid.grammar.repeats import copies_moved, pattern_child, recount
-from facaid.resizing import copy_procedure, repeat_unit, resize
+from facaid.grammar.repeats import copies_moved, copies_where, most_typical, recount
+from facaid.resizing import copy_lengths, copy_procedure, repeat_unit, resize
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
 
@@ -214,7 +226,7 @@ def named_parameters(proc: Procedure) -> list[Parameter]:
     out: list[Parameter] = []
     floors, paths = _count_of(inst, proc, "floor")
     if floors:
-        editable = bool(_floor_repeats(proc, inst, "floor", "y"))
+        editable = bool(_floor_repeats(proc, inst, "floor", "y")) or unrepeated_floors(proc, inst) is not None
         out.append(Parameter("floors", "upper floors", floors, "count", True, floors if not editable else 1,
                              floors if not editable else MAX_COUNT, paths))
     for name, (label, role, axis) in _LENGTHS.items():
@@ -239,113 +251,6 @@ def named_parameters(proc: Procedure) -> list[Parameter]:
     out.append(Parameter("height", "facade height", float(proc.height), "px", False, 8.0, MAX_EXTENT, ["root"]))
     order = {n: i for i, n in enumerate(NAMES)}
     return sorted(out, key=lambda p: order[p.name])
-
-
-def _grow(proc: Procedure, axis: str, own: dict[int, float], shrink: bool = False) -> None:
-    """Grow the nodes in ``own`` (id → change of each instance's length along ``axis``) and, to fit them, every
-    node enclosing them and the image; a normalised tree stays normalised, so nothing else changes size. With
-    ``shrink`` (a count made smaller), a node whose edited children shrink shrinks with them and its other children
-    follow (a floor fewer makes the image lower beside it too); else the wall takes what they give up (a narrower
-    window leaves its floor as high)."""
-    memo: dict[int, float] = {}
-    holds: dict[int, bool] = {}
-
-    def has_target(node: Node) -> bool:
-        if id(node) not in holds:
-            holds[id(node)] = id(node) in own or any(has_target(c) for c in _inner(node))
-        return holds[id(node)]
-
-    def pad(node: Node, extra: float) -> None:
-        """Lengthen ``node`` by ``extra`` in what holds no edited node (a wing whose floors grew less than its
-        neighbour's takes the difference in its wall or sky, not in its floors)."""
-        if node.rule == "leaf" or id(node) in own:
-            return
-        if node.axis != axis:
-            for c in node.children:
-                pad(c, extra)
-            return
-        free = [i for i, c in enumerate(node.children) if not has_target(c)]
-        i = next((i for i in free if node.sizes[i].mode == "flt"), free[0] if free else 0)
-        copies = (len(_grown_copies(node, i)) if node.rule == "repeat"
-                  else 1 if node.rule == "split" or (node.center and i == len(node.children) - 1) else 2)
-        if not copies:  # every copy of the item has its own size: they share the extra
-            _pad_own_sizes(node, i, extra)
-            return
-        node.sizes[i] = Size(node.sizes[i].mode, round(node.sizes[i].value + extra / copies, 4))
-        if not free:
-            pad(node.children[i], extra / copies)
-
-    def grow(node: Node) -> float:
-        key = id(node)
-        if key in memo:
-            return memo[key]
-        if key in own:
-            g = own[key]
-        elif node.rule == "leaf":
-            g = 0.0
-        elif node.axis != axis:  # its children side by side: all as long as the longest needs (see ``shrink``)
-            parts = [grow(c) for c in node.children]
-            edited = [d for c, d in zip(node.children, parts, strict=True) if has_target(c)]
-            g = max(edited) if shrink and edited else max(parts)
-            for c, d in zip(node.children, parts, strict=True):
-                if d != g:
-                    pad(c, g - d)
-        else:
-            parts = [grow(c) for c in node.children]
-            node.sizes = [Size(s.mode, max(0.0, round(s.value + d, 4))) for s, d in zip(node.sizes, parts,
-                                                                                      strict=True)]
-            if node.rule == "repeat":  # a copy an exception sizes keeps its size
-                g = sum(len(_grown_copies(node, j)) * d for j, d in enumerate(parts))
-            elif node.rule == "mirror":
-                g = 2 * sum(parts) - (parts[-1] if node.center else 0.0)
-            else:
-                g = sum(parts)
-        memo[key] = g
-        for o in node.exceptions:  # a node an exception puts in place grows too (its windows are windows), and
-            # is padded to what the node it replaces grew by, so that it fills the same place
-            if o.node is not None:
-                own_growth = grow(o.node)
-                replaced = _pattern_at(node, o.path)
-                if replaced is not None and memo.get(id(replaced), own_growth) > own_growth:  # (one that grew
-                    pad(o.node, memo[id(replaced)] - own_growth)  # more is laid out in its place as it is)
-        return g
-
-    g = grow(proc.root)
-    if axis == "x":
-        proc.width = round(proc.width + g, 4)
-    else:
-        proc.height = round(proc.height + g, 4)
-
-
-def _inner(node: Node) -> list[Node]:
-    """A node's children and the nodes its exceptions put in place."""
-    return node.children + [o.node for o in node.exceptions if o.node is not None]
-
-
-def _pattern_at(node: Node, path: tuple[int, ...]) -> Node | None:
-    """The node of ``node``'s pattern that an exception's path names (a repeat's copies read as its pattern), or
-    None where the path goes below a leaf."""
-    target = node.children[path[0]]
-    for step in path[1:]:
-        if target.rule == "leaf":
-            return None
-        target = pattern_child(target, step)
-    return target
-
-
-def _pad_own_sizes(node: Node, item: int, extra: float) -> None:
-    """Share ``extra`` among the exceptions that size the laid-out copies of a repeat's pattern item ``item``."""
-    laid_out = node.count + (item < node.tail)
-    sized = [k for k, o in enumerate(node.exceptions) if o.path == (item,) and o.size is not None and o.copy < laid_out]
-    for k in sized:
-        o = node.exceptions[k]
-        node.exceptions[k] = o._replace(size=Size(o.size.mode, round(o.size.value + extra / len(sized), 4)))
-
-
-def _grown_copies(node: Node, item: int) -> list[int]:
-    """The copies of a repeat's pattern item ``item`` that take the item's own size (no exception sizes them)."""
-    resized = {o.copy for o in node.exceptions if o.path == (item,) and o.size is not None}
-    return [c for c in range(node.count + (item < node.tail)) if c not in resized]
 
 
 def _along(nodes: dict[str, Node], path: str, axis: str) -> Node:
@@ -379,6 +284,8 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
     if name in ("width", "height"):
         return resize(proc, value if name == "width" else proc.width, value if name == "height" else proc.height)
     out = normalised(proc)
+    if name == "bays":  # a row mirrored around its centre bay as the repeat it draws, so that it takes one bay
+        out = unmirrored(out)
     inst = _Instances(out)
     nodes = _nodes(out)
     if name in _LENGTHS or name in _WINDOW or name == "margin":
@@ -386,10 +293,10 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         if name in _WINDOW:  # windows of other sizes (the ground floor's, a dormer) change by as much, each
             # through the part that holds it along the axis (a window in a column split along y: the column), so
             # that a narrower window makes a narrower column, not a column as wide as its widest part
-            _grow(out, axis, {id(_along(nodes, path, axis)): value - p.value for path in p.nodes})
+            grow(out, axis, {id(_along(nodes, path, axis)): value - p.value for path in p.nodes})
         else:
             side = 0 if axis == "x" else 1
-            _grow(out, axis, {id(n): value - inst.typical(id(n))[side] for n in (nodes[path] for path in p.nodes)
+            grow(out, axis, {id(n): value - inst.typical(id(n))[side] for n in (nodes[path] for path in p.nodes)
                               if id(n) in inst.extent})  # a node an exception replaces everywhere has no length
     else:
         role, axis = ("floor", "y") if name == "floors" else ("tile", "x")
@@ -397,15 +304,45 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             repeats = [(pth, n) for pth, n in out.nodes() if n.rule == "repeat" and n.axis == "x"
                        and n.count != "fill" and any(c.role == "tile" for c in n.children)]
         else:
+            if not _floor_repeats(out, inst, role, axis) and (run := unrepeated_floors(out, inst)) is not None:
+                as_floors_repeat(*run, inst)  # floors laid out one by one: the repeat they are, to take one more
+                inst = _Instances(out)
             repeats = _floor_repeats(out, inst, role, axis)[:1]
         if not repeats and int(value) != int(p.value):
             raise ValueError(f"{name} cannot change here: no repeat lays out the {role}s (edit the tree instead)")
         own: dict[int, float] = {}
         change = int(value) - int(p.value)
         # rows of tiles of one count stay in step: their new tiles go where the most laid-out row's go
-        main = max((n for _, n in repeats if id(n) in inst.extent), key=lambda n: inst.count[id(n)], default=None)
-        if main is not None:  # as it is before any row changes
-            main = Node("repeat", count=main.count, exceptions=list(main.exceptions))
+        main_path, main = max(((pth, n) for pth, n in repeats if id(n) in inst.extent),
+                              key=lambda pn: inst.count[id(pn[1])], default=(None, None))
+        main_node, boxes = main, first_boxes(out)
+        source, before = None, False
+        if name == "floors" and repeats and id(repeats[0][1]) in inst.extent:  # a floor more repeats, a floor
+            # fewer takes, the floor fewest exceptions change of those the door reaches into none of
+            source = plain_floor(out, repeats[0][1], inst)
+        ground = {id(n) for p, g in out.nodes() if g.role == "ground" for _, n in g.walk()}
+        aligned: list[tuple[Node, int]] = []
+        gap = None
+        if main is not None:  # as it is before any row changes; a new bay repeats its most typical column
+            if name == "bays":  # of the building that holds the most laid-out row (a wing keeps its bays)
+                building = building_of(out, main_path)
+                repeats = [(pth, n) for pth, n in repeats if f"{pth}/".startswith(building)]
+                # a row of as many copies as long under the bays (the ground floor's shops) keeps in step too
+                width = inst.extent[id(main)][0]
+                repeats += [(pth, n) for pth, n in out.nodes() if n.rule == "repeat" and n.axis == "x"
+                            and n.count == main.count and f"{pth}/".startswith(building) and "!" not in pth
+                            and id(n) in inst.extent and abs(inst.extent[id(n)][0] - width) <= 2.0
+                            and all(n is not m for _, m in repeats)]
+                stepped = tuple(n for _, n in repeats if n.count == main.count)
+                doors = copies_where(out.root, main, stepped, lambda n: holds_door([n]))
+                source = most_typical(out.root, main, stepped, doors)
+                # a new bay beside the door's column goes on the side the door does not reach into
+                before = source is not None and source in doors and source + 1 in doors
+                aligned = aligned_rows(out, inst.extent, main, building)
+            main = Node("repeat", count=main.count, children=list(main.children), exceptions=list(main.exceptions))
+            if name == "bays" and 1 <= main.count + change <= MAX_COUNT and id(main_node) in boxes:
+                step = copies_moved(main, main.count + change, source, before)
+                gap = opening(main_node, inst.extent[id(main_node)][0], boxes[id(main_node)][0], step)
         if name == "bays" and not p.value:
             raise ValueError("bays cannot change here: no floor holds its tiles (edit the tree instead)")
         for _, node in repeats:
@@ -420,14 +357,32 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             new = node.count + delta
             if not 1 <= new <= MAX_COUNT:
                 raise ValueError(f"{name} {value:g} needs a repeat of {new} copies (1 to {MAX_COUNT})")
-            unit, _ = repeat_unit(node, inst.extent[id(node)][0 if axis == "x" else 1])
-            own[id(node)] = delta * unit
+            length = inst.extent[id(node)][0 if axis == "x" else 1]
             in_step = main is not None and main.count == node.count and name == "bays"
-            recount(out.root, node, new, copies_moved(main, new) if in_step else None)
+            moved = (copies_moved(main, new, source, before) if in_step
+                     else copies_moved(node, new, source) if name == "floors" else copies_moved(node, new))
+            # every row's new tile is the source column's cell, the ground floor's its typical shop; a new floor
+            # is a copy of the source floor. The facade grows by the new copies, each as long as what it copies, or
+            # shrinks by the copies taken out, each as long as it was
+            copied = source if in_step or name == "floors" else None
+            lengths = copy_lengths(node, length)
+            mine = copied is not None and id(node) not in ground and any(o.copy == copied for o in node.exceptions)
+            own[id(node)] = (delta * (lengths[copied] if mine else repeat_unit(node, length)[0]) if delta > 0
+                             else -sum(lengths[c] for c in range(node.count) if c not in moved))
+            recount(out.root, node, new, moved, copied, id(node) not in ground)
+        if own and gap is not None:
+            # rows written out cell by cell under the bays (a ground floor of shops) take a cell in step; rows of
+            # their own over the bays (an attic's dormers) open their wall where the new bay goes
+            for row, offset in aligned:
+                own[id(row)] = step_cells(row, offset, inst.extent[id(row)][0], main, step, source)
+            at, width = gap
+            for row in wall_rows(out, inst.extent, boxes, main_node, building, own):
+                if (grown := open_wall(row, inst.extent[id(row)][0], boxes[id(row)][0], at, width)) is not None:
+                    own[id(row)] = grown
         if not own and change:
             raise ValueError(f"{name} cannot be {value:g} here: no row of {role}s takes {change:+d} (a mirrored row "
                              f"changes by two)")
-        _grow(out, axis, own, shrink=change < 0)
+        grow(out, axis, own, shrink=change < 0)
     try:
         validate(out)
     except ProcedureError as exc:

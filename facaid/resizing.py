@@ -35,6 +35,13 @@ def repeat_unit(node, length: float) -> tuple[float, float]:
     return sum(lengths[typical * k:(typical + 1) * k]), tail
 
 
+def copy_lengths(node, length: float) -> list[float]:
+    """The length each copy of the counted repeat ``node`` lays out to on ``length``."""
+    k = len(node.children)
+    lengths = layout(expand_over(node, length, None)[0], length)
+    return [sum(lengths[c * k : (c + 1) * k]) for c in range(node.count)]
+
+
 def resize(proc: Procedure, width: float, height: float) -> Procedure:
     """The facade at a new size: fixed sizes keep their pixels, floating ones stretch, and every repeat
     lays out as many copies of its pattern as now fit beside its tail (rounded, at least one), as a ``"fill"``

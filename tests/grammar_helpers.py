@@ -53,10 +53,11 @@ def example() -> Procedure:
                   bays=[Override(2, (0,), size=Size("flt", 90))])
 
 
-def real_like(seed: int = 0, floors: int = 5, bays: int = 6) -> Segmentation:
+def real_like(seed: int = 0, floors: int = 5, bays: int = 6, door: int | None = None) -> Segmentation:
     """An annotation drawn the way people draw CMP's: layered boxes, edges a few pixels off, a facade box, windows
     with sills and hoods in rows and columns, one window's blind closed, a balcony on the second floor, a taller
-    ground floor of shops around a door, a cornice band under the roof, and sky above."""
+    ground floor of shops around a door (under column ``door``, by default the middle one), a cornice band under
+    the roof, and sky above."""
     rng = np.random.default_rng(seed)
     tile, storey, top, ground = 70, 95, 60, 130
     width, height = 30 * 2 + bays * tile, top + floors * storey + ground
@@ -79,7 +80,7 @@ def real_like(seed: int = 0, floors: int = 5, bays: int = 6) -> Segmentation:
     y = top + floors * storey
     for b in range(bays):
         x = 30 + b * tile
-        if b == bays // 2:
+        if b == (bays // 2 if door is None else door):
             rects.append(("door", j(x + 16), j(y + 30), j(x + 54), height))
         else:
             rects.append(("shop", j(x + 6), j(y + 24), j(x + 64), j(height - 6)))

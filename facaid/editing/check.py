@@ -12,22 +12,25 @@ floor is a blend of three floors or sits under the shops; looking at the picture
    alike band of its size;
 3. it holds windows, and the rows (columns) of windows grow by as many as it holds (one; two where a bay is a
    pair of windows, or a floor has a mezzanine) while the columns (rows) stay as they were; a shop window several
-   bays wide is in no column (`facaid.editing.windows.WIDE`).
+   bays wide is in no column (`facaid.editing.windows.WIDE`);
+4. the doors stay as many as they were: a new bay beside the entrance is another shop, not a second door.
 
 A removal (− 1) is judged as the insertion that would undo it: the old facade is the new one with a band put in.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from facaid.editing.windows import WIDE, centre_bands, lattice, window_boxes
-from facaid.grammar.execute import flat_rows
+from facaid.grammar.execute import first_boxes, flat_rows
 from facaid.grammar.procedure import Procedure
+from facaid.labels import LABEL_ID
 from facaid.parameters import named_parameters, set_parameter
-from facaid.segmentation import Segmentation, rasterize
+from facaid.segmentation import Segmentation, rasterize, region_boxes
 
 KEEP = 0.98  # share of the old pixels a new floor leaves where they were
 KEEP_BAY = 0.93  # the same for a new bay column (the ground floor may re-lay its shops around the door)
@@ -36,6 +39,9 @@ EDGE = 2  # a band put in within this many pixels of the image's edge is stuck o
 NEAR = 0.01  # rows that keep this much less than the most kept are as good a place for the band
 TRIES = 8  # of those, this many (evenly spaced) are tried for the band's likeness
 SAMPLE = (2, 4)  # the band's rows and columns compared in the copy search: every 2nd row, every 4th column
+DOOR = LABEL_ID["door"]
+BACKGROUND = LABEL_ID["background"]
+SKY = 0.9  # share of the band above a building beside the one that took a floor that must be sky
 EDITS = (("floors", 1), ("floors", -1), ("bays", 1), ("bays", -1))
 MORE = (("floors", 1), ("bays", 1))  # the edits a reading is chosen by
 _AXIS = {"floors": "y", "bays": "x"}
@@ -70,7 +76,8 @@ def kept(old: np.ndarray, new: np.ndarray) -> np.ndarray:
     return (above + below) / old.size
 
 
-def insertion(old: np.ndarray, new: np.ndarray, keep: float) -> tuple[int, float, float]:
+def insertion(old: np.ndarray, new: np.ndarray, keep: float,
+              holds: Callable[[int], int] | None = None) -> tuple[int, float, float]:
     """Where a band went into ``old`` to make ``new``: of the rows away from the edges that keep nearly the most of
     ``old``'s pixels (and at least ``keep``), the one whose band is most alike a band of ``old`` (a band between two
     like floors can go in at any row of them: only some of those cut a floor where the old ones are cut), with the
@@ -88,9 +95,15 @@ def insertion(old: np.ndarray, new: np.ndarray, keep: float) -> tuple[int, float
     spread = near[np.unique(np.linspace(0, len(near) - 1, min(len(near), TRIES)).round().astype(int))]
     best = (-1.0, 0.0, 0)
     for y in sorted(spread.tolist(), key=lambda y: -share[y]):  # the most kept first; a copy found ends it
-        best = max(best, (best_copy(new[y : y + h], old), float(share[y]), y))
+        found = (best_copy(new[y : y + h], old), float(share[y]), y)
+        if found[0] >= COPY and holds is not None and not holds(y):  # a band between two like bays cut through
+            best = max(best, (COPY - 1e-9, *found[1:]))  # their windows: a copy, but another place may hold one
+            continue
+        best = max(best, found)
         if best[0] >= COPY:
             break
+    if best[0] == COPY - 1e-9:
+        best = (COPY, *best[1:])
     return best[2], best[1], best[0]
 
 
@@ -133,7 +146,7 @@ def judge_insert(old: np.ndarray, new: np.ndarray, old_lattice: tuple[int, int],
     h = new.shape[0] - old.shape[0]
     if h <= 0:
         return Verdict(False, f"the facade did not grow by a {word}")
-    at, unchanged, copy = insertion(old, new, keep)
+    at, unchanged, copy = insertion(old, new, keep, lambda y: band_lattice(new_windows, y, h, axis))
     figures = {"unchanged": unchanged, "copy": copy, "at": at}
     grows, stays = (0, 1) if axis == "y" else (1, 0)
     if at <= EDGE or at >= old.shape[0] - EDGE:
@@ -154,15 +167,71 @@ def judge_insert(old: np.ndarray, new: np.ndarray, old_lattice: tuple[int, int],
     return Verdict(True, f"one {word} like the others put in between two", **figures)
 
 
+def wings(proc: Procedure) -> tuple[str, list[tuple[int, int]]] | None:
+    """The buildings of a facade of wings: the path of the outermost split along x two or more of whose children
+    hold a node of role ``facade``, and each child's columns [x0, x1); None for a facade of one building."""
+    boxes = first_boxes(proc)
+    for path, node in proc.nodes():
+        if node.rule != "split" or node.axis != "x" or "!" in path:
+            continue
+        if (sum(any(n.role == "facade" for _, n in c.walk()) for c in node.children) >= 2
+                and all(id(c) in boxes for c in node.children)):
+            return path, [(round(boxes[id(c)][0]), round(boxes[id(c)][2])) for c in node.children]
+    return None
+
+
+def judge_wings(old: Procedure, new: Procedure, old_map: np.ndarray, new_map: np.ndarray, old_rows: np.ndarray,
+                new_rows: np.ndarray, axis: str, keep: float) -> Verdict | None:
+    """The rule on a facade of wings, building by building (None where the facade is one building): the edited
+    building is judged by `judge_insert`; every other keeps its pixels, a floor more of its neighbour adding sky
+    above it (on top, `SKY` of that band background), a bay more of its neighbour moving it aside."""
+    found = wings(old)
+    if found is None:
+        return None
+    path, old_x = found
+    node = dict(new.nodes()).get(path)
+    boxes = first_boxes(new)
+    if node is None or len(node.children) != len(old_x) or any(id(c) not in boxes for c in node.children):
+        return None
+    new_x = [(round(boxes[id(c)][0]), round(boxes[id(c)][2])) for c in node.children]
+    edited: list[Verdict] = []
+    for (a0, a1), (b0, b1) in zip(old_x, new_x, strict=True):
+        o, n = old_map[:, a0:a1], new_map[:, b0:b1]
+        h = n.shape[0] - o.shape[0] if axis == "y" else n.shape[1] - o.shape[1]
+        if axis == "y" and h > 0 and n.shape[1] == o.shape[1] and kept(o, n)[0] >= keep \
+                and (n[:h] == BACKGROUND).mean() >= SKY:
+            continue  # sky above a building beside the one that took the floor
+        if axis == "x" and h == 0 and n.shape == o.shape and (n == o).mean() >= keep:
+            continue  # a building beside the one that took the bay
+        def strip(rows: np.ndarray, x0: int, x1: int) -> np.ndarray:
+            centres = (rows[:, 1] + rows[:, 3]) / 2
+            part = rows[(centres >= x0) & (centres < x1)].copy()
+            part[:, [1, 3]] -= x0
+            return part
+        mine, theirs = strip(old_rows, a0, a1), strip(new_rows, b0, b1)
+        edited.append(judge_insert(o, n, lattice(mine, typical=True), lattice(theirs, typical=True),
+                                   window_boxes(theirs), axis, keep))
+    if not edited:
+        return Verdict(False, "no building of the facade took the edit")
+    return next((v for v in edited if not v.clean), edited[0])
+
+
 def judge(before: Procedure, after: Procedure, name: str, change: int) -> Verdict:
     """Whether ``after``, ``before`` with the count ``name`` ("floors" or "bays") changed by ``change`` (+1 or
     -1), is the clean edit of the module's rule."""
     axis = _AXIS[name]
     keep = KEEP if name == "floors" else KEEP_BAY
     old, new = (before, after) if change > 0 else (after, before)
-    new_rows = flat_rows(new)
-    out = judge_insert(label_map(old), label_map(new), lattice(flat_rows(old), typical=True),
-                       lattice(new_rows, typical=True), window_boxes(new_rows), axis, keep)
+    old_rows, new_rows = flat_rows(old), flat_rows(new)
+    old_map, new_map = label_map(old), label_map(new)
+    out = judge_wings(old, new, old_map, new_map, old_rows, new_rows, axis, keep)
+    if out is None:
+        out = judge_insert(old_map, new_map, lattice(old_rows, typical=True), lattice(new_rows, typical=True),
+                           window_boxes(new_rows), axis, keep)
+    doors = [len(region_boxes(rows, (DOOR,))) for rows in (old_rows, new_rows)]
+    if out.clean and doors[0] != doors[1]:  # the entrance stays: a new bay beside it is a shop, not a door
+        return Verdict(False, f"the doors went from {doors[change < 0]} to {doors[change > 0]}", out.unchanged,
+                       out.copy, out.at)
     if change < 0 and out.clean:
         return Verdict(True, f"one {'floor' if name == 'floors' else 'bay'} like the others taken out",
                        out.unchanged, out.copy, out.at)

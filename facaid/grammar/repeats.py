@@ -3,7 +3,7 @@ path runs through, and a repeat's count changed with every exception kept on its
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
 from facaid.grammar.limits import MAX_COUNT
@@ -61,16 +61,18 @@ class PathIndex:
         return found
 
 
-def copies_moved(node: Node, count: int) -> dict[int, int]:
+def copies_moved(node: Node, count: int, source: int | None = None, before: bool = False) -> dict[int, int]:
     """Where each copy of the repeat ``node`` goes when its count becomes ``count`` (a copy absent: removed; the
-    tail, ``node.count``, goes to ``count``): new copies are typical and go after the last typical copy (one that no
-    exception of ``node`` changes), between its like; removed copies are typical ones from the end first, then the
-    others from the end, but the last copy that lays out the pattern (with none, it would never be laid out)."""
+    tail, ``node.count``, goes to ``count``): new copies are typical and go after ``source`` (before it with
+    ``before``; by default after the last typical copy, one that no exception of ``node`` changes), between their
+    like; removed copies are ``source`` first, then typical ones from the end, then the others, those fewest
+    exceptions change first (from the end), but the last copy that lays out the pattern (with none, it would never
+    be laid out)."""
     old = node.count
     changed = {o.copy for o in node.exceptions}
     typical = [c for c in range(old) if c not in changed]
     if count >= old:
-        at = typical[-1] + 1 if typical else old
+        at = source + (not before) if source is not None else typical[-1] + 1 if typical else old
         new = {c: c if c < at else c + count - old for c in range(old)}
     else:
         # a copy that lays the pattern out (no exception puts a node in place of its items) stays while it is the
@@ -80,16 +82,65 @@ def copies_moved(node: Node, count: int) -> dict[int, int]:
                     and any(h[: len(o.path)] == o.path for h in holders)}
         laying = {c for c in range(old) if c not in replaced}
         gone: set[int] = set()
-        for c in typical[::-1] + [c for c in range(old - 1, -1, -1) if c in changed]:
+        first = [source] if source is not None else []
+        own = {c: sum(1 for o in node.exceptions if o.copy == c) for c in changed}
+        for c in first + typical[::-1] + sorted(changed, key=lambda c: (own[c], -c)):
             if len(gone) == old - count:
                 break
-            if laying - gone != {c}:
+            if c not in gone and laying - gone != {c}:
                 gone.add(c)
         if len(gone) < old - count:  # only that copy is left to take
             gone |= laying
         new = {c: c - sum(1 for g in gone if g < c) for c in range(old) if c not in gone}
     new[old] = count  # the tail
     return new
+
+
+def most_typical(root: Node, node: Node, rows: tuple[Node, ...] = (),
+                 avoid: frozenset[int] = frozenset()) -> int | None:
+    """Of the typical copies of the repeat ``node`` (no exception of its own), the one fewest exceptions change: of
+    the repeats above that run through it, and of ``rows``, repeats of as many copies kept in step with it (a
+    floor of its own tiles); the last of those, None with none typical. It is the column every floor lays out most
+    as its typical tile: a new copy repeats it, cells of other floors and all, and a copy fewer takes it. A copy in
+    ``avoid`` (one holding the door, `copies_where`) is taken only where all are."""
+    changed = {o.copy for o in node.exceptions}
+    typical = [c for c in range(node.count) if c not in changed]
+    if not typical:
+        return None
+    k = len(node.children)
+    through = {c: 0 for c in typical}
+    for _, o, s in _through(root, node):
+        if (c := o.path[s] // k) in through:
+            through[c] += 1
+    for row in rows:
+        for o in row.exceptions:
+            if row is not node and o.copy in through:
+                through[o.copy] += 1
+    return min(typical[::-1], key=lambda c: (c in avoid, through[c]))
+
+
+def copies_where(root: Node, node: Node, rows: tuple[Node, ...], test: Callable[[Node], bool]) -> frozenset[int]:
+    """The copies of the repeat ``node`` where an exception puts a node ``test`` is true of (one that holds the
+    door): an exception of a repeat above whose path runs through the copy, or of one of ``rows`` (repeats kept in
+    step with ``node``) at the same copy."""
+    k = len(node.children)
+    found = {o.path[s] // k for _, o, s in _through(root, node) if o.node is not None and test(o.node)}
+    found |= {o.copy for row in rows for o in row.exceptions if o.node is not None and test(o.node)}
+    return frozenset(found)
+
+
+def _through(root: Node, node: Node) -> Iterator[tuple[Node, Override, int]]:
+    """The exceptions of the repeats under ``root`` above ``node`` whose paths run through it: (the repeat, the
+    exception, the step of its path that names ``node``'s child, copy times pattern length plus item)."""
+    index = PathIndex()
+    for _, above in root.walk():
+        if not above.exceptions or above is node:
+            continue
+        for o in above.exceptions:
+            for s, target in along_path(above, o, above.exceptions, index):
+                if target is node and s + 1 < len(o.path):
+                    yield above, o, s + 1
+                    break
 
 
 def _holders(node: Node) -> Iterator[tuple[int, ...]]:
@@ -110,33 +161,32 @@ def _holders(node: Node) -> Iterator[tuple[int, ...]]:
         yield from ((item,) for item in range(len(node.children)))
 
 
-def recount(root: Node, node: Node, count: int, new: dict[int, int] | None = None) -> None:
+def recount(root: Node, node: Node, count: int, new: dict[int, int] | None = None, source: int | None = None,
+            own: bool = True) -> None:
     """Set the count of the repeat ``node`` (in the tree under ``root``) to ``count``, in place, keeping every
     exception on its copy as `copies_moved` places the copies (or as ``new`` says, a mapping of the same kind:
     rows of tiles that must stay in step). The tail keeps its exceptions, and the paths of repeats above that run
-    through ``node`` follow their copies."""
+    through ``node`` follow their copies. New copies repeat copy ``source`` where given: the exceptions above that
+    run through it, and its own unless ``own`` is False (a ground floor's new cell is its typical shop, not the
+    source's door)."""
     k = len(node.children)
-    moved = (copies_moved(node, count) if new is None else new).get  # a copy's new index, None when it goes
-    paths = {}  # the repeats above first: their paths run through node's copies as they are now
-    index = PathIndex()
-    for _, above in root.walk():
-        if not above.exceptions or above is node:
-            continue
-        kept = []
-        for o in above.exceptions:
-            steps = list(o.path)
-            for s, target in along_path(above, o, above.exceptions, index):
-                if target is node and s + 1 < len(steps):
-                    c = moved(steps[s + 1] // k)
-                    if c is None:
-                        break
-                    steps[s + 1] = c * k + steps[s + 1] % k
-            else:
-                kept.append(o._replace(path=tuple(steps)))
-        paths[id(above)] = (above, kept)
-    for above, kept in paths.values():
-        above.exceptions = kept
-    node.exceptions = [o._replace(copy=moved(o.copy)) for o in node.exceptions if moved(o.copy) is not None]
+    moved = (copies_moved(node, count, source) if new is None else new).get  # a copy's new index, None: it goes
+    added = sorted(set(range(count)) - {moved(c) for c in range(node.count)}) if source is not None else []
+    redone: dict[int, list[Override]] = {}  # id of an exception above -> what it becomes (none: its copy goes)
+    aboves: dict[int, tuple[Node, list[Override]]] = {}  # the repeats above, and the new copies' exceptions
+    for above, o, s in _through(root, node):  # the repeats above first: their paths run through node as it is now
+        extra = aboves.setdefault(id(above), (above, []))[1]
+        c, item = divmod(o.path[s], k)
+        to = moved(c)
+        redone[id(o)] = [] if to is None else [o._replace(path=(*o.path[:s], to * k + item, *o.path[s + 1 :]))]
+        if c == source:
+            extra += [o._replace(path=(*o.path[:s], a * k + item, *o.path[s + 1 :])) for a in added]
+    for above, extra in aboves.values():
+        above.exceptions = [e for o in above.exceptions for e in redone.get(id(o), [o])] + extra
+    kept = [o._replace(copy=moved(o.copy)) for o in node.exceptions if moved(o.copy) is not None]
+    if own:
+        kept += [o._replace(copy=a) for o in node.exceptions if o.copy == source for a in added]
+    node.exceptions = kept
     node.count = count
 
 

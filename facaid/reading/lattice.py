@@ -9,9 +9,10 @@ Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013), in thre
    leaves uncovered (`facaid.editing.windows.whole_windows`); their rows and columns (`window_bands`: bands of
    centres split where the gap is over half the median window height, width; bands whose extents overlap are one;
    a column needs windows in `COLUMN_SUPPORT` of the floors). Floors: horizontal bands that each hold one row of
-   windows with its companions, cut between two rows where the label map is most wall; the last rows whose bands
-   hold doors or shops are the ground floor. Tiles: the columns within the floors, cut the same way; the side
-   margins; the attic above.
+   windows with its companions, cut between two rows where the label map is most wall, at one offset from their
+   windows where the wall allows (`ALIGN`: floors as high as the windows' pitch); the last rows whose bands hold
+   doors or shops are the ground floor. Tiles: the columns within the floors, cut the same way; the side margins;
+   the attic above.
 2. **The typical floor and bay** (`read_floors`). The typical floor is a real one, the medoid of the floors; the
    typical bay the medoid column; the typical tile is where they cross (`facaid.reading.units`). The typical floor
    is that floor as it is: a row of typical tiles with its own cells' deltas, so that a new floor is a copy of it.
@@ -38,8 +39,10 @@ from facaid.labels import BACKGROUND, FACADE, GLASS, LABEL_ID
 from facaid.reading.units import Delta, Deltas, Unit, exact_tree, medoid, resample
 from facaid.segmentation import Segmentation, flatten, rasterize, region_boxes
 
+ALIGN = 0.05  # a cut between two bands may move to a line this much less wall to sit at the typical offset
 JITTER = 0.08  # a floor or column length off the median by more than this share is its own
 COLUMN_SUPPORT = 0.5  # a column of windows needs windows in this share of the floors
+DOOR = LABEL_ID["door"]
 GROUND_SHARE = 0.05  # a last row of windows whose band is this much door or shop belongs to the ground floor
 
 
@@ -66,14 +69,17 @@ def window_bands(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
     return merged
 
 
-def _cut(profile: np.ndarray, lo: int, hi: int) -> int:
-    """Where to cut between two bands: the line in [lo, hi] whose share of wall (``profile``) is highest, the
-    middle of the widest run of such lines."""
+def _cut(profile: np.ndarray, lo: int, hi: int, near: float | None = None) -> int:
+    """Where to cut between two bands: a line in [lo, hi] whose share of wall (``profile``) is highest, the middle
+    of the widest run of such lines; with ``near``, of the lines within `ALIGN` of that share, the one nearest it."""
     lo, hi = int(max(0, lo)), int(min(len(profile), max(lo, hi)))
     if hi <= lo:
         return lo
     seg = profile[lo : hi + 1] if hi < len(profile) else profile[lo:hi]
     best = seg.max()
+    if near is not None:
+        good = np.flatnonzero(seg >= best - ALIGN)
+        return lo + int(good[np.argmin(np.abs(lo + good - near))])
     good = np.flatnonzero(seg >= best - 1e-9)
     runs = np.split(good, np.flatnonzero(np.diff(good) > 1) + 1)
     run = max(runs, key=len)
@@ -81,10 +87,15 @@ def _cut(profile: np.ndarray, lo: int, hi: int) -> int:
 
 
 def _edges(profile: np.ndarray, starts: np.ndarray, ends: np.ndarray, limit: int) -> list[int]:
-    """The cuts around bands that start at ``starts`` and end at ``ends`` (sorted): one between each two, and an
-    outer one on each side at the typical distance of the inner cuts from their bands."""
+    """The cuts around bands that start at ``starts`` and end at ``ends`` (sorted): one between each two, each as
+    near its band's start less the typical distance of the cuts from their bands as the wall allows (`ALIGN`:
+    floors and tiles cut at one offset from their windows are as long as the windows' pitch), and an outer one on
+    each side at that distance."""
     inner = [_cut(profile, int(e), int(s)) for e, s in zip(ends[:-1], starts[1:], strict=True)]
     before = np.median([s - c for s, c in zip(starts[1:], inner, strict=True)])
+    if ALIGN:
+        inner = [_cut(profile, int(e), int(s), s - before) for e, s in zip(ends[:-1], starts[1:], strict=True)]
+        before = np.median([s - c for s, c in zip(starts[1:], inner, strict=True)])
     after = np.median([c - e for e, c in zip(ends[:-1], inner, strict=True)])
     first = int(np.clip(round(starts[0] - before), 0, starts[0]))
     last = int(np.clip(round(ends[-1] + after), ends[-1], limit))
@@ -315,7 +326,7 @@ def _band(label_map: np.ndarray, xs: list[int], bay: int, tile_w: np.ndarray, ro
     if height < 2:
         return _role(exact_tree(label_map), role)
     cells = [label_map[:, xs[j] : xs[j + 1]] for j in range(len(xs) - 1)]
-    unit = Unit(cells[bay], height, int(tile_w[bay]))
+    unit = Unit(cells[_typical_cell(cells, bay, int(tile_w[bay]))], height, int(tile_w[bay]))
     row = _row(unit, [deltas.of(unit, cell) for cell in cells], tile_w, bay)
     items: list[tuple[Size, Node]] = []
     if xs[0] > 0:
@@ -324,6 +335,15 @@ def _band(label_map: np.ndarray, xs: list[int], bay: int, tile_w: np.ndarray, ro
     if xs[-1] < width:
         items.append((Size("abs", float(width - xs[-1])), exact_tree(label_map[:, xs[-1] :])))
     return Node.split("x", items, role=role) if len(items) > 1 else _role(row, role)
+
+
+def _typical_cell(cells: list[np.ndarray], bay: int, width: int) -> int:
+    """The cell of a band that a new bay repeats: the typical column's, but where it holds a door and others do
+    not, the medoid of those without (a new bay beside the entrance is another shop, not a second door)."""
+    plain = [j for j, cell in enumerate(cells) if not (cell == DOOR).any()]
+    if not plain or len(plain) == len(cells) or bay in plain:
+        return bay
+    return plain[medoid([[resample(cells[j], cells[j].shape[0], width)] for j in plain])]
 
 
 def _merge_paths(deltas: list[Override]) -> list[Override]:

@@ -1,10 +1,11 @@
 """The edit check: an edit of a count judged from the facade before and after, as a person looks at it."""
 
 import numpy as np
-from grammar_helpers import example
+from grammar_helpers import example, tile
 
 from facaid.editing.check import check_edits, insertion, judge, judge_insert, label_map
 from facaid.generator import generate_procedure
+from facaid.grammar.procedure import Node, Override, Procedure, Size
 from facaid.parameters import set_parameter
 
 
@@ -61,3 +62,15 @@ def test_fewer_floors_make_a_lower_facade():
     proc = generate_procedure(5003)
     fewer = set_parameter(proc, "floors", 2)
     assert fewer.height < proc.height - 50
+
+
+def test_a_second_door_is_not_clean():
+    """A new bay whose ground-floor cell is a door (a tree whose typical ground tile is one) adds a door: not clean
+    however alike the band, since the entrance stays one (issue 67's trial)."""
+    row = Node.repeat("x", 4, [(Size("flt", 60), tile())], role="floor")
+    floors = Node.repeat("y", 3, [(Size("flt", 90), row)], role="floors")
+    ground = Node.repeat("x", 4, [(Size("flt", 60), tile(sill=False, window="door"))], role="ground")
+    ground.exceptions = [Override(c, (0, 1, 1), node=Node.leaf("shop")) for c in (0, 1, 3)]
+    proc = Procedure(240, 370, Node.split("y", [(Size("flt", 270), floors), (Size("flt", 100), ground)]))
+    verdict = check_edits(proc, (("bays", 1),))["bays+1"]
+    assert not verdict.clean and verdict.reason == "the doors went from 1 to 2"

@@ -24,11 +24,11 @@ from facaid.grammar.procedure import (
     Size,
     validate,
 )
-from facaid.grammar.repeats import copies_moved, recount
+from facaid.grammar.repeats import copies_moved, most_typical, recount
 from facaid.labels import LABEL_ID
 from facaid.native import rects
 from facaid.parameters import named_parameters, normalised, set_parameter
-from facaid.segmentation import flatten_array_numpy, rasterize
+from facaid.segmentation import flatten_array_numpy, rasterize, region_boxes
 from facaid.tokenizer import Tokenizer
 
 needs_c = pytest.mark.skipif(rects.library() is None, reason="no C compiler to build the rectangles library")
@@ -287,6 +287,24 @@ def test_bays_plus_one_keeps_the_rows_of_tiles_in_step():
     rows = [n for _, n in wider.nodes() if n.rule == "repeat" and n.axis == "x"]
     assert [o.copy for o in rows[0].exceptions] == [4, 5]  # the floors' own tiles after the new one (copy 3)
     assert [o.copy for o in rows[1].exceptions] == [4]  # the door moved with its column, not left under the new one
+
+
+def test_a_new_bay_repeats_a_real_column_on_every_floor():
+    """Where a floor differs in every cell (a lattice reading's floor of balconies, written as deltas of the floors'
+    repeat), a new bay is a copy of the column fewest floors change, on every floor: that floor's new cell has its
+    balcony too, not the typical floor's tile (b0002's and b0006's new columns were the typical tile throughout)."""
+    row = Node.repeat("x", 4, [(Size("flt", 60), tile())], role="floor")
+    floors = Node.repeat("y", 3, [(Size("flt", 90), row)], role="floors")
+    floors.exceptions = [Override(1, (0, j, 1, 2), node=leaf("balcony")) for j in range(4)]
+    floors.exceptions.append(Override(2, (0, 2, 1, 1), node=leaf("blind")))
+    proc = Procedure(240, 270, floors)
+    assert most_typical(proc.root, row) == 3  # column 2 has the blind as well
+    wider = set_parameter(proc, "bays", 5)
+    validate(wider)
+    count = {name: len(region_boxes(flat_rows(wider), (LABEL_ID[name],))) for name in ("balcony", "blind", "window")}
+    assert count == {"balcony": 5, "blind": 1, "window": 14}
+    narrower = set_parameter(proc, "bays", 3)  # a copy fewer takes that column: the blind stays
+    assert len(region_boxes(flat_rows(narrower), (LABEL_ID["blind"],))) == 1
 
 
 def test_a_repeat_whose_copies_all_have_their_own_size_takes_its_share():

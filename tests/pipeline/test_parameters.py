@@ -11,7 +11,9 @@ from facaid.formats.cga import procedure_cga
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.labels import LABEL_ID
 from facaid.parameters import NAMES, named_parameters, normalised, set_parameter, set_parameters
+from facaid.segmentation import rasterize
 
 
 def _values(proc):
@@ -165,10 +167,27 @@ def test_bad_values_name_the_problem():
     flat = Procedure(100, 100, Node.split("y", [(Size("flt", 50), Node.leaf("facade", role="floor")),
                                                 (Size("flt", 50), Node.leaf("facade", role="floor"))]))
     assert _values(flat)["floors"] == 2
-    with pytest.raises(ValueError, match="cannot change here"):
-        set_parameter(flat, "floors", 3)
+    side = Procedure(100, 100, Node.split("x", [(Size("flt", 50), Node.leaf("facade", role="floor")),
+                                                (Size("flt", 50), Node.leaf("facade", role="floor"))]))
+    with pytest.raises(ValueError, match="cannot change here"):  # floors side by side: no storey to repeat
+        set_parameter(side, "floors", 3)
     with pytest.raises(ValueError, match="no 'attic_height'"):
         set_parameter(flat, "attic_height", 3)
+
+
+def test_floors_laid_out_one_by_one_take_one_more():
+    """A house of one floor, or of floors a split lays out one by one (the generator's, when they differ), takes a
+    floor more: the floors become the repeat they are, the typical one repeated, the facade one floor higher."""
+    one = Procedure(100, 150, Node.split("y", [(Size("abs", 50), Node.leaf("background")),
+                                               (Size("flt", 100), Node.leaf("window", role="floor"))]))
+    two = set_parameter(one, "floors", 2)
+    assert _values(two)["floors"] == 2 and two.height == 250
+    flat = Procedure(100, 100, Node.split("y", [(Size("flt", 40), Node.leaf("facade", role="floor")),
+                                                (Size("flt", 60), Node.leaf("window", role="floor"))]))
+    three = set_parameter(flat, "floors", 3)
+    assert _values(three)["floors"] == 3
+    labels = rasterize(to_segmentation(three))[:, 50]
+    assert (labels == LABEL_ID["window"]).sum() == 120 and (labels == LABEL_ID["facade"]).sum() == 40
 
 
 def test_cli_lists_and_sets(tmp_path, capsys):

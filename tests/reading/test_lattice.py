@@ -131,3 +131,17 @@ def test_a_shared_size_changes_every_copy_its_exceptions_too():
     before, after = widths(proc), widths(wider)
     assert len(before) == len(after) > 25
     assert sum(b - a == pytest.approx(4, abs=0.6) for a, b in zip(before, after, strict=True)) >= len(before) - 1
+
+
+@pytest.mark.parametrize("door", range(6))
+def test_a_new_bay_beside_the_entrance_is_a_shop_not_a_second_door(door):
+    """Wherever the door is, even under the typical column, bays + 1 adds a shop to the ground floor (issue 67: a
+    second door was a failure the trial saw), and the edit is clean."""
+    from facaid.editing.check import check_edits
+
+    seg = real_like(door=door)
+    proc = lattice.read_lattice(seg)
+    wider = set_parameter(proc, "bays", 7)
+    doors = region_boxes(flat_rows(wider), (LABEL_ID["door"],))
+    assert len(doors) == 1
+    assert check_edits(proc, (("bays", 1),))["bays+1"].clean

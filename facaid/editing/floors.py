@@ -1,0 +1,68 @@
+"""The floors a floor edit takes: floors a split lays out one by one become the repeat they are
+(`unrepeated_floors`, `as_floors_repeat`), and the copy a floor more repeats and a floor fewer takes is the plainest
+floor the entrance does not reach into (`plain_floor`)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from facaid.grammar.execute import first_boxes, flat_rows
+from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.labels import LABEL_ID
+from facaid.resizing import copy_lengths
+from facaid.segmentation import region_boxes
+
+
+def unrepeated_floors(proc: Procedure, inst) -> tuple[Node, int, int] | None:
+    """Where a facade's upper floors are laid out by a split along y and no repeat (a house of one floor, or of two
+    that differ): (that split, the index of its first floor and of its last + 1); None otherwise. `floors` ± 1
+    makes them a repeat first (`as_floors_repeat`)."""
+    floors = [(p, n) for p, n in proc.nodes() if n.role == "floor" and inst.outer.get(id(n))]
+    if not floors or any(inst.count[id(n)] != 1 or "!" in p for p, n in floors):
+        return None
+    parents = {p.rsplit("/", 1)[0] for p, _ in floors}
+    if len(parents) != 1:
+        return None
+    parent = dict(proc.nodes()).get(parents.pop())
+    if parent is None or parent.rule != "split" or parent.axis != "y":
+        return None
+    at = sorted(int(p.rsplit("/", 1)[1]) for p, _ in floors)
+    if at != list(range(at[0], at[-1] + 1)):
+        return None
+    return parent, at[0], at[-1] + 1
+
+
+def as_floors_repeat(parent: Node, lo: int, hi: int, inst) -> None:
+    """The floors ``parent.children[lo:hi]`` as one repeat (in place): of the floor most of them are (the last of
+    those), the others its exceptions, each at its height."""
+    floors = parent.children[lo:hi]
+    heights = [inst.extent[id(f)][1] for f in floors]
+    trees = [json.dumps(f.to_dict(), sort_keys=True) for f in floors]
+    typical = max(range(len(floors)), key=lambda i: (trees.count(trees[i]), i))
+    row = Node.repeat("y", len(floors), [(Size("flt", round(heights[typical], 4)), floors[typical])])
+    for c, (floor, tree, h) in enumerate(zip(floors, trees, heights, strict=True)):
+        size = Size("flt", round(h, 4)) if abs(h - heights[typical]) > 0.5 else None
+        node = floor if tree != trees[typical] else None
+        if size is not None or node is not None:
+            row.exceptions.append(Override(c, (0,), size, node))
+    total = round(sum(inst.extent[id(c)][1] for c in floors), 4)
+    parent.sizes[lo:hi] = [Size("flt", total)]
+    parent.children[lo:hi] = [row]
+
+
+def plain_floor(proc: Procedure, floors: Node, inst) -> int:
+    """The copy of the floors' repeat that a floor more repeats and a floor fewer takes: of those no door reaches
+    into (the entrance's top can reach into the floor above the ground), the one fewest exceptions change, the
+    last of those."""
+    y0 = first_boxes(proc)[id(floors)][1]
+    edges = y0 + np.concatenate([[0.0], np.cumsum(copy_lengths(floors, inst.extent[id(floors)][1]))])
+    doors = region_boxes(flat_rows(proc), (LABEL_ID["door"],))
+    reached = {c for _, top, _, bottom in doors.tolist() for c in range(floors.count)
+               if top < edges[c + 1] - 1 and bottom > edges[c] + 1}
+    changed = {c: sum(1 for o in floors.exceptions if o.copy == c) for c in range(floors.count)}
+    return min(range(floors.count), key=lambda c: (c in reached, changed[c], -c))
+
+
+__all__ = ["as_floors_repeat", "plain_floor", "unrepeated_floors"]
