@@ -312,6 +312,9 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             raise ValueError(f"{name} cannot change here: no repeat lays out the {role}s (edit the tree instead)")
         own: dict[int, float] = {}
         change = int(value) - int(p.value)
+        if name == "bays" and p.nodes:  # the building whose bays the parameter counts (a wing keeps its own)
+            building = building_of(out, p.nodes[0])
+            repeats = [(pth, n) for pth, n in repeats if f"{pth}/".startswith(building)]
         # rows of tiles of one count stay in step: their new tiles go where the most laid-out row's go
         main_path, main = max(((pth, n) for pth, n in repeats if id(n) in inst.extent),
                               key=lambda pn: inst.count[id(pn[1])], default=(None, None))
@@ -324,9 +327,8 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         aligned: list[tuple[Node, int]] = []
         gap = None
         if main is not None:  # as it is before any row changes; a new bay repeats its most typical column
-            if name == "bays":  # of the building that holds the most laid-out row (a wing keeps its bays)
+            if name == "bays":
                 building = building_of(out, main_path)
-                repeats = [(pth, n) for pth, n in repeats if f"{pth}/".startswith(building)]
                 # a row of as many copies as long under the bays (the ground floor's shops) keeps in step too
                 width = inst.extent[id(main)][0]
                 repeats += [(pth, n) for pth, n in out.nodes() if n.rule == "repeat" and n.axis == "x"

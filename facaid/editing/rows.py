@@ -66,7 +66,7 @@ ALIGNED = 0.1  # a cell of a row written out lines up with a tile when their len
 
 def step_cells(row: Node, offset: int, length: float, main: Node, moved: dict[int, int],
                 source: int | None) -> float:
-    """Put in ``row`` (a split whose children from ``offset`` on line up with ``main``'s, `_aligned_rows`) the cells
+    """Put in ``row`` (a split whose children from ``offset`` on line up with ``main``'s, `aligned_rows`) the cells
     of the tiles ``moved`` adds, or take out those of the tiles it removes, in place; the change of its length. A
     new cell copies the source tile's cell, or the nearest one without a door (the entrance stays one); a removed
     tile's cell with the door leaves the nearest one without instead."""
@@ -95,14 +95,16 @@ def step_cells(row: Node, offset: int, length: float, main: Node, moved: dict[in
                 row.sizes.insert(offset + a * k + j, size)
                 row.children.insert(offset + a * k + j, child.copy())
             change += sum(lengths[span(cell)])
+    taken = []  # the cells to take out, chosen before any goes (their indices are the row's as it is)
     for g in gone:
-        cell = nearest(g)
-        plain.remove(cell)
+        if not plain:
+            break
+        taken.append(nearest(g))
+        plain.remove(taken[-1])
+    for cell in sorted(taken, reverse=True):
         change -= sum(lengths[span(cell)])
         del row.sizes[span(cell)]
         del row.children[span(cell)]
-        if not plain:
-            break
     return change
 
 

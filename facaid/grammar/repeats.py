@@ -179,15 +179,20 @@ def recount(root: Node, node: Node, count: int, new: dict[int, int] | None = Non
         c, item = divmod(o.path[s], k)
         to = moved(c)
         redone[id(o)] = [] if to is None else [o._replace(path=(*o.path[:s], to * k + item, *o.path[s + 1 :]))]
-        if c == source:
-            extra += [o._replace(path=(*o.path[:s], a * k + item, *o.path[s + 1 :])) for a in added]
+        if c == source:  # each new copy its own nodes: one node in two places would edit both
+            extra += [_own(o)._replace(path=(*o.path[:s], a * k + item, *o.path[s + 1 :])) for a in added]
     for above, extra in aboves.values():
         above.exceptions = [e for o in above.exceptions for e in redone.get(id(o), [o])] + extra
     kept = [o._replace(copy=moved(o.copy)) for o in node.exceptions if moved(o.copy) is not None]
     if own:
-        kept += [o._replace(copy=a) for o in node.exceptions if o.copy == source for a in added]
+        kept += [_own(o)._replace(copy=a) for o in node.exceptions if o.copy == source for a in added]
     node.exceptions = kept
     node.count = count
+
+
+def _own(o: Override) -> Override:
+    """The exception with a copy of its node (a new copy's exceptions never share a node with its source's)."""
+    return o if o.node is None else o._replace(node=o.node.copy())
 
 
 def along_path(node: Node, o: Override, exceptions: list[Override],

@@ -12,7 +12,7 @@ from facaid.editing.rows import unmirrored
 from facaid.editing.windows import lattice
 from facaid.generator import generate_procedure
 from facaid.grammar.execute import flat_rows
-from facaid.grammar.procedure import Node, Procedure, Size, validate
+from facaid.grammar.procedure import Node, Override, Procedure, Size, validate
 from facaid.labels import LABEL_ID
 from facaid.parameters import named_parameters, set_parameter
 from facaid.segmentation import region_boxes
@@ -127,3 +127,40 @@ def test_generated_facades_edit_cleanly():
         verdicts = check_edits(proc, MORE)
         both += len(verdicts) == 2 and all(v.clean for v in verdicts.values())
     assert eligible >= 35 and both / eligible >= 0.85
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_wing_takes_the_bays_asked_for(seed):
+    """The named `bays` counts the first wing's tiles; set, that wing has as many (the edit went to the building
+    of the most laid-out row, and the named value did not move on most generated wings)."""
+    proc = generate_procedure(seed, "wings")
+    bays = {p.name: p for p in named_parameters(proc)}["bays"]
+    for value in (bays.value + 1, bays.value + 2, max(1, bays.value - 1)):
+        try:
+            out = set_parameter(proc, "bays", value)
+        except ValueError:
+            continue
+        assert {p.name: p.value for p in named_parameters(out)}["bays"] == value
+
+
+def test_a_new_copy_has_nodes_of_its_own():
+    """A new bay copies its source column's exceptions with nodes of their own: one node in two places of a tree
+    would make an edit of one change both."""
+    row = Node.repeat("x", 4, [(Size("flt", 60), tile())], role="floor")
+    floors = Node.repeat("y", 3, [(Size("flt", 90), row)], role="floors")
+    floors.exceptions = [Override(1, (0, j, 1, 2), node=leaf("balcony")) for j in range(4)]
+    wider = set_parameter(Procedure(240, 270, floors), "bays", 6)
+    nodes = [id(n) for _, node in wider.nodes() for o in node.exceptions if o.node is not None
+             for _, n in o.node.walk()]
+    assert len(nodes) == len(set(nodes))
+
+
+def test_two_bays_fewer_never_take_a_door():
+    """Two bays fewer on a ground floor of shops and three doors take two shops out; the cells to take are chosen
+    before any goes (the second was chosen by indices the first had moved, and a door went)."""
+    proc = shops_under_bays(door=0, bays=7)
+    ground = next(n for _, n in proc.nodes() if n.role == "ground")
+    for j in (2, 4):
+        ground.children[j] = cell("door")
+    narrower = set_parameter(proc, "bays", 5)
+    assert len(boxes(narrower, "door")) == 3 and len(boxes(narrower, "shop")) == 2
