@@ -201,8 +201,10 @@ def judge_wings(old: Procedure, new: Procedure, old_map: np.ndarray, new_map: np
         if axis == "y" and h > 0 and n.shape[1] == o.shape[1] and kept(o, n)[0] >= keep \
                 and (n[:h] == BACKGROUND).mean() >= SKY:
             continue  # sky above a building beside the one that took the floor
-        if axis == "x" and h == 0 and n.shape == o.shape and (n == o).mean() >= keep:
-            continue  # a building beside the one that took the bay
+        if axis == "x" and abs(h) <= EDGE and n.shape[0] == o.shape[0]:
+            w = min(o.shape[1], n.shape[1])  # a building beside the one that took the bay (a pixel's rounding)
+            if (n[:, :w] == o[:, :w]).mean() >= keep:
+                continue
         def strip(rows: np.ndarray, x0: int, x1: int) -> np.ndarray:
             centres = (rows[:, 1] + rows[:, 3]) / 2
             part = rows[(centres >= x0) & (centres < x1)].copy()
