@@ -7,10 +7,13 @@ nobody anything they were not shown before."""
 from __future__ import annotations
 
 import io
+import os
+import re
+import shutil
 import zipfile
 
 import pytest
-from site_helpers import facade_png
+from site_helpers import collect_errors, facade_png, login
 
 from facaid.generator import generate
 from webapp.facades.models import Photo, Procedure, Segmentation
@@ -161,3 +164,29 @@ def test_migration_0009_gives_procedures_their_photos_scale_where_it_discloses_n
             assert got.metres_per_pixel == pytest.approx(metres / width), pk
             assert got.scale_from == f"the photo's real width, {metres:g} m"
     assert Procedure.objects.get(id=no_photo).metres_per_pixel is None
+
+
+@pytest.mark.django_db(transaction=True)
+@pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")
+def test_in_the_browser_a_fork_downloads_at_its_owners_size(scaled, live_server, browser, bob, tmp_path):
+    """Bob, who may not see Alice's photo, forks her procedure from its page and downloads the fork's 3D relief: it
+    is 22 m wide, as hers is, and the fork's page says where that size comes from (screenshot looked at)."""
+    photo, proc = scaled
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    errors = collect_errors(page, [])
+    login(page, live_server.url, "bob", "bob-password-1")
+    page.goto(f"{live_server.url}/procedures/{proc.code}")
+    page.click("form.inline button:has-text('Fork')")
+    page.wait_for_url(re.compile(rf"/procedures/(?!{proc.code})[\w-]+"))
+    assert page.url.rstrip("/").split("/")[-1] != str(proc.code)
+    with page.expect_download() as download:
+        page.click("a.button[href$='/download/mesh.zip']")
+    with zipfile.ZipFile(download.value.path()) as z:
+        obj = z.read("facade.obj").decode()
+    xs = [float(line.split()[1]) for line in obj.splitlines() if line.startswith("v ")]
+    assert max(xs) - min(xs) == pytest.approx(REAL_WIDTH, abs=0.01)
+    assert "the photo's real width, 22 m" in page.content().replace("&#x27;", "'")
+    page.screenshot(path=str(tmp_path / "fork.png"), full_page=True)
+    if os.environ.get("FACAID_SCREENSHOTS"):
+        shutil.copy(tmp_path / "fork.png", os.environ["FACAID_SCREENSHOTS"])
+    assert errors == []
