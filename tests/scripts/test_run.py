@@ -66,8 +66,11 @@ class Run:
                         FACAID_RECOVER_SECONDS="1", FACAID_HEARTBEAT_SECONDS="1", FACAID_JOB_STALE_SECONDS="4",
                         PYTHONUNBUFFERED="1")
         with open(self.out, "wb") as out:
+            # a terminal's Ctrl-C reaches a script whose SIGINT is the default; a test process may have left it
+            # ignored (then inherited: bash cannot trap a signal ignored when it starts, and exited 0 on Ctrl-C)
             self.proc = subprocess.Popen(["bash", "scripts/run"], cwd=ROOT, env=self.env, stdout=out,
-                                         stderr=subprocess.STDOUT, start_new_session=True)
+                                         stderr=subprocess.STDOUT, start_new_session=True,
+                                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
     def terminal(self) -> str:
         return self.out.read_text(errors="replace")
