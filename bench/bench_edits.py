@@ -14,10 +14,7 @@ from __future__ import annotations
 import argparse
 from collections import Counter
 
-from facaid.editing.check import MORE, check_edits
-from facaid.editing.windows import lattice
-from facaid.generator import generate_procedure
-from facaid.grammar.execute import flat_rows
+from facaid.evaluation.editability import generated_edits
 
 
 def main() -> None:
@@ -25,23 +22,13 @@ def main() -> None:
     ap.add_argument("--start", type=int, default=5000)
     ap.add_argument("--count", type=int, default=100)
     args = ap.parse_args()
-    both = eligible = 0
+    eligible, clean, others = generated_edits(range(args.start, args.start + args.count))
+    both, failed = len(clean), sorted(others)
     why: Counter = Counter()
-    failed = []
-    for seed in range(args.start, args.start + args.count):
-        proc = generate_procedure(seed)
-        rows, columns = lattice(flat_rows(proc))
-        if rows < 2 or columns < 2:
-            continue
-        eligible += 1
-        verdicts = check_edits(proc, MORE)
-        if len(verdicts) == 2 and all(v.clean for v in verdicts.values()):
-            both += 1
-            continue
-        failed.append(seed)
-        for name in ("floors", "bays"):
-            v = verdicts.get(f"{name}+1")
-            why[(f"{name} + 1", "no such edit" if v is None else v.reason.split(" (")[0])] += v is None or not v.clean
+    for verdicts in others.values():
+        for key, v in verdicts.items():
+            if v is None or not v.clean:
+                why[(key.replace("+1", " + 1"), "no such edit" if v is None else v.reason.split(" (")[0])] += 1
     print(f"seeds {args.start}-{args.start + args.count - 1}: {eligible} with a lattice of windows; floors + 1 and "
           f"bays + 1 both clean on {both} ({100 * both / max(1, eligible):.1f} %; target 95 %)")
     for (edit, reason), n in why.most_common():

@@ -91,5 +91,28 @@ def editability(proc: Procedure, annotation: tuple[int, int] | None = None) -> d
     return out
 
 
-__all__ = ["KEPT", "PITCH", "describes", "editability", "kept_elements", "lattice", "segmentation_lattice",
+def generated_edits(seeds: range) -> tuple[int, list[int], dict[int, dict]]:
+    """`floors` + 1 and `bays` + 1 on the generated facades of ``seeds`` that have a lattice of windows (two rows
+    and two columns at least, as a CMP facade is eligible), judged by `check_edits`: (how many had one, the seeds
+    where both were clean, and for the others their verdicts by edit, None for an edit they cannot make)."""
+    from facaid.editing.check import MORE
+    from facaid.generator import generate_procedure
+
+    eligible, clean, others = 0, [], {}
+    for seed in seeds:
+        proc = generate_procedure(seed)
+        rows, columns = lattice(flat_rows(proc))
+        if rows < 2 or columns < 2:
+            continue
+        eligible += 1
+        verdicts = check_edits(proc, MORE)
+        if len(verdicts) == 2 and all(v.clean for v in verdicts.values()):
+            clean.append(seed)
+        else:
+            others[seed] = {f"{name}+1": verdicts.get(f"{name}+1") for name in ("floors", "bays")}
+    return eligible, clean, others
+
+
+__all__ = ["KEPT", "PITCH", "describes", "editability", "generated_edits", "kept_elements", "lattice",
+           "segmentation_lattice",
            "window_boxes"]
