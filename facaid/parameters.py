@@ -312,23 +312,21 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
             raise ValueError(f"{name} cannot change here: no repeat lays out the {role}s (edit the tree instead)")
         own: dict[int, float] = {}
         change = int(value) - int(p.value)
-        if name == "bays" and p.nodes:  # the building whose bays the parameter counts (a wing keeps its own)
-            building = building_of(out, p.nodes[0])
-            repeats = [(pth, n) for pth, n in repeats if f"{pth}/".startswith(building)]
+        # the building whose bays the parameter counts (a wing keeps its own)
+        building = building_of(out, p.nodes[0]) if name == "bays" and p.nodes else "root/"
+        repeats = [(pth, n) for pth, n in repeats if f"{pth}/".startswith(building)]
         # rows of tiles of one count stay in step: their new tiles go where the most laid-out row's go
-        main_path, main = max(((pth, n) for pth, n in repeats if id(n) in inst.extent),
-                              key=lambda pn: inst.count[id(pn[1])], default=(None, None))
+        main = max((n for _, n in repeats if id(n) in inst.extent), key=lambda n: inst.count[id(n)], default=None)
         main_node, boxes = main, first_boxes(out)
         source, before = None, False
         if name == "floors" and repeats and id(repeats[0][1]) in inst.extent:  # a floor more repeats, a floor
             # fewer takes, the floor fewest exceptions change of those the door reaches into none of
             source = plain_floor(out, repeats[0][1], inst)
-        ground = {id(n) for p, g in out.nodes() if g.role == "ground" for _, n in g.walk()}
+        ground = {id(n) for _, g in out.nodes() if g.role == "ground" for _, n in g.walk()}
         aligned: list[tuple[Node, int]] = []
         gap = None
         if main is not None:  # as it is before any row changes; a new bay repeats its most typical column
             if name == "bays":
-                building = building_of(out, main_path)
                 # a row of as many copies as long under the bays (the ground floor's shops) keeps in step too
                 width = inst.extent[id(main)][0]
                 repeats += [(pth, n) for pth, n in out.nodes() if n.rule == "repeat" and n.axis == "x"
@@ -340,7 +338,7 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
                 source = most_typical(out.root, main, stepped, doors)
                 # a new bay beside the door's column goes on the side the door does not reach into
                 before = source is not None and source in doors and source + 1 in doors
-                aligned = aligned_rows(out, inst.extent, main, building)
+                aligned = aligned_rows(out, inst.extent, boxes, main, building)
             main = Node("repeat", count=main.count, children=list(main.children), exceptions=list(main.exceptions))
             if name == "bays" and 1 <= main.count + change <= MAX_COUNT and id(main_node) in boxes:
                 step = copies_moved(main, main.count + change, source, before)

@@ -26,11 +26,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from facaid.editing.windows import WIDE, centre_bands, lattice, window_boxes
-from facaid.grammar.execute import first_boxes, flat_rows
+from facaid.grammar.execute import first_boxes, flat_rows, label_map
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID
 from facaid.parameters import named_parameters, set_parameter
-from facaid.segmentation import Segmentation, rasterize, region_boxes
+from facaid.segmentation import region_boxes
 
 KEEP = 0.98  # share of the old pixels a new floor leaves where they were
 KEEP_BAY = 0.93  # the same for a new bay column (the ground floor may re-lay its shops around the door)
@@ -61,12 +61,6 @@ class Verdict:
         return asdict(self)
 
 
-def label_map(proc: Procedure) -> np.ndarray:
-    """The procedure's label map at full resolution, flattened as a person's annotation is."""
-    rows = flat_rows(proc)
-    return rasterize(Segmentation.from_array(round(proc.width), round(proc.height), rows))
-
-
 def kept(old: np.ndarray, new: np.ndarray) -> np.ndarray:
     """For each row y of ``old`` (0 to its height), the share of its pixels left where they were if a band of
     ``new.shape[0] - old.shape[0]`` rows went in at y to make ``new`` (of the same width)."""
@@ -93,17 +87,17 @@ def insertion(old: np.ndarray, new: np.ndarray, keep: float,
         at = int(np.argmax(share))  # at an edge, or too much changed: judged as it is
         return at, float(share[at]), best_copy(new[at : at + h], old)
     spread = near[np.unique(np.linspace(0, len(near) - 1, min(len(near), TRIES)).round().astype(int))]
-    best = (-1.0, 0.0, 0)
+    best, unheld = (-1.0, 0.0, 0), None
     for y in sorted(spread.tolist(), key=lambda y: -share[y]):  # the most kept first; a copy found ends it
         found = (best_copy(new[y : y + h], old), float(share[y]), y)
         if found[0] >= COPY and holds is not None and not holds(y):  # a band between two like bays cut through
-            best = max(best, (COPY - 1e-9, *found[1:]))  # their windows: a copy, but another place may hold one
+            unheld = max(unheld or found[1:], found[1:])  # their windows: a copy, but another place may hold one
             continue
         best = max(best, found)
         if best[0] >= COPY:
             break
-    if best[0] == COPY - 1e-9:
-        best = (COPY, *best[1:])
+    if best[0] < COPY and unheld is not None:  # no place holds one: the copy that cuts through them, at the bar
+        best = (COPY, *unheld)
     return best[2], best[1], best[0]
 
 
@@ -205,12 +199,7 @@ def judge_wings(old: Procedure, new: Procedure, old_map: np.ndarray, new_map: np
             w = min(o.shape[1], n.shape[1])  # a building beside the one that took the bay (a pixel's rounding)
             if (n[:, :w] == o[:, :w]).mean() >= keep:
                 continue
-        def strip(rows: np.ndarray, x0: int, x1: int) -> np.ndarray:
-            centres = (rows[:, 1] + rows[:, 3]) / 2
-            part = rows[(centres >= x0) & (centres < x1)].copy()
-            part[:, [1, 3]] -= x0
-            return part
-        mine, theirs = strip(old_rows, a0, a1), strip(new_rows, b0, b1)
+        mine, theirs = _strip(old_rows, a0, a1), _strip(new_rows, b0, b1)
         edited.append(judge_insert(o, n, lattice(mine, typical=True), lattice(theirs, typical=True),
                                    window_boxes(theirs), axis, keep))
     if not edited:
@@ -218,14 +207,30 @@ def judge_wings(old: Procedure, new: Procedure, old_map: np.ndarray, new_map: np
     return next((v for v in edited if not v.clean), edited[0])
 
 
-def judge(before: Procedure, after: Procedure, name: str, change: int) -> Verdict:
+def _strip(rows: np.ndarray, x0: int, x1: int) -> np.ndarray:
+    """The flattened rows whose centres lie in the columns [x0, x1), moved to start at x0."""
+    centres = (rows[:, 1] + rows[:, 3]) / 2
+    part = rows[(centres >= x0) & (centres < x1)].copy()
+    part[:, [1, 3]] -= x0
+    return part
+
+
+def _pictured(proc: Procedure) -> tuple[np.ndarray, np.ndarray]:
+    """The procedure's flattened rows and its label map, executed once."""
+    rows = flat_rows(proc)
+    return rows, label_map(proc, rows)
+
+
+def judge(before: Procedure, after: Procedure, name: str, change: int,
+          drawn: tuple[np.ndarray, np.ndarray] | None = None) -> Verdict:
     """Whether ``after``, ``before`` with the count ``name`` ("floors" or "bays") changed by ``change`` (+1 or
-    -1), is the clean edit of the module's rule."""
+    -1), is the clean edit of the module's rule. ``drawn``: ``before``'s `_pictured` where it is at hand (the
+    unedited facade, judged against each of its edits)."""
     axis = _AXIS[name]
     keep = KEEP if name == "floors" else KEEP_BAY
     old, new = (before, after) if change > 0 else (after, before)
-    old_rows, new_rows = flat_rows(old), flat_rows(new)
-    old_map, new_map = label_map(old), label_map(new)
+    pictures = (drawn or _pictured(before), _pictured(after))
+    (old_rows, old_map), (new_rows, new_map) = pictures if change > 0 else pictures[::-1]
     out = judge_wings(old, new, old_map, new_map, old_rows, new_rows, axis, keep)
     if out is None:
         out = judge_insert(old_map, new_map, lattice(old_rows, typical=True), lattice(new_rows, typical=True),
@@ -244,7 +249,8 @@ def check_edits(proc: Procedure, edits: tuple[tuple[str, int], ...] = EDITS) -> 
     """`floors` ± 1 and `bays` ± 1 (or those of ``edits``) tried on ``proc`` and judged, keyed "floors+1",
     "floors-1", "bays+1" and "bays-1"; a count the procedure does not have, or cannot change that way, is left out."""
     params = {p.name: p for p in named_parameters(proc)}
-    out = {}
+    out: dict[str, Verdict] = {}
+    drawn = _pictured(proc) if edits else None  # the unedited facade, drawn once for every edit
     for name, change in edits:
         p = params.get(name)
         if p is None or not p.min <= p.value + change <= p.max or p.min == p.max:
@@ -255,7 +261,7 @@ def check_edits(proc: Procedure, edits: tuple[tuple[str, int], ...] = EDITS) -> 
         except ValueError as exc:
             out[key] = Verdict(False, f"{name} {p.value + change:g} cannot be made: {exc}")
             continue
-        out[key] = judge(proc, edited, name, change)
+        out[key] = judge(proc, edited, name, change, drawn)
     return out
 
 

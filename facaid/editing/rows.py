@@ -15,11 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from facaid.grammar.execute import first_boxes, flat_rows
+from facaid.grammar.execute import label_map
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.procedure import Node, Override, Procedure, Size
 from facaid.resizing import repeat_unit
-from facaid.segmentation import Segmentation, rasterize
 
 
 def building_of(proc: Procedure, path: str) -> str:
@@ -34,12 +33,12 @@ def building_of(proc: Procedure, path: str) -> str:
     return "root/"
 
 
-def aligned_rows(proc: Procedure, extent: dict, main: Node, building: str) -> list[tuple[Node, int]]:
+def aligned_rows(proc: Procedure, extent: dict, boxes: dict, main: Node, building: str) -> list[tuple[Node, int]]:
     """The splits along x of the ``building`` some of whose children line up with the copies of the row of tiles
     ``main`` (as many, each as long and where it is, within `ALIGNED`), with the index of the first of those: a
     ground floor written out as a shop under each bay and the door under one. A bay more puts a cell in them where
-    it puts its tile; a bay fewer takes one out."""
-    boxes = first_boxes(proc)
+    it puts its tile; a bay fewer takes one out. ``extent`` and ``boxes``: every node's first instance's size and
+    box."""
     if id(main) not in boxes:  # a row only an exception lays out: none is placed by it
         return []
     length = extent[id(main)][0]
@@ -178,11 +177,11 @@ def unmirrored(proc: Procedure) -> Procedure:
              if _as_repeat(child) is not None]
     if not found:
         return proc
-    before = _label_map(proc)
+    before = label_map(proc)
     for parent, i in found:
         mirror = parent.children[i]
         parent.children[i] = _as_repeat(mirror)
-        after = _label_map(proc)
+        after = label_map(proc)
         if after.shape != before.shape or (after != before).mean() > SAME:
             parent.children[i] = mirror
     return proc
@@ -208,10 +207,6 @@ def _as_repeat(mirror: Node) -> Node | None:
             out.exceptions.append(Override(side.count, (j,), own if size != own else None,
                                            None if same else centre.copy()))
     return out
-
-
-def _label_map(proc: Procedure) -> np.ndarray:
-    return rasterize(Segmentation.from_array(round(proc.width), round(proc.height), flat_rows(proc)))
 
 
 __all__ = ["ALIGNED", "SAME", "aligned_rows", "building_of", "holds_door", "open_wall", "opening", "step_cells",

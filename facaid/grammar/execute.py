@@ -15,7 +15,7 @@ from facaid.grammar.limits import MAX_COUNT
 from facaid.grammar.procedure import MAX_LEAVES, Node, Procedure, ProcedureError
 from facaid.labels import BACKGROUND, LABEL_ID
 from facaid.native.rects import executed_rows
-from facaid.segmentation import Segmentation, flatten_array
+from facaid.segmentation import Segmentation, flatten_array, rasterize
 
 
 @dataclass
@@ -264,6 +264,13 @@ def flat_rows(proc: Procedure) -> np.ndarray:
     Python, which also raises `ProcedureError` for a tree that expands to too much."""
     rows = executed_rows(proc.root, (proc.width, proc.height), MAX_COUNT, MAX_LEAVES)
     return flatten_array(round(proc.width), round(proc.height), leaf_array(proc)) if rows is None else rows
+
+
+def label_map(proc: Procedure, rows: np.ndarray | None = None) -> np.ndarray:
+    """The procedure's label map at full resolution, flattened as a person's annotation is (its `flat_rows`, or
+    ``rows`` where they are at hand)."""
+    rows = flat_rows(proc) if rows is None else rows
+    return rasterize(Segmentation.from_array(round(proc.width), round(proc.height), rows))
 
 
 def to_segmentation(proc: Procedure, leaves: list[tuple[int, float, float, float, float]] | None = None
