@@ -21,6 +21,8 @@ read, both are the one procedure.
 A shortcut for annotations unlike the model's training data: when the decoded structure reproduces less than
 `FAR_OFF` of the pixels before sizing and the induced one at least `FAR_BEHIND` more, only the induced one is
 sized (``result.shortcut``): sizing the decoded structure could not close that gap, and it is the slowest stage.
+The test is made on the greedy candidate, decoded first and alone, so that the samples are not drawn where it
+holds (`_decoded`).
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ import numpy as np
 import torch
 
 from facaid.decoding import Candidate, decode, ranked_candidates
-from facaid.defaults import DEFAULT_K, STRUCTURES
+from facaid.defaults import DEFAULT_K, STRUCTURES, TEMPERATURE
 from facaid.editing.check import MORE, check_edits
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
@@ -78,11 +80,12 @@ class Reconstruction:
     structure: str = "exact"  # what ``procedure`` is: "editable" (floors of tiles: the model's or the lattice's)
     alternative: Procedure | None = None  # the other structure, where there are two
     alternative_accuracy: float | None = None
+    candidates: int = 0  # how many candidates were decoded (the greedy one alone where the input is far off)
 
     def to_dict(self) -> dict[str, Any]:
         out = {"accuracy_decoded": self.accuracy_decoded, "accuracy": self.accuracy, "iou": self.iou,
                "timings": self.timings, "retried": self.retried, "source": self.source, "shortcut": self.shortcut,
-               "denoised": self.denoised, "structure": self.structure}
+               "denoised": self.denoised, "structure": self.structure, "candidates": self.candidates}
         if self.alternative is not None:
             out["alternative_accuracy"] = self.alternative_accuracy
         return out
@@ -130,7 +133,9 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     flat = flatten(seg)
     readable = fit_to_model(flat, tokenizer)
     t1 = time.perf_counter()
-    ranked = ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix, reference=flat)
+    gate = sizing and induce and prefix is None
+    ranked, induced, drawn = _decoded(model, tokenizer, readable, flat, k, seed, prefix, gate)
+    read = induced is not None  # the induced structure, read at most once
     t2 = time.perf_counter()
     decoded = ranked[0].procedure
     before = procedure_accuracy(decoded, flat)
@@ -138,8 +143,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     source = "model"
     if sizing:
         tell(0.5, "sizing")
-        induced, read = None, False  # the induced structure, read at most once
-        if induce and prefix is None and before < FAR_OFF:
+        if gate and before < FAR_OFF and not read:
             induced, read = induce_procedure(flat), True
         induced_before = procedure_accuracy(induced, flat) if induced is not None else None
         if induced_before is not None and induced_before >= before + FAR_BEHIND:
@@ -159,7 +163,7 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
                         fitted, before, source = other, other.accuracy_before, "induced"
         if fitted.accuracy < retry_below and retry_k and source == "model" and not denoised:
             tell(0.75, f"sampling {retry_k} more candidates")
-            retried = True
+            retried, drawn = True, drawn + retry_k
             more = decode(model, tokenizer, readable, k=retry_k, sample=True, greedy=0, seed=seed + 1, prefix=prefix)
             other = _second_chance(ranked[1:] + more, ranked[0], flat)
             if other is not None and other.accuracy > fitted.accuracy:
@@ -181,9 +185,29 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
                                        "accuracy": round(editable.accuracy, 6),
                                        "group": editable.procedure.meta["group"]}
             result = _with_editable(result, editable, structure)
+    result.candidates = drawn
     t4 = time.perf_counter()
     timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, lattice=t4 - t3, total=t4 - t0)
     return result
+
+
+def _decoded(model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation, flat: Segmentation, k: int,
+             seed: int, prefix: list[int] | None, gate: bool) -> tuple[list[Candidate], Procedure | None, int]:
+    """The ranked candidates (`ranked_candidates`), the induced structure where it was read, and how many
+    candidates were decoded. With ``gate`` and K > 1 the greedy candidate is decoded first, alone: where it is
+    `FAR_OFF` and the induced structure `FAR_BEHIND` ahead of it (an annotation unlike the model's training
+    data: a real facade), the samples are not drawn, as only the induced structure is sized then; else the
+    K - 1 samples follow, the same as decoded in one batch with it."""
+    if not gate or k == 1:
+        return ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix, reference=flat), None, k
+    greedy = decode(model, tokenizer, readable, k=1, temperature=TEMPERATURE, seed=seed)[0]
+    greedy_before = procedure_accuracy(greedy.procedure, flat)
+    induced = None
+    if greedy_before < FAR_OFF:
+        induced = induce_procedure(flat)
+        if induced is not None and procedure_accuracy(induced, flat) >= greedy_before + FAR_BEHIND:
+            return ranked_candidates(model, tokenizer, readable, k=1, reference=flat, greedy=greedy), induced, 1
+    return ranked_candidates(model, tokenizer, readable, k=k, seed=seed, reference=flat, greedy=greedy), induced, k
 
 
 def best_reading(flat: Segmentation):

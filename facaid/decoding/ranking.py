@@ -48,15 +48,22 @@ def rank_key(candidate: Candidate) -> tuple[int, float]:
 
 def ranked_candidates(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, k: int = DEFAULT_K, *,
                       temperature: float = TEMPERATURE, seed: int = 0, prefix: list[int] | None = None,
-                      reference: Segmentation | None = None, compose: bool = True) -> list[Candidate]:
+                      reference: Segmentation | None = None, compose: bool = True,
+                      greedy: Candidate | None = None) -> list[Candidate]:
     """The greedy candidate and K-1 samples, executed, scored against ``reference`` (default: ``seg``, what
-    the model read) and ranked by `rank_key`, best first.
+    the model read) and ranked by `rank_key`, best first. ``greedy``: the greedy candidate, decoded already
+    (`decode` with K = 1 at the same temperature, which its log-probability depends on); only the samples are
+    decoded then, the same ones as in one batch with it.
 
     With ``compose`` (and K > 1, no ``prefix``), the first candidate becomes its composition with the others
     (`facaid.composition.compose`: each region's best subtree) when that differs from it; the composition
     carries the log-probability of the candidate it started from and ``swaps`` > 0. The candidates follow."""
-    candidates = decode(model, tokenizer, seg, k=k, sample=k > 1, greedy=1, temperature=temperature, seed=seed,
-                        prefix=prefix)  # one batch, sharing the cross-attention
+    if greedy is None:
+        candidates = decode(model, tokenizer, seg, k=k, sample=k > 1, greedy=1, temperature=temperature, seed=seed,
+                            prefix=prefix)  # one batch, sharing the cross-attention
+    else:  # each sampled row draws its own row of the step's noise, so the samples do not depend on the greedy row
+        candidates = [greedy] + (decode(model, tokenizer, seg, k=k - 1, sample=True, greedy=0, temperature=temperature,
+                                        seed=seed, prefix=prefix) if k > 1 else [])
     if reference is None:
         reference = seg
     target, counts = scaled_label_map(reference, 0.25), element_counts(reference)

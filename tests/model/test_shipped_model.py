@@ -16,6 +16,22 @@ def test_shipped_model_loads_by_default_and_reconstructs():
     assert result.accuracy >= result.accuracy_decoded
     assert result.accuracy > 0.8
     assert not result.shortcut  # a decoded structure near the input is sized, not passed over
+    assert result.candidates == 2  # the greedy candidate was near the input: the sample was drawn too
+
+
+@pytest.mark.skipif(not (DEFAULT_CHECKPOINT / "model.safetensors").is_file(), reason="no shipped checkpoint")
+def test_the_samples_drawn_after_the_greedy_candidate_are_the_batchs():
+    from facaid.decoding import decode, ranked_candidates
+    from facaid.defaults import TEMPERATURE
+
+    model, tokenizer = default_model()
+    for seed in (300, 308, 311):  # seeds whose ranking a greedy log-probability at another temperature changed
+        seg = generate(seed).segmentation
+        batch = ranked_candidates(model, tokenizer, seg, k=6, seed=seed)
+        greedy = decode(model, tokenizer, seg, k=1, temperature=TEMPERATURE, seed=seed)[0]
+        split = ranked_candidates(model, tokenizer, seg, k=6, seed=seed, greedy=greedy)
+        assert [c.ids for c in split] == [c.ids for c in batch]
+        assert [c.logprob for c in split] == pytest.approx([c.logprob for c in batch], abs=1e-4)
 
 
 @pytest.mark.skipif(not (DEFAULT_CHECKPOINT / "model.safetensors").is_file(), reason="no shipped checkpoint")
@@ -25,9 +41,10 @@ def test_a_real_annotation_takes_the_shortcut_to_the_induced_structure(cmp_recor
     from facaid.segmentation import Segmentation, flatten
 
     seg = Segmentation.from_dict(cmp_records[0], clip=True)
-    result = reconstruct(seg, k=2, structure="exact")
+    result = reconstruct(seg, k=4, structure="exact")
     assert result.shortcut and result.source == "induced" and result.structure == "exact"
-    editable = reconstruct(seg, k=2)  # by default: the lattice reading, the exact one beside it
+    assert result.candidates == 1  # the greedy candidate was far off: no samples were drawn
+    editable = reconstruct(seg, k=4)  # by default: the lattice reading, the exact one beside it
     assert (editable.structure, editable.source) == ("editable", "lattice")
     assert editable.alternative_accuracy == result.accuracy and editable.alternative.to_json() == \
         result.procedure.to_json()

@@ -188,3 +188,17 @@ def test_box_integrals_equal_torchs_autograd_of_the_lookups():
     (got * weights).sum().backward()
     (want * weights).sum().backward()
     torch.testing.assert_close(a.grad, b.grad, rtol=0, atol=1e-9)
+
+
+def test_the_tables_of_a_label_map_are_made_once_for_its_sizings():
+    from facaid.sizing import cached_integrals
+
+    label_map = np.zeros((40, 30), dtype=np.int64)
+    label_map[5:15, 4:20] = 2
+    first = cached_integrals(label_map, [0, 2], 1.0)
+    assert cached_integrals(label_map.copy(), [0, 2], 1.0) is first  # the same pixels: the same tables
+    assert torch.equal(first, smoothed_integrals(label_map, [0, 2], 1.0))
+    other = label_map.copy()
+    other[20, 20] = 2
+    assert cached_integrals(other, [0, 2], 1.0) is not first
+    assert cached_integrals(label_map, [0, 2], 0.0) is not first  # another edge width
