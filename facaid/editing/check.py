@@ -11,7 +11,7 @@ floor is a blend of three floors or sits under the shops; looking at the picture
 2. the inserted band is a copy of a band of the old facade: at least `COPY` of its pixels equal those of the most
    alike band of its size;
 3. it holds windows, and the rows (columns) of windows grow by as many as it holds (one; two where a bay is a
-   pair of windows, or a floor has a mezzanine) while the columns (rows) stay as they were; a shop window several
+   pair of windows, or a floor has a mezzanine; counted as most of its shifts count them, `band_holds`) while the columns (rows) stay as they were; a shop window several
    bays wide is in no column (`facaid.editing.windows.WIDE`);
 4. the doors stay as many as they were: a new bay beside the entrance is another shop, not a second door.
 
@@ -39,6 +39,7 @@ EDGE = 2  # a band put in within this many pixels of the image's edge is stuck o
 NEAR = 0.01  # rows that keep this much less than the most kept are as good a place for the band
 TRIES = 8  # of those, this many (evenly spaced) are tried for the band's likeness
 SAMPLE = (2, 4)  # the band's rows and columns compared in the copy search: every 2nd row, every 4th column
+SHIFTS = 8  # the shifts of a new band whose counts of window rows (columns) it holds are compared
 DOOR = LABEL_ID["door"]
 BACKGROUND = LABEL_ID["background"]
 SKY = 0.9  # share of the band above a building beside the one that took a floor that must be sky
@@ -128,6 +129,16 @@ def band_lattice(windows: np.ndarray, at: int, h: int, axis: str) -> int:
     return centre_bands(centres[inside], sizes[inside])
 
 
+def band_holds(windows: np.ndarray, at: int, h: int, axis: str) -> int:
+    """How many rows (columns) of windows a band of ``h`` put in at ``at`` holds: the count most of its shifts by
+    up to half its height either way give (`band_lattice`; the fewer of two as common). A band between two like
+    floors may go in from the middle of one row of windows to the middle of the next, and then the count of the
+    band as it lies depends on a pixel's rounding: one row, or the two it runs between."""
+    counts = [band_lattice(windows, at + s, h, axis) for s in np.linspace(-h / 2, h / 2, SHIFTS + 1)[:-1]]
+    values, times = np.unique(counts, return_counts=True)
+    return int(values[np.argmax(times)])
+
+
 def judge_insert(old: np.ndarray, new: np.ndarray, old_lattice: tuple[int, int], new_lattice: tuple[int, int],
                  new_windows: np.ndarray, axis: str, keep: float) -> Verdict:
     """Whether ``new`` is ``old`` with one band inserted along ``axis`` ("y": a floor, "x": a bay) by the module's
@@ -151,7 +162,7 @@ def judge_insert(old: np.ndarray, new: np.ndarray, old_lattice: tuple[int, int],
     if copy < COPY:
         return Verdict(False, f"the new {word} is like no {word} of the facade (at best {100 * copy:.0f} % alike, "
                               f"{100 * COPY:.0f} % needed)", **figures)
-    held = band_lattice(new_windows, at, h, axis)
+    held = band_holds(new_windows, at, h, axis)
     if not held:
         return Verdict(False, f"the new {word} holds no windows", **figures)
     if new_lattice[grows] != old_lattice[grows] + held or new_lattice[stays] != old_lattice[stays]:
@@ -265,5 +276,5 @@ def check_edits(proc: Procedure, edits: tuple[tuple[str, int], ...] = EDITS) -> 
     return out
 
 
-__all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "MORE", "Verdict", "best_copy", "check_edits", "insertion", "judge",
+__all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "MORE", "Verdict", "band_holds", "best_copy", "check_edits", "insertion", "judge",
            "judge_insert", "kept", "label_map"]

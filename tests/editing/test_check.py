@@ -3,7 +3,7 @@
 import numpy as np
 from grammar_helpers import example, tile
 
-from facaid.editing.check import check_edits, insertion, judge, judge_insert, label_map
+from facaid.editing.check import band_holds, band_lattice, check_edits, insertion, judge, judge_insert, label_map
 from facaid.generator import generate_procedure
 from facaid.grammar.procedure import Node, Override, Procedure, Size
 from facaid.parameters import set_parameter
@@ -28,6 +28,18 @@ def test_a_floor_put_in_between_two_is_clean():
     windows = np.array([[10, 15 + 20 * i, 20, 25 + 20 * i] for i in range(5)] +
                        [[40, 15 + 20 * i, 50, 25 + 20 * i] for i in range(5)])
     assert judge_insert(old, new, (4, 2), (5, 2), windows, "y", 0.98).clean
+
+
+def test_a_floor_put_in_from_the_middle_of_one_row_of_windows_to_the_next_holds_one_row():
+    # rows of windows 10 px high at a pitch of 20 px, drawn a pixel off as a reading is: the band put in runs from
+    # the middle of one row to the middle of the next, and as it lies it takes in both rows' centres
+    rows = [15, 35, 55.5, 75, 95]
+    windows = np.array([[x, c - 5, x + 10, c + 5] for c in rows for x in (10, 40)], dtype=float)
+    assert band_lattice(windows, 35, 21, "y") == 2  # the centres at 35 and 55.5
+    assert band_holds(windows, 35, 21, "y") == 1
+    pairs = np.array([[x, c - 3, x + 10, c + 3] for f in range(5) for c in (20 * f + 12, 20 * f + 20)
+                      for x in (10, 40)], dtype=float)  # a floor with a mezzanine: two rows of windows a floor
+    assert band_holds(pairs, 30, 20, "y") == 2
 
 
 def test_a_band_stuck_on_at_the_edge_or_unlike_any_floor_is_not():
