@@ -320,8 +320,8 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         main_node, boxes = main, first_boxes(out)
         source, before = None, False
         if name == "floors" and repeats and id(repeats[0][1]) in inst.extent:  # a floor more repeats, a floor
-            # fewer takes, the floor fewest exceptions change of those the door reaches into none of
-            source = plain_floor(out, repeats[0][1], inst)
+            # fewer takes, of the floors the door reaches into none of (`plain_floor`)
+            source = plain_floor(out, repeats[0][1], inst, fewer=change < 0)
         ground = {id(n) for _, g in out.nodes() if g.role == "ground" for _, n in g.walk()}
         aligned: list[tuple[Node, int]] = []
         gap = None

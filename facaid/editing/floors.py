@@ -1,6 +1,6 @@
 """The floors a floor edit takes: floors a split lays out one by one become the repeat they are
-(`unrepeated_floors`, `as_floors_repeat`), and the copy a floor more repeats and a floor fewer takes is the plainest
-floor the entrance does not reach into (`plain_floor`)."""
+(`unrepeated_floors`, `as_floors_repeat`); the copy a floor more repeats is the plainest floor the entrance does not
+reach into, and the one a floor fewer takes the floor another floor repeats most closely (`plain_floor`)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,9 @@ import json
 
 import numpy as np
 
-from facaid.grammar.execute import first_boxes, flat_rows
+from facaid.grammar.execute import first_boxes, flat_rows, label_map
 from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.grammar.repeats import copies_moved
 from facaid.labels import LABEL_ID
 from facaid.resizing import copy_lengths
 from facaid.segmentation import region_boxes
@@ -52,17 +53,42 @@ def as_floors_repeat(parent: Node, lo: int, hi: int, inst) -> None:
     parent.children[lo:hi] = [row]
 
 
-def plain_floor(proc: Procedure, floors: Node, inst) -> int:
-    """The copy of the floors' repeat that a floor more repeats and a floor fewer takes: of those no door reaches
-    into (the entrance's top can reach into the floor above the ground), the one fewest exceptions change, the
-    last of those."""
+def plain_floor(proc: Procedure, floors: Node, inst, fewer: bool = False) -> int:
+    """The copy of the floors' repeat that a floor more repeats, or with ``fewer`` a floor fewer takes: of those no
+    door reaches into (the entrance's top can reach into the floor above the ground), the one fewest exceptions
+    change, the last of those; a floor fewer first the copy another copy repeats most closely (`twins`), so that
+    what is taken out is a floor the facade keeps (of two floors with a long balcony and two without, the repeat's
+    typical copy may be one of the first two, which differ by their windows)."""
     y0 = first_boxes(proc)[id(floors)][1]
     edges = y0 + np.concatenate([[0.0], np.cumsum(copy_lengths(floors, inst.extent[id(floors)][1]))])
-    doors = region_boxes(flat_rows(proc), (LABEL_ID["door"],))
+    rows = flat_rows(proc)
+    doors = region_boxes(rows, (LABEL_ID["door"],))
     reached = {c for _, top, _, bottom in doors.tolist() for c in range(floors.count)
                if top < edges[c + 1] - 1 and bottom > edges[c] + 1}
     changed = {c: sum(1 for o in floors.exceptions if o.copy == c) for c in range(floors.count)}
-    return min(range(floors.count), key=lambda c: (c in reached, changed[c], -c))
+    twin = twins(label_map(proc, rows), edges) if fewer else [0.0] * floors.count
+    # a copy that alone lays the floor's own pattern out cannot go (`copies_moved` keeps it): its twin goes instead
+    kept = {c for c in range(floors.count) if fewer and c in copies_moved(floors, floors.count - 1, c)}
+    return min(range(floors.count), key=lambda c: (c in reached, c in kept, -round(twin[c], 2), changed[c], -c))
 
 
-__all__ = ["as_floors_repeat", "plain_floor", "unrepeated_floors"]
+def twins(picture: np.ndarray, edges: np.ndarray, step: tuple[int, int] = (2, 4)) -> list[float]:
+    """For each band [edges[c], edges[c + 1]) of a label map, how closely another band repeats it: the share of
+    pixels (sampled every ``step`` rows and columns) equal to those of the most alike other band, over the lower
+    one's height from the top, times the ratio of their heights."""
+    sy, sx = step
+    bands = [picture[int(round(a)) : int(round(b)), ::sx] for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    out = []
+    for c, band in enumerate(bands):
+        best = 0.0
+        for d, other in enumerate(bands):
+            h = min(len(band), len(other))
+            if d == c or h == 0:
+                continue
+            alike = float((band[:h:sy] == other[:h:sy]).mean()) * h / max(len(band), len(other))
+            best = max(best, alike)
+        out.append(best)
+    return out
+
+
+__all__ = ["as_floors_repeat", "plain_floor", "twins", "unrepeated_floors"]

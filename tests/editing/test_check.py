@@ -86,3 +86,26 @@ def test_a_second_door_is_not_clean():
     proc = Procedure(240, 370, Node.split("y", [(Size("flt", 270), floors), (Size("flt", 100), ground)]))
     verdict = check_edits(proc, (("bays", 1),))["bays+1"]
     assert not verdict.clean and verdict.reason == "the doors went from 1 to 2"
+
+
+def test_a_floor_fewer_takes_a_floor_the_facade_keeps_a_twin_of():
+    from grammar_helpers import facade
+
+    from facaid.editing.floors import twins
+    from facaid.grammar.procedure import Node, Size
+
+    def row(window: str) -> Node:
+        return Node.repeat("x", 5, [(Size("flt", 60), tile(window=window))], role="floor")
+
+    # the repeat's own floor once (copy 0), two floors of closed blinds, and one of balconies: the plain floor is
+    # the one fewest exceptions change, but no floor left is like it; a floor of blinds has its twin
+    proc = facade([Override(1, (0,), node=row("blind")), Override(2, (0,), node=row("blind")),
+                   Override(3, (0,), node=row("balcony"))])
+    edges = np.array([40.0, 130.0, 220.0, 310.0, 400.0])
+    alike = twins(label_map(proc), edges)
+    assert alike[1] == alike[2] == 1.0 and max(alike[0], alike[3]) < 0.9
+    fewer = set_parameter(proc, "floors", 3)
+    floors = fewer.root.children[1]
+    assert [o.copy for o in floors.exceptions] == [1, 2]  # a floor of blinds went; the plain one stayed
+    verdict = check_edits(proc)["floors-1"]
+    assert verdict.clean, verdict
