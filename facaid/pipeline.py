@@ -49,7 +49,7 @@ from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
 from facaid.reading.lattice import readings
 from facaid.segmentation import Segmentation, flatten, flatten_array, rasterize
-from facaid.sizing import fit_sizes
+from facaid.sizing import fit_sizes, forget_tables
 from facaid.tokenizer import Tokenizer
 
 # When the best decoded structure reproduces less than FAR_OFF of the pixels before sizing, the induced structure
@@ -129,13 +129,12 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
     tell = progress or (lambda fraction, stage: None)
     timings = {}
     t0 = time.perf_counter()
-    tell(0.0, f"decoding {k} candidate{'s' if k > 1 else ''}")
+    tell(0.0, f"decoding {'up to ' if k > 1 else ''}{k} candidate{'s' if k > 1 else ''}")
     flat = flatten(seg)
     readable = fit_to_model(flat, tokenizer)
     t1 = time.perf_counter()
     gate = sizing and induce and prefix is None
-    ranked, induced, drawn = _decoded(model, tokenizer, readable, flat, k, seed, prefix, gate)
-    read = induced is not None  # the induced structure, read at most once
+    ranked, induced, read, drawn = _decoded(model, tokenizer, readable, flat, k, seed, prefix, gate)
     t2 = time.perf_counter()
     decoded = ranked[0].procedure
     before = procedure_accuracy(decoded, flat)
@@ -186,28 +185,32 @@ def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None 
                                        "group": editable.procedure.meta["group"]}
             result = _with_editable(result, editable, structure)
     result.candidates = drawn
+    forget_tables()  # the tables its sizings shared
     t4 = time.perf_counter()
     timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, lattice=t4 - t3, total=t4 - t0)
     return result
 
 
 def _decoded(model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation, flat: Segmentation, k: int,
-             seed: int, prefix: list[int] | None, gate: bool) -> tuple[list[Candidate], Procedure | None, int]:
-    """The ranked candidates (`ranked_candidates`), the induced structure where it was read, and how many
-    candidates were decoded. With ``gate`` and K > 1 the greedy candidate is decoded first, alone: where it is
+             seed: int, prefix: list[int] | None,
+             gate: bool) -> tuple[list[Candidate], Procedure | None, bool, int]:
+    """The ranked candidates (`ranked_candidates`), the induced structure and whether it was read (it is read at
+    most once a reconstruction), and how many candidates were decoded. With ``gate`` and K > 1 the greedy candidate is decoded first, alone: where it is
     `FAR_OFF` and the induced structure `FAR_BEHIND` ahead of it (an annotation unlike the model's training
     data: a real facade), the samples are not drawn, as only the induced structure is sized then; else the
     K - 1 samples follow, the same as decoded in one batch with it."""
     if not gate or k == 1:
-        return ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix, reference=flat), None, k
+        return (ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix, reference=flat), None,
+                False, k)
     greedy = decode(model, tokenizer, readable, k=1, temperature=TEMPERATURE, seed=seed)[0]
     greedy_before = procedure_accuracy(greedy.procedure, flat)
-    induced = None
+    induced, read = None, False
     if greedy_before < FAR_OFF:
-        induced = induce_procedure(flat)
+        induced, read = induce_procedure(flat), True
         if induced is not None and procedure_accuracy(induced, flat) >= greedy_before + FAR_BEHIND:
-            return ranked_candidates(model, tokenizer, readable, k=1, reference=flat, greedy=greedy), induced, 1
-    return ranked_candidates(model, tokenizer, readable, k=k, seed=seed, reference=flat, greedy=greedy), induced, k
+            return ranked_candidates(model, tokenizer, readable, k=1, reference=flat, greedy=greedy), induced, True, 1
+    return (ranked_candidates(model, tokenizer, readable, k=k, seed=seed, reference=flat, greedy=greedy), induced,
+            read, k)
 
 
 def best_reading(flat: Segmentation):

@@ -91,7 +91,9 @@ def smoothed_integrals(label_map: np.ndarray, classes: list[int], tau: float) ->
 
 
 def cached_integrals(label_map: np.ndarray, classes: list[int], tau: float) -> torch.Tensor:
-    """`smoothed_integrals`, kept for the last `_TABLES_KEPT` (label map, classes, edge width) asked for."""
+    """`smoothed_integrals`, kept for the last `_TABLES_KEPT` (label map, classes, edge width) asked for: the same
+    tensor is handed out again, to be read only. Keyed by the map's bytes, so a map changed in place is a new key.
+    The worker runs one job a process at a time; threads sharing the cache would need a lock."""
     digest = hashlib.blake2b(np.ascontiguousarray(label_map).view(np.uint8), digest_size=16).digest()
     key = (digest, label_map.shape, str(label_map.dtype), tuple(classes), float(tau))
     if key in _TABLES:
@@ -102,6 +104,11 @@ def cached_integrals(label_map: np.ndarray, classes: list[int], tau: float) -> t
     while len(_TABLES) > _TABLES_KEPT:
         _TABLES.popitem(last=False)
     return tables
+
+
+def forget_tables() -> None:
+    """Let the kept tables go (`facaid.reconstruct` does at its end: up to 200 MB, not to be held between jobs)."""
+    _TABLES.clear()
 
 
 def box_integrals(tables: torch.Tensor, index: torch.Tensor, boxes: torch.Tensor) -> torch.Tensor:

@@ -130,8 +130,9 @@ def band_lattice(windows: np.ndarray, at: int, h: int, axis: str) -> int:
 
 
 def band_holds(windows: np.ndarray, at: int, h: int, axis: str) -> int:
-    """How many rows (columns) of windows a band of ``h`` put in at ``at`` holds: the count most of its shifts by
-    up to half its height either way give (`band_lattice`; the fewer of two as common). A band between two like
+    """How many rows (columns) of windows a band of ``h`` put in at ``at`` holds: the count most of `SHIFTS` shifts
+    of it give, evenly spaced over one band's length from half of it up (`band_lattice`; the fewer of two as common:
+    a shift by a whole band is the same band in a repeating facade). A band between two like
     floors may go in from the middle of one row of windows to the middle of the next, and then the count of the
     band as it lies depends on a pixel's rounding: one row, or the two it runs between."""
     counts = [band_lattice(windows, at + s, h, axis) for s in np.linspace(-h / 2, h / 2, SHIFTS + 1)[:-1]]

@@ -8,12 +8,17 @@ import json
 
 import numpy as np
 
-from facaid.grammar.execute import first_boxes, flat_rows, label_map
+from facaid.grammar.execute import first_boxes, flat_rows
 from facaid.grammar.procedure import Node, Override, Procedure, Size
 from facaid.grammar.repeats import copies_moved
 from facaid.labels import LABEL_ID
+from facaid.metrics import scaled_procedure_map
 from facaid.resizing import copy_lengths
 from facaid.segmentation import region_boxes
+
+TWIN = 0.9  # a floor another repeats this closely is as good to take out as any other such (the judge's likeness)
+PICTURE = 512  # the longer side of the picture floors are compared in
+TWINS_AT_MOST = 64  # floors compared two by two at most (past it, a floor fewer takes the plainest)
 
 
 def unrepeated_floors(proc: Procedure, inst) -> tuple[Node, int, int] | None:
@@ -56,28 +61,32 @@ def as_floors_repeat(parent: Node, lo: int, hi: int, inst) -> None:
 def plain_floor(proc: Procedure, floors: Node, inst, fewer: bool = False) -> int:
     """The copy of the floors' repeat that a floor more repeats, or with ``fewer`` a floor fewer takes: of those no
     door reaches into (the entrance's top can reach into the floor above the ground), the one fewest exceptions
-    change, the last of those; a floor fewer first the copy another copy repeats most closely (`twins`), so that
-    what is taken out is a floor the facade keeps (of two floors with a long balcony and two without, the repeat's
-    typical copy may be one of the first two, which differ by their windows)."""
-    y0 = first_boxes(proc)[id(floors)][1]
+    change, the last of those; a floor fewer first a copy another copy repeats (`twins` at least `TWIN`, else the
+    most alike), so that what is taken out is a floor the facade keeps (of two floors with a long balcony and two
+    without, the repeat's typical copy may be one of the first two, which differ by their windows)."""
+    x0, y0, x1, _ = first_boxes(proc)[id(floors)]
     edges = y0 + np.concatenate([[0.0], np.cumsum(copy_lengths(floors, inst.extent[id(floors)][1]))])
-    rows = flat_rows(proc)
-    doors = region_boxes(rows, (LABEL_ID["door"],))
+    doors = region_boxes(flat_rows(proc), (LABEL_ID["door"],))
     reached = {c for _, top, _, bottom in doors.tolist() for c in range(floors.count)
                if top < edges[c + 1] - 1 and bottom > edges[c] + 1}
     changed = {c: sum(1 for o in floors.exceptions if o.copy == c) for c in range(floors.count)}
-    twin = twins(label_map(proc, rows), edges) if fewer else [0.0] * floors.count
-    # a copy that alone lays the floor's own pattern out cannot go (`copies_moved` keeps it): its twin goes instead
-    kept = {c for c in range(floors.count) if fewer and c in copies_moved(floors, floors.count - 1, c)}
-    return min(range(floors.count), key=lambda c: (c in reached, c in kept, -round(twin[c], 2), changed[c], -c))
+    twin = [0.0] * floors.count
+    kept: set[int] = set()
+    if fewer and floors.count <= TWINS_AT_MOST:
+        scale = min(1.0, PICTURE / max(proc.width, proc.height))  # a small picture: a tree may be 100,000 px
+        picture = scaled_procedure_map(proc, scale)[:, int(x0 * scale) : max(int(x0 * scale) + 1, int(x1 * scale))]
+        twin = twins(picture, edges * scale)
+        # a copy that alone lays the floor's own pattern out cannot go (`copies_moved` keeps it): its twin goes
+        kept = {c for c in range(floors.count) if c in copies_moved(floors, floors.count - 1, c)}
+    return min(range(floors.count), key=lambda c: (c in reached, c in kept, twin[c] < TWIN,
+                                                   0.0 if twin[c] >= TWIN else -twin[c], changed[c], -c))
 
 
-def twins(picture: np.ndarray, edges: np.ndarray, step: tuple[int, int] = (2, 4)) -> list[float]:
+def twins(picture: np.ndarray, edges: np.ndarray) -> list[float]:
     """For each band [edges[c], edges[c + 1]) of a label map, how closely another band repeats it: the share of
-    pixels (sampled every ``step`` rows and columns) equal to those of the most alike other band, over the lower
-    one's height from the top, times the ratio of their heights."""
-    sy, sx = step
-    bands = [picture[int(round(a)) : int(round(b)), ::sx] for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    pixels equal to those of the most alike other band, over the lower one's height from the top, times the ratio
+    of their heights."""
+    bands = [picture[int(round(a)) : int(round(b))] for a, b in zip(edges[:-1], edges[1:], strict=True)]
     out = []
     for c, band in enumerate(bands):
         best = 0.0
@@ -85,8 +94,7 @@ def twins(picture: np.ndarray, edges: np.ndarray, step: tuple[int, int] = (2, 4)
             h = min(len(band), len(other))
             if d == c or h == 0:
                 continue
-            alike = float((band[:h:sy] == other[:h:sy]).mean()) * h / max(len(band), len(other))
-            best = max(best, alike)
+            best = max(best, float((band[:h] == other[:h]).mean()) * h / max(len(band), len(other)))
         out.append(best)
     return out
 

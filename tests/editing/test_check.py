@@ -109,3 +109,28 @@ def test_a_floor_fewer_takes_a_floor_the_facade_keeps_a_twin_of():
     assert [o.copy for o in floors.exceptions] == [1, 2]  # a floor of blinds went; the plain one stayed
     verdict = check_edits(proc)["floors-1"]
     assert verdict.clean, verdict
+
+
+def test_a_floor_fewer_leaves_the_copy_that_alone_lays_out_the_floors_pattern():
+    from grammar_helpers import facade
+
+    from facaid.editing.floors import plain_floor
+    from facaid.grammar.procedure import Node, Size
+    from facaid.parameters import _floor_repeats, _Instances, normalised
+
+    def row(window: str) -> Node:
+        out = Node.repeat("x", 5, [(Size("flt", 60), tile(window=window))], role="floor")
+        out.exceptions = [Override(2, (0,), size=Size("flt", 90))]
+        return out
+
+    # the pattern's row has an exception of its own (its middle bay wider), so a copy must keep laying it out:
+    # copy 3 alone does; copy 2 is drawn alike by a node of its own, copies 0 and 1 are floors of blinds
+    proc = facade([Override(0, (0,), node=row("blind")), Override(1, (0,), node=row("blind")),
+                   Override(2, (0,), node=row("window"))], bays=[Override(2, (0,), size=Size("flt", 90))])
+    out = normalised(proc)
+    inst = _Instances(out)
+    floors = _floor_repeats(out, inst, "floor", "y")[0][1]
+    assert plain_floor(out, floors, inst) == 3  # a floor more repeats the pattern's own copy
+    assert plain_floor(out, floors, inst, fewer=True) == 2  # a floor fewer takes its twin
+    verdict = check_edits(proc)["floors-1"]
+    assert verdict.clean, verdict

@@ -44,6 +44,8 @@ def test_a_real_annotation_takes_the_shortcut_to_the_induced_structure(cmp_recor
     result = reconstruct(seg, k=4, structure="exact")
     assert result.shortcut and result.source == "induced" and result.structure == "exact"
     assert result.candidates == 1  # the greedy candidate was far off: no samples were drawn
+    from facaid.sizing import _TABLES
+    assert not _TABLES  # the tables its sizings shared are let go
     editable = reconstruct(seg, k=4)  # by default: the lattice reading, the exact one beside it
     assert (editable.structure, editable.source) == ("editable", "lattice")
     assert editable.alternative_accuracy == result.accuracy and editable.alternative.to_json() == \
