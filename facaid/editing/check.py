@@ -13,7 +13,8 @@ floor is a blend of three floors or sits under the shops; looking at the picture
 3. it holds windows, and the rows (columns) of windows grow by as many as it holds (one; two where a bay is a
    pair of windows, or a floor has a mezzanine; counted as most of its shifts count them, `band_holds`) while the columns (rows) stay as they were; a shop window several
    bays wide is in no column (`facaid.editing.windows.WIDE`);
-4. the doors stay as many as they were: a new bay beside the entrance is another shop, not a second door.
+4. the doors stay as many as they were: a new bay beside the entrance is another shop, not a second door; but
+   where every bay has a door of its own (a row of entrances), a new bay brings one more.
 
 A removal (− 1) is judged as the insertion that would undo it: the old facade is the new one with a band put in.
 """
@@ -248,13 +249,24 @@ def judge(before: Procedure, after: Procedure, name: str, change: int,
         out = judge_insert(old_map, new_map, lattice(old_rows, typical=True), lattice(new_rows, typical=True),
                            window_boxes(new_rows), axis, keep)
     doors = [len(region_boxes(rows, (DOOR,))) for rows in (old_rows, new_rows)]
-    if out.clean and doors[0] != doors[1]:  # the entrance stays: a new bay beside it is a shop, not a door
+    if out.clean and doors[0] != doors[1] and not _door_a_bay(old, name, doors):
+        # the entrance stays: a new bay beside it is a shop, not a door
         return Verdict(False, f"the doors went from {doors[change < 0]} to {doors[change > 0]}", out.unchanged,
                        out.copy, out.at)
     if change < 0 and out.clean:
         return Verdict(True, f"one {'floor' if name == 'floors' else 'bay'} like the others taken out",
                        out.unchanged, out.copy, out.at)
     return out
+
+
+def _door_a_bay(old: Procedure, name: str, doors: list[int]) -> bool:
+    """Whether a bay more of ``old`` (the facade with fewer bays) may bring a door more: where every bay of it
+    has a door of its own (doors at least as many as bays: a row of houses' or shops' entrances), the new bay is
+    one more of them."""
+    if name != "bays" or doors[1] != doors[0] + 1:
+        return False
+    bays = next((p.value for p in named_parameters(old) if p.name == "bays"), None)
+    return bays is not None and doors[0] >= bays
 
 
 def check_edits(proc: Procedure, edits: tuple[tuple[str, int], ...] = EDITS) -> dict[str, Verdict]:

@@ -6,6 +6,7 @@ from grammar_helpers import example, tile
 from facaid.editing.check import band_holds, band_lattice, check_edits, insertion, judge, judge_insert, label_map
 from facaid.generator import generate_procedure
 from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.labels import LABEL_ID
 from facaid.parameters import set_parameter
 
 
@@ -86,6 +87,18 @@ def test_a_second_door_is_not_clean():
     proc = Procedure(240, 370, Node.split("y", [(Size("flt", 270), floors), (Size("flt", 100), ground)]))
     verdict = check_edits(proc, (("bays", 1),))["bays+1"]
     assert not verdict.clean and verdict.reason == "the doors went from 1 to 2"
+
+
+def test_a_new_bay_of_a_row_of_entrances_brings_its_door():
+    """Where every bay has a door of its own (a row of shop doors), a bay more is one more of them."""
+    row = Node.repeat("x", 4, [(Size("flt", 60), tile())], role="floor")
+    floors = Node.repeat("y", 3, [(Size("flt", 90), row)], role="floors")
+    ground = Node.repeat("x", 4, [(Size("flt", 60), tile(sill=False, window="door"))], role="ground")
+    proc = Procedure(240, 370, Node.split("y", [(Size("flt", 270), floors), (Size("flt", 100), ground)]))
+    verdicts = check_edits(proc)
+    assert verdicts["bays+1"].clean and verdicts["bays-1"].clean, verdicts
+    more = set_parameter(proc, "bays", 5)
+    assert (label_map(more) == LABEL_ID["door"]).any(axis=0).reshape(-1).sum() == 5 * 30  # five doors, 30 px each
 
 
 def test_a_floor_fewer_takes_a_floor_the_facade_keeps_a_twin_of():
