@@ -195,10 +195,10 @@ def _decoded(model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation, f
              seed: int, prefix: list[int] | None,
              gate: bool) -> tuple[list[Candidate], Procedure | None, bool, int]:
     """The ranked candidates (`ranked_candidates`), the induced structure and whether it was read (it is read at
-    most once a reconstruction), and how many candidates were decoded. With ``gate`` and K > 1 the greedy candidate is decoded first, alone: where it is
-    `FAR_OFF` and the induced structure `FAR_BEHIND` ahead of it (an annotation unlike the model's training
-    data: a real facade), the samples are not drawn, as only the induced structure is sized then; else the
-    K - 1 samples follow, the same as decoded in one batch with it."""
+    most once a reconstruction), and how many candidates were decoded. With ``gate`` and K > 1 the greedy
+    candidate is decoded first, alone: where it is `FAR_OFF` and the induced structure `FAR_BEHIND` ahead of it
+    (an annotation unlike the model's training data: a real facade), the samples are not drawn, as only the
+    induced structure is sized then; else the K - 1 samples follow, the same as decoded in one batch with it."""
     if not gate or k == 1:
         return (ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix, reference=flat), None,
                 False, k)

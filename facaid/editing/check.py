@@ -11,8 +11,9 @@ floor is a blend of three floors or sits under the shops; looking at the picture
 2. the inserted band is a copy of a band of the old facade: at least `COPY` of its pixels equal those of the most
    alike band of its size;
 3. it holds windows, and the rows (columns) of windows grow by as many as it holds (one; two where a bay is a
-   pair of windows, or a floor has a mezzanine; counted as most of its shifts count them, `band_holds`) while the columns (rows) stay as they were; a shop window several
-   bays wide is in no column (`facaid.editing.windows.WIDE`);
+   pair of windows, or a floor has a mezzanine; counted as most of its shifts count them, `band_holds`) while the
+   columns (rows) stay as they were; a shop window several bays wide is in no column
+   (`facaid.editing.windows.WIDE`);
 4. the doors stay as many as they were: a new bay beside the entrance is another shop, not a second door; but
    where every bay has a door of its own (a row of entrances), a new bay brings one more.
 
@@ -289,5 +290,5 @@ def check_edits(proc: Procedure, edits: tuple[tuple[str, int], ...] = EDITS) -> 
     return out
 
 
-__all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "MORE", "Verdict", "band_holds", "best_copy", "check_edits", "insertion", "judge",
-           "judge_insert", "kept", "label_map"]
+__all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "MORE", "Verdict", "band_holds", "best_copy", "check_edits",
+           "insertion", "judge", "judge_insert", "kept", "label_map"]

@@ -113,7 +113,7 @@ def test_progress_hears_each_stage_in_order(tiny):
     heard = []
     reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False,
                 progress=lambda f, stage: heard.append((f, stage)))
-    assert [s for _, s in heard] == ["decoding 2 candidates", "sizing", "sampling 2 more candidates"]
+    assert [s for _, s in heard] == ["decoding up to 2 candidates", "sizing", "sampling 2 more candidates"]
     assert [f for f, _ in heard] == sorted(f for f, _ in heard) and heard[0][0] >= 0 and heard[-1][0] < 1
     heard.clear()
     reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0, induce=False,
@@ -129,7 +129,7 @@ def test_worker_reports_loading_then_the_pipeline_s_stages(tiny, tmp_path):
     heard = []
     out = job(generate(6).segmentation.to_dict(), str(tmp_path / "ckpt"), k=2,
               progress=lambda f, stage: heard.append((round(f, 6), stage)))
-    assert heard[0] == (0.05, "loading the model") and heard[1] == (0.2, "decoding 2 candidates")
+    assert heard[0] == (0.05, "loading the model") and heard[1] == (0.2, "decoding up to 2 candidates")
     assert heard[2] == (0.6, "sizing") and heard[-1] == (1.0, "done")
     assert [f for f, _ in heard] == sorted(f for f, _ in heard)
     Procedure.from_dict(out["procedure"])
