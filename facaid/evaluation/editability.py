@@ -114,5 +114,4 @@ def generated_edits(seeds: range) -> tuple[int, list[int], dict[int, dict]]:
 
 
 __all__ = ["KEPT", "PITCH", "describes", "editability", "generated_edits", "kept_elements", "lattice",
-           "segmentation_lattice",
-           "window_boxes"]
+           "segmentation_lattice", "window_boxes"]
