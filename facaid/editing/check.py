@@ -10,10 +10,11 @@ floor is a blend of three floors or sits under the shops; looking at the picture
    unchanged (`KEEP_BAY` for a bay, whose new column may re-lay the ground floor's shops around its door);
 2. the inserted band is a copy of a band of the old facade: at least `COPY` of its pixels equal those of the most
    alike band of its size;
-3. it holds windows, and the rows (columns) of windows grow by as many as it holds (one; two where a bay is a
-   pair of windows, or a floor has a mezzanine; counted as most of its shifts count them, `band_holds`) while the
-   columns (rows) stay as they were; a shop window several bays wide is in no column
-   (`facaid.editing.windows.WIDE`);
+3. it holds windows, and the rows (columns) of windows grow by one, or by as many as it holds (two where a bay is
+   a pair of windows, or a floor has a mezzanine; counted as most of its shifts count them, `band_holds`), while
+   the columns (rows) stay as they were; a shop window several bays wide is in no column
+   (`facaid.editing.windows.WIDE`). Counted apart from the facade, a band may hold a strip of a window or a dormer
+   as a row (column) of its own that the facade's count joins to its neighbour: one more is what the issue asks;
 4. the doors stay as many as they were: a new bay beside the entrance is another shop, not a second door; but
    where every bay has a door of its own (a row of entrances), a new bay brings one more.
 
@@ -168,7 +169,7 @@ def judge_insert(old: np.ndarray, new: np.ndarray, old_lattice: tuple[int, int],
     held = band_holds(new_windows, at, h, axis)
     if not held:
         return Verdict(False, f"the new {word} holds no windows", **figures)
-    if new_lattice[grows] != old_lattice[grows] + held or new_lattice[stays] != old_lattice[stays]:
+    if new_lattice[grows] - old_lattice[grows] not in (1, held) or new_lattice[stays] != old_lattice[stays]:
         what = ("rows", "columns") if axis == "y" else ("columns", "rows")
         return Verdict(False, f"the windows went from {old_lattice[grows]} {what[0]} and {old_lattice[stays]} "
                               f"{what[1]} to {new_lattice[grows]} and {new_lattice[stays]}", **figures)

@@ -43,6 +43,19 @@ def test_a_floor_put_in_from_the_middle_of_one_row_of_windows_to_the_next_holds_
     assert band_holds(pairs, 30, 20, "y") == 2
 
 
+def test_a_floor_whose_window_has_a_strip_beside_it_grows_the_rows_by_one():
+    # each row of windows has a strip of a window 6 px lower beside one of them: counted apart from the facade, the
+    # new floor holds two rows (the strip's centre is over half a window's height off); the facade grows by one
+    old, new = floors_map(4), floors_map(5)
+    windows = np.array([[10, 15 + 20 * i, 20, 25 + 20 * i] for i in range(5)] +
+                       [[40, 15 + 20 * i, 50, 25 + 20 * i] for i in range(5)] +
+                       [[21, 23 + 20 * i, 23, 29 + 20 * i] for i in range(5)], dtype=float)
+    verdict = judge_insert(old, new, (4, 2), (5, 2), windows, "y", 0.98)
+    assert band_holds(windows, verdict.at, 20, "y") == 2
+    assert verdict.clean
+    assert not judge_insert(old, new, (4, 2), (7, 2), windows, "y", 0.98).clean  # two rows more than it holds
+
+
 def test_a_band_stuck_on_at_the_edge_or_unlike_any_floor_is_not():
     old = floors_map(4)
     under = np.concatenate([old, old[10:30]])  # a floor under the shops, at the image's edge
