@@ -39,22 +39,33 @@ def whole_windows(boxes: np.ndarray) -> np.ndarray:
     return boxes[(h >= STRIP * np.median(h)) & (w >= STRIP * np.median(w))]
 
 
-def pitch(centres: np.ndarray, sizes: np.ndarray) -> float | None:
-    """The median spacing of the bands of centres (each band at its median centre), None with fewer than 3 bands."""
-    if len(centres) == 0:
+def pitch(windows: np.ndarray, axis: str) -> float | None:
+    """The pitch of ``windows`` (boxes x0, y0, x1, y1) along ``axis`` ("y": the floors', "x": the bays'): the median
+    distance from a window's centre to the nearest one's beyond it in its column ("y") or row ("x": overlapping it
+    across the axis by half the narrower one at least). A person measures a floor from a window to the one above
+    it: the rows of two buildings of different floors beside each other, or a dormer over a column, are no pitch
+    of either. None where the windows make fewer than three rows (columns) or fewer than two such pairs."""
+    lo, hi, across_lo, across_hi = (1, 3, 0, 2) if axis == "y" else (0, 2, 1, 3)
+    if len(windows) == 0:
         return None
-    order = np.argsort(centres)
-    c = centres[order]
-    cuts = np.flatnonzero(np.diff(c) > 0.5 * np.median(sizes)) + 1
-    middles = [float(np.median(band)) for band in np.split(c, cuts)]
-    return float(np.median(np.diff(middles))) if len(middles) >= 3 else None
+    centres, sizes = (windows[:, lo] + windows[:, hi]) / 2, windows[:, hi] - windows[:, lo]
+    if centre_bands(centres, sizes) < 3:
+        return None
+    across = windows[:, across_hi] - windows[:, across_lo]
+    steps = []
+    for i in range(len(windows)):
+        overlap = np.minimum(windows[:, across_hi], windows[i, across_hi]) - np.maximum(windows[:, across_lo],
+                                                                                       windows[i, across_lo])
+        beyond = (overlap >= 0.5 * np.minimum(across, across[i])) & (centres > centres[i] + 0.5 * sizes[i])
+        if beyond.any():
+            steps.append(float((centres[beyond] - centres[i]).min()))
+    return float(np.median(steps)) if len(steps) >= 2 else None
 
 
 def pitches(rows: np.ndarray) -> tuple[float | None, float | None]:
-    """(floor pitch, bay pitch): the median spacing of the window rows and of the window columns of a flattened
-    segmentation's rows, each None with fewer than three."""
+    """(floor pitch, bay pitch) of a flattened segmentation's rows: `pitch` of its whole windows along y and x."""
     w = whole_windows(window_boxes(rows))
-    return (pitch((w[:, 1] + w[:, 3]) / 2, w[:, 3] - w[:, 1]), pitch((w[:, 0] + w[:, 2]) / 2, w[:, 2] - w[:, 0]))
+    return pitch(w, "y"), pitch(w, "x")
 
 
 def lattice(rows: np.ndarray, typical: bool = False) -> tuple[int, int]:

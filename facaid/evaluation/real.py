@@ -211,8 +211,8 @@ def format_summary(result: dict) -> str:
                      f"{share['bays']}, floors + 1 works {share['floors_plus_one']}, bays + 1 {share['bays_plus_one']}"
                      f" (counting window rows); clean as a person looks: floors + 1 "
                      f"{100 * group['floors_clean_share']:.1f} %, bays + 1 {100 * group['bays_clean_share']:.1f} %")
-            for key, what in (("floor_height_ok", "floor_height within 15 % of the rows' pitch"),
-                              ("tile_width_ok", "tile_width the columns' pitch")):
+            for key, what in (("floor_height_ok", "floor_height within 15 % of the floors' pitch"),
+                              ("tile_width_ok", "tile_width the bays' pitch")):
                 if group.get(f"{key}_share") is not None:
                     line += f"; {what} {100 * group[f'{key}_share']:.0f} % of {group[f'{key}_judged']}"
         if "elements_kept_share" in group:
