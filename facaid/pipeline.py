@@ -216,18 +216,24 @@ def _decoded(model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation, f
 def best_reading(flat: Segmentation):
     """Of the lattice readings of a flattened segmentation (`facaid.reading.lattice.readings`), sized, the first
     whose `floors` + 1 and `bays` + 1 are clean (`facaid.editing.check`: the grid as read is tried first, the others
-    only where its edits fail), else the most accurate; a `SizingResult`, its procedure's meta naming its ``group``,
-    or None where there is no lattice."""
+    only where its edits fail), else of those with the most clean edits the most accurate (a reading of floors
+    two by two whose edits both fail is no better for being a little more accurate than the grid whose new floor
+    is clean); a `SizingResult`, its procedure's meta naming its ``group``, or None where there is no lattice."""
     best, key = None, None
     for group, proc in readings(flat):
         fitted = fit_sizes(proc, flat)
-        clean = all(v.clean for v in check_edits(fitted.procedure, MORE).values())
+        verdicts = list(check_edits(fitted.procedure, MORE).values())
         fitted.procedure.meta["group"] = list(group)
-        if key is None or (clean, fitted.accuracy) > key:
-            best, key = fitted, (clean, fitted.accuracy)
-        if clean:
+        if key is None or reading_key(verdicts, fitted.accuracy) > key:
+            best, key = fitted, reading_key(verdicts, fitted.accuracy)
+        if all(v.clean for v in verdicts):
             break
     return best
+
+
+def reading_key(verdicts: list, accuracy: float) -> tuple[int, float]:
+    """How `best_reading` ranks a reading: by how many of its edits' ``verdicts`` are clean, then by accuracy."""
+    return sum(v.clean for v in verdicts), accuracy
 
 
 def _with_editable(exact: Reconstruction, editable, structure: str) -> Reconstruction:

@@ -4,12 +4,12 @@ import pytest
 
 import facaid
 from facaid.cli import main
-from facaid.editing.check import check_edits
+from facaid.editing.check import Verdict, check_edits
 from facaid.generator import generate
 from facaid.grammar import Procedure, validate
 from facaid.metrics import procedure_accuracy
 from facaid.model import save_model
-from facaid.pipeline import reconstruct
+from facaid.pipeline import reading_key, reconstruct
 from facaid.segmentation import flatten
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
@@ -157,3 +157,12 @@ def test_bad_real_input_gets_a_procedure_or_a_clear_error():
         many.append(Rect(2 + i % 10, x, y, x + rng.randrange(1, 10), y + rng.randrange(1, 10)))
     with pytest.raises(ValueError, match=r"too many rectangles for the model: \d+ after flattening \(at most 640\)"):
         reconstruct(Segmentation(2000, 2000, tuple(many)), k=2)
+
+
+def test_a_reading_is_ranked_by_its_clean_edits_then_its_accuracy():
+    clean, broken = Verdict(True, "one floor like the others"), Verdict(False, "the new bay is like no bay")
+    grid = reading_key([clean, broken], 0.95)  # the grid as read: its new floor is clean
+    pairs = reading_key([broken, broken], 0.99)  # floors two by two: a little more accurate, no edit clean
+    both = reading_key([clean, clean], 0.90)
+    assert both > grid > pairs
+    assert reading_key([clean, broken], 0.96) > grid
