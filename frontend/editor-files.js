@@ -76,6 +76,7 @@ export function mountFiles(ed) {
 
   async function openRectify() {
     ed.rectifying = await openRectifyMode(ed.canvas, $("#rectify-preview"), ed.info);
+    ed.draw();  // the zoom label says the step's scale
     $("#rectify-panel").hidden = false;
     // its step in view in the side panel, which scrolls on its own: the page stays put, the save bar in view
     const panel = $("#rectify-panel"), aside = panel.closest("aside");

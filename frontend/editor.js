@@ -137,9 +137,10 @@ const toImage = (sx, sy) => [(sx - view.ox) / view.scale, (sy - view.oy) / view.
 const toScreen = (x, y) => [x * view.scale + view.ox, y * view.scale + view.oy];
 
 function draw() {
+  const scale = rectifying ? rectifying.scale : view.scale;  // the photo as the rectification step shows it
+  $("#zoom").textContent = `zoom ${Math.round(100 * scale)} %`;
   if (rectifying) return rectifying.draw();
   if (seg) drawScene(ctx, {canvas, photo, seg, view, ui, fill: Number($("#fill").value)});
-  $("#zoom").textContent = `zoom ${Math.round(100 * view.scale)} %`;
 }
 
 /** The cursor's image position and the size of a single selected rectangle, in image pixels. */

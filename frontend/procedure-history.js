@@ -83,7 +83,7 @@ export function mountHistory({code, owner, csrf}) {
     document.getElementById("compare-diff-caption").textContent =
       `in magenta, ${(100 * body.differing).toFixed(2)} % of the pixels: their label differs` + (sa === sb ? ""
         : ` (the two are of different sizes, ${sa} and ${sb} px: laid over each other from the top left, where ` +
-          "one reaches beyond the other the other counts as background)");
+          "one reaches beyond the other, the other counts as background there)");
     document.getElementById("comparison").hidden = false;
     status.textContent = "";
   }

@@ -87,6 +87,14 @@ def test_at_1280x800_the_rectification_step_keeps_its_size_field_and_apply_in_vi
                                    f"{box['y'] + box['height'] / 2})?.closest('{selector}') !== null")
             assert on_top, selector
     screenshot(page, "rectify-1280x800.png", tmp_path)
+    # issue 68: the real-size field shows its whole placeholder; the zoom label is the rectification step's
+    fits = page.evaluate("""(() => { const i = document.querySelector('#real-metres'), s = getComputedStyle(i);
+        const c = document.createElement('canvas').getContext('2d'); c.font = s.font;
+        const inner = i.clientWidth - parseFloat(s.paddingLeft) - parseFloat(s.paddingRight);
+        return [c.measureText(i.placeholder).width, inner]; })()""")
+    assert fits[0] + 16 <= fits[1], fits  # and room for the spin buttons
+    scale = page.evaluate(f"{E}.rectifying.scale")
+    assert page.text_content("#zoom") == f"zoom {round(100 * scale)} %"
     page.click("#rectify-propose")  # its note, several lines, moves nothing under the controls
     page.wait_for_function("document.querySelector('#rectify-note').textContent.startsWith('Corners proposed')")
     preview, actions = (page.locator(s).bounding_box() for s in ("#rectify-preview", ".rectify-actions"))
