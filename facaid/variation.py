@@ -152,9 +152,13 @@ def vary(proc: Procedure, n: int = 8, seed: int = 0,
             continue
         if hold and _counts(variant, hold) != counts:  # a swapped floor of another facade holds other tiles
             continue
-        variant.meta = {**proc.meta, "variation": kind, "variation_seed": seed, "variation_index": i}
+        variant.meta = {**proc.meta, "variation": kind, "variation_seed": seed, "variation_index": i,
+                        "counts": _counts(variant, COUNTS)}
         out.append(variant)
     return out
+
+
+COUNTS = ("floors", "bays")  # what a variant's meta says it has ("counts"): its caption, "7 floors, 8 tiles a floor"
 
 
 def _counts(proc: Procedure, names: tuple[str, ...]) -> dict[str, float]:
@@ -209,6 +213,6 @@ def _vary_ranges(proc: Procedure, n: int, seed: int, rng: random.Random,
         except (ProcedureError, ValueError):
             continue
         variant.meta = {**proc.meta, "variation": "ranges", "variation_seed": seed, "variation_index": len(out),
-                        "parameters": values}
+                        "parameters": values, "counts": _counts(variant, COUNTS)}
         out.append(variant)
     return out

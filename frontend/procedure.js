@@ -295,6 +295,18 @@ document.getElementById("save")?.addEventListener("click", async () => {
   if (r.ok) { showSaved(body); versions.refresh(); }
 });
 
+/** What a variant is, in words: "7 floors, 8 tiles a floor · resized to 828 × 739 px" (its counts, then what
+ * made it, then the parameters a range drew: ``drawn``). */
+function variantCaption(v, drawn) {
+  const c = v.meta?.counts || {};
+  const plural = (n, one, many) => `${n} ${n === 1 ? one : many}`;
+  const counts = [c.floors != null ? plural(c.floors, "floor", "floors") : "",
+    c.bays != null ? `${plural(c.bays, "tile", "tiles")} a floor` : ""].filter(Boolean).join(", ");
+  const how = {resize: `resized to ${Math.round(v.width)} × ${Math.round(v.height)} px`, count: "a count changed",
+    swap: "floors or tiles swapped"}[v.meta?.variation] || "";
+  return [counts, how, drawn].filter(Boolean).join(" · ") || "a variant";
+}
+
 // A tree (the edited one, or a variation) as a procedure of the user's whose parent is this one; its page opens.
 async function saveAsNew(data) {
   const [r, body] = await send(`/api/v1/procedures/${code}/save-as-new`, "POST", {data});
@@ -363,8 +375,7 @@ document.getElementById("vary").addEventListener("click", async () => {
       const p = parameters.find((q) => q.name === name);
       return `${p?.label || name} ${value}${p?.unit === "px" ? " px" : ""}`;
     }).join(", ");
-    caption.textContent = `${v.meta?.variation || "variant"} · ${Math.round(v.width)}×${Math.round(v.height)}` +
-      (drawn ? ` · ${drawn}` : "");
+    caption.textContent = variantCaption(v, drawn);
     const use = document.createElement("button");
     use.textContent = "Edit this one";
     use.title = "load it into the parameters: saving it then makes a new version, or a new procedure";

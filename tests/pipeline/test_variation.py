@@ -8,6 +8,7 @@ from facaid.cli import main
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar import Procedure, ProcedureError, execute, validate
 from facaid.labels import LABEL_ID, LABELS
+from facaid.parameters import named_parameters
 from facaid.variation import change_count, resize, swap, vary, with_count, with_size
 
 
@@ -25,6 +26,9 @@ def test_variants_are_valid_and_deterministic(seed, style, vseed):
     for v in a:
         validate(v)
     assert {v.meta["variation"] for v in a} >= {"resize", "count"}
+    for v in a:  # each says its counts, as its caption does
+        counts = {p.name: p.value for p in named_parameters(v) if p.name in ("floors", "bays")}
+        assert v.meta["counts"] == counts and counts
     assert proc.to_json() == generate_procedure(seed, style).to_json()  # the input is untouched
 
 
@@ -101,8 +105,6 @@ def test_cli_vary(tmp_path, capsys):
 def test_held_counts_stay_as_they_are(seed, style, vseed, hold):
     """A held count (its edits are not clean, say) is the same in every variant: no repeat that lays it out is
     recounted, and the facade is not resized along its axis; the other kinds still vary."""
-    from facaid.parameters import named_parameters
-
     proc = generate_procedure(seed, style)
     before = {p.name: p.value for p in named_parameters(proc)}
     try:

@@ -190,14 +190,21 @@ def test_save_as_new_and_saved_variations_have_lineage_and_titles_of_their_own(f
     copy = r.json()
     assert copy["parent"] == str(proc.code) and copy["owner"] == "alice" and copy["visibility"] == "private"
     assert copy["title"] == "Rivoli · swap variant (seed 0, #{})".format(variant["meta"]["variation_index"] + 1)
-    assert copy["version"] == 2 and copy["data"] == Tree.from_dict(variant).to_dict()
+    # issue 68: it starts at version 1, the variation, which says whence it came
+    assert copy["version"] == 1 and copy["data"] == Tree.from_dict(variant).to_dict()
     accuracy, _ = measure(Tree.from_dict(variant), flatten(SegmentationData.from_dict(seg["data"])))
     assert copy["accuracy"] == accuracy and copy["segmentation"] == seg["code"]  # her photo: measured against it
     copies = Procedure.objects.get(code=copy["code"])
-    assert [v.data for v in copies.versions.order_by("version")] == [proc.data, copy["data"]]  # whence it came
-    assert "from version 1 of Rivoli" in copies.versions.get(version=2).note
+    assert [v.data for v in copies.versions.order_by("version")] == [copy["data"]]
+    first = copies.versions.get(version=1)
+    assert first.note == "saved from a variation of version 1 of “Rivoli”" and first.kind == "created"
+    assert first.accuracy == accuracy and copies.metrics["edits"]
     plain = as_alice.post(_url(proc, "save-as-new"), {}, format="json").json()
     assert plain["title"] == "Rivoli · variant 2" and plain["version"] == 1 and plain["data"] == proc.data
+    assert _history(as_alice, Procedure.objects.get(code=plain["code"]))[0]["note"] == \
+        "saved as a new procedure from version 1 of “Rivoli”"
+    fork = as_bob.post(_url(proc, "fork"), {}, format="json").json()
+    assert _history(as_bob, Procedure.objects.get(code=fork["code"]))[0]["note"] == "forked from version 1 of “Rivoli”"
     named = as_alice.post(_url(proc, "save-as-new"), {"title": "Rivoli, five floors"}, format="json").json()
     assert named["title"] == "Rivoli, five floors"
     assert Procedure.objects.get(id=proc.id).data == proc.data  # the original is untouched

@@ -30,10 +30,12 @@ from facaid.photo.rectify import propose_corners_file, rectify_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
 from webapp.facades.models import (
+    Change,
     Draft,
     Job,
     Photo,
     Procedure,
+    ProcedureVersion,
     Segmentation,
     Visibility,
     check_quota,
@@ -308,17 +310,26 @@ def gallery_page(where: tuple, build: Callable[[], Any]) -> Any:
     return page
 
 
-def fork_procedure(user, proc: Procedure) -> Procedure:
+def fork_procedure(user, proc: Procedure, data: dict | None = None, note: str = "",
+                   measure: Callable[[Procedure], None] | None = None, title: str = "") -> Procedure:
     """A private copy owned by ``user`` with ``proc`` as its parent. It keeps the links to the photo and the
     segmentation, which show (the overlay, the re-run) only while the photo is shared with the viewer
     (`access.photo_visible_to`, checked on every view): once a private photo is shared, the fork shows it too. It
     keeps the procedure's own scale (its metres per pixel, which all who may see the procedure are shown:
-    `disclosure`), so that it downloads at its parent's size."""
-    title = proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}"
-    return Procedure.objects.create(
-        owner=user, title=title[:200], data=proc.data, parent=proc, accuracy=proc.accuracy, metrics=proc.metrics,
-        photo=proc.photo, segmentation_id=proc.segmentation_id, metres_per_pixel=proc.metres_per_pixel,
-        scale_from=proc.scale_from)
+    `disclosure`), so that it downloads at its parent's size. Its first version says where it came from ("forked
+    from version 3 of “Street”"), or ``note``; with ``data`` (an edited tree or a variation), that tree is its
+    first version, its figures made by ``measure`` (`versions.remeasure`). Titled ``title``, else "Fork of …"."""
+    title = title or (proc.title if proc.title.startswith("Fork of") else f"Fork of {proc.title or 'procedure'}")
+    current = proc.current_version()
+    copy = Procedure(
+        owner=user, title=title[:200], data=proc.data if data is None else data, parent=proc,
+        accuracy=proc.accuracy, metrics=proc.metrics, photo=proc.photo, segmentation_id=proc.segmentation_id,
+        metres_per_pixel=proc.metres_per_pixel, scale_from=proc.scale_from)
+    if data is not None and measure is not None:
+        measure(copy)
+    copy.save(change=Change(ProcedureVersion.Kind.CREATED, note or (
+        f"forked from version {current.version if current else 1} of “{proc.title or proc.code}”")))
+    return copy
 
 
 def rerun(user, proc: Procedure, nodes: int, k: int = DEFAULT_K) -> Job:

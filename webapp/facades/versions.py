@@ -155,22 +155,23 @@ def new_title(user, proc: Procedure, data: dict) -> str:
 
 def save_as_new(user, proc: Procedure, data: dict | None = None, title: str = "") -> Procedure:
     """A new procedure of ``user``'s whose parent is ``proc``: a fork (its links to the photo as a fork keeps
-    them), then ``data`` (an edited tree or a variation, when given) as its second version, re-measured."""
+    them) whose first version is ``data`` (an edited tree or a variation, when given), re-measured."""
     tree = proc.data if data is None else data
     current = proc.current_version()
-    note = f"saved as a new procedure from version {current.version if current else 1} of {proc}"
+    meta = tree.get("meta") if isinstance(tree.get("meta"), dict) else {}
+    made = "a variation" if isinstance(meta.get("variation"), str) and meta["variation"] else "an edit"
+    note = (f"saved as a new procedure from version {current.version if current else 1} of “{proc}”" if data is None
+            else f"saved from {made} of version {current.version if current else 1} of “{proc}”")
     title = title or new_title(user, proc, tree)
     # its edits checked before the transaction writes (SQLite's one writer is not held for them)
     checks = editcheck.checked(None, tree, tree_digest(tree))[editcheck.KEY]
-    with transaction.atomic():
-        copy = services.fork_procedure(user, proc)
-        copy.title = title
-        if data is None:
-            copy.save(update_fields=["title"])
-        else:
-            copy.metrics = {**(copy.metrics or {}), editcheck.KEY: checks}
-            save_tree(copy, data, Change(ProcedureVersion.Kind.EDIT, note))
-    return copy
+    return services.fork_procedure(user, proc, data, note[:200], measure=lambda p: _measured(p, checks), title=title)
+
+
+def _measured(proc: Procedure, checks: dict) -> None:
+    """`remeasure`, with the edits' verdicts of its tree already made (``checks``)."""
+    remeasure(proc)
+    proc.metrics = {**(proc.metrics or {}), editcheck.KEY: checks}
 
 
 def compare(proc: Procedure, a, b, max_side: int = rendering.COMPARE_SIDE) -> tuple[ProcedureVersion,

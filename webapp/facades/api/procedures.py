@@ -102,7 +102,7 @@ def procedure_fork(request, code):
 @extend_schema(request=SaveAsNewSerializer, responses={201: ProcedureSerializer},
                summary="Save as a new procedure: yours, private, whose parent is this one (kept with its photo as a "
                        "fork keeps it), holding 'data' (an edited tree or a variation; default: this one's tree) as "
-                       "its second version, re-measured; titled from 'title', else from the variation that made it "
+                       "its first version, re-measured; titled from 'title', else from the variation that made it "
                        "or a running number, so that it is told apart from its parent")
 @api_view(["POST"])
 @throttle_classes(HEAVY)
