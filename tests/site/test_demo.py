@@ -108,3 +108,16 @@ def test_a_demo_too_heavy_to_draw_leaves_the_front_page_up_and_is_not_redrawn(de
         assert 'src="data:image/png;base64,' not in r.content.decode()
     assert caches["pages"].get(key) == {"caption": "", "variations": []}
     assert sum("without its pictures" in m for m in caplog.messages) == 1  # drawn once, not on every visit
+
+
+@pytest.mark.django_db(transaction=True)
+def test_the_demo_made_now_is_on_the_first_page_at_once(client):
+    """Issue 68: `scripts/run` makes the demo's procedure before the site opens (`demo --now`, the worker's task run
+    here with the shipped model): a newcomer's first page has its example and "Try the demo", never "Nothing public
+    yet"."""
+    call_command("demo", now=True)
+    proc = Procedure.objects.get(owner__username="demo")
+    assert proc.visibility == "public" and proc.accuracy > 0.9
+    assert proc.versions.get(version=1).kind == "created"
+    page = client.get("/").content.decode()
+    assert 'id="try-demo"' in page and proc.get_absolute_url() in page and "Nothing public yet" not in page

@@ -1,6 +1,7 @@
 """``python manage.py demo``: a demo account with a demo facade photo (a photo-like picture of a generated facade,
-`facaid.photo.photolike`), its segmentation and a queued reconstruction (the worker turns it into a public procedure,
-the front page's example: `webapp.facades.example`). Does nothing if the account exists."""
+`facaid.photo.photolike`), its segmentation and its reconstruction into a public procedure, the front page's example
+(`webapp.facades.example`): queued for the worker, or with ``--now`` made here, as the worker makes it, so that the
+first page a newcomer opens has its example (`scripts/run` does). Does nothing if the account exists."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from facaid.generator import generate
 from facaid.photo.photolike import render_photo
 from webapp.facades import jobs
 from webapp.facades.example import DEMO_PASSWORD, DEMO_USERNAME
-from webapp.facades.models import Photo, Segmentation, Visibility
+from webapp.facades.models import Job, Photo, Segmentation, Visibility
 
 
 class Command(BaseCommand):
@@ -23,8 +24,10 @@ class Command(BaseCommand):
 
     def add_arguments(self, parser):
         parser.add_argument("--seed", type=int, default=3, help="generator seed of the demo facade")
+        parser.add_argument("--now", action="store_true",
+                            help="reconstruct it here (seconds), not on the worker: the front page shows it at once")
 
-    def handle(self, *args, seed: int, **options):
+    def handle(self, *args, seed: int, now: bool = False, **options):
         users = get_user_model()
         if users.objects.filter(username=DEMO_USERNAME).exists():
             self.stdout.write(f"demo account exists: log in as {DEMO_USERNAME} / {DEMO_PASSWORD}")
@@ -39,5 +42,20 @@ class Command(BaseCommand):
         photo.save()
         seg = Segmentation.objects.create(photo=photo, version=1, data=sample.segmentation.to_dict(),
                                           rect_count=len(sample.segmentation.rects))
-        jobs.submit(owner=user, segmentation=seg, params={"k": DEFAULT_K, "seed": 0, "visibility": Visibility.PUBLIC})
-        self.stdout.write(f"demo account created: log in as {DEMO_USERNAME} / {DEMO_PASSWORD}; its facade is queued")
+        fields = {"owner": user, "segmentation": seg,
+                  "params": {"k": DEFAULT_K, "seed": 0, "visibility": Visibility.PUBLIC}}
+        made = ""
+        if now:
+            from webapp.facades import tasks  # the worker's task, run in this process
+
+            job = Job.objects.create(**fields)
+            tasks.run_job.apply(args=[job.id])
+            job.refresh_from_db()
+            if job.status == Job.Status.DONE:
+                made = "its procedure is made"
+            else:
+                self.stderr.write(f"the demo's reconstruction failed here ({job.message}); the worker will make it")
+        if not made:
+            jobs.submit(**fields)
+            made = "its facade is queued"
+        self.stdout.write(f"demo account created: log in as {DEMO_USERNAME} / {DEMO_PASSWORD}; {made}")
