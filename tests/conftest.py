@@ -40,3 +40,15 @@ def tiny():
     model = FacaidModel(FacaidConfig(d_model=16, encoder_layers=1, decoder_layers=1, heads=2, ffn=32, node_boxes=True,
                                      tokenizer=config.to_dict())).eval()
     return model, Tokenizer(config)
+
+
+
+def pytest_xdist_node_collection_finished(node, ids):
+    """With ``-n``, say how many tests run as soon as a worker has collected them (``-q`` hides xdist's count)."""
+    config = node.config
+    if getattr(config, "_facaid_said_total", False):
+        return
+    config._facaid_said_total = True
+    reporter = config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None:
+        reporter.write_line(f"{len(ids)} tests, on {config.getoption('numprocesses')} workers")
