@@ -253,6 +253,7 @@ function scheduleRender() {
       if (renderedUrl) URL.revokeObjectURL(renderedUrl);
       renderedUrl = url;
       document.getElementById("render").src = url;
+      showWhole();
       const overlay = document.getElementById("overlay");
       if (overlay) overlay.src = url;
       fitOverlay();
@@ -422,6 +423,12 @@ function fitOverlay() {
 
 drawTree();
 fitOverlay();
+/** The picture's width over its height, for the stylesheet to keep it whole in the window beside the parameters. */
+function showWhole() {
+  document.getElementById("render").style.setProperty("--ratio", String(proc.width / Math.max(1, proc.height)));
+}
+
+showWhole();
 if (document.getElementById("render").hasAttribute("src")) askNamed();  // a tree that cannot be drawn: said above
 else document.getElementById("named-status").textContent = "The named parameters are not read: see above.";
 versions.refresh().then(() => {

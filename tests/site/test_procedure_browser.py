@@ -451,3 +451,39 @@ def test_a_tree_that_cannot_be_drawn_is_shown_without_its_picture(live_server, a
     assert page.inner_text("#named-status") == "The named parameters are not read: see above."
     page.screenshot(path=str(tmp_path / "not-drawn.png"))
     assert errors == []
+
+
+def test_at_1280x800_the_picture_stays_whole_in_view_beside_the_parameters(live_server, alice, browser, tmp_path):
+    """Issue 68, item 5: at 1280 x 800 only the bottom 190 px of the picture showed while the parameters were
+    edited. The picture sits beside them and stays in view, whole, wherever the page is scrolled to edit them."""
+    from site_helpers import screenshot
+
+    data = generate(3).procedure.to_dict()  # a tall facade: at the panel's width it would be taller than the window
+    assert data["height"] > data["width"]
+    proc = Procedure.objects.create(owner=alice, data=data, visibility="private")
+    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 800}, advanced=False)
+    page.wait_for_selector("#named input[name=floors]")
+    page.wait_for_function("document.getElementById('render').naturalWidth > 0")
+
+    def in_view() -> dict:
+        box = page.locator("#render").bounding_box()
+        assert box["y"] >= 0 and box["y"] + box["height"] <= 800 and box["x"] + box["width"] <= 1280, box
+        return box
+
+    in_view()  # as the page opens, under its title
+    for selector in ("#named input[name=floors]", "#named tr:last-child input", "#advanced summary"):
+        page.locator(selector).scroll_into_view_if_needed()
+        field = page.locator(selector).bounding_box()
+        box = in_view()
+        assert box["x"] + box["width"] <= field["x"], (box, field)  # beside the fields, not over them
+    assert abs(box["width"] / box["height"] - data["width"] / data["height"]) < 0.02  # whole, not squeezed
+    screenshot(page, "procedure-parameters-1280x800.png", tmp_path)
+
+    # a floor more: the taller picture still fits
+    floors = page.locator("#named input[name=floors]")
+    floors.fill(str(int(floors.input_value()) + 2))
+    floors.press("Enter")
+    page.wait_for_function("document.getElementById('saved').textContent === 'unsaved changes'")
+    page.wait_for_function("document.getElementById('render').complete")
+    in_view()
+    assert errors == []
