@@ -44,7 +44,11 @@ function select(paths, by, name = null) {
   if (by === "picture" || by === "3d") {  // the node in the tree, scrolled to within the tree (the page stays)
     const li = document.querySelector(`#tree li[data-path="${paths[0]}"]`);
     if (li) {
+      // the tree opens above the 3D panel: the page scrolls by what it grew, so the panel stays under the pointer
+      const anchor = document.getElementById(by === "3d" ? "preview3d" : "picture-panel"), before = anchor
+        .getBoundingClientRect().top;
       document.getElementById("advanced").open = true;
+      window.scrollBy(0, anchor.getBoundingClientRect().top - before);
       const box = document.getElementById("tree");
       box.scrollTop += li.getBoundingClientRect().top - box.getBoundingClientRect().top - box.clientHeight / 3;
     }
@@ -423,9 +427,9 @@ function fitOverlay() {
 
 drawTree();
 fitOverlay();
-/** The picture's width over its height, for the stylesheet to keep it whole in the window beside the parameters. */
+/** The picture's width over its height, for the stylesheet to keep it (and the overlay) whole in the window. */
 function showWhole() {
-  document.getElementById("render").style.setProperty("--ratio", String(proc.width / Math.max(1, proc.height)));
+  document.getElementById("edit-cols").style.setProperty("--ratio", String(proc.width / Math.max(1, proc.height)));
 }
 
 showWhole();

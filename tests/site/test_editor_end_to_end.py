@@ -107,8 +107,11 @@ def test_editor_from_upload_to_downloads(live_server, alice, worker, page, tmp_p
     assert "No facade is drawn" not in page.text_content("#status")  # it is: no hint to draw it
     page.click("#result-link")
     page.wait_for_url(f"{base}/procedures/*")
-    # the procedure and its overlay on the photo at the same scale, side by side
+    # the procedure and its overlay on the photo at the same scale, side by side: the overlay is below the
+    # parameters, beside the picture, which stays in view (issue 68)
     page.wait_for_function("['render', 'overlay'].every(id => document.getElementById(id).complete)")
+    page.evaluate("window.scrollBy(0, document.getElementById('overlay-box').closest('.panel').getBoundingClientRect()"
+                  ".top - parseFloat(getComputedStyle(document.getElementById('picture-panel')).top))")  # stuck there
     render, overlay = (page.locator(f"#{i}").bounding_box() for i in ("render", "overlay"))
     assert abs(render["width"] - overlay["width"]) <= 1 and abs(render["height"] - overlay["height"]) <= 1
     assert abs(render["y"] - overlay["y"]) <= 1  # side by side

@@ -121,6 +121,8 @@ def test_the_3d_panel_loads_the_procedure_lit_and_names_its_elements(live_server
     # the page selects the same node: in the tree, and outlined in the picture
     assert page.get_attribute("#tree li.selected", "data-path") == node_path
     assert int(page.get_attribute("#selection", "data-outlined")) >= 1
+    # the tree opened above it, and the page stayed: the view is still under the pointer
+    assert abs(page.locator("#preview3d-canvas").bounding_box()["y"] - view["y"]) <= 1
 
     # a drag orbits (a frame drawn), fit to view draws again
     frames = page.evaluate("window.facaidPreview3d.frames")

@@ -455,7 +455,8 @@ def test_a_tree_that_cannot_be_drawn_is_shown_without_its_picture(live_server, a
 
 def test_at_1280x800_the_picture_stays_whole_in_view_beside_the_parameters(live_server, alice, browser, tmp_path):
     """Issue 68, item 5: at 1280 x 800 only the bottom 190 px of the picture showed while the parameters were
-    edited. The picture sits beside them and stays in view, whole, wherever the page is scrolled to edit them."""
+    edited. The picture sits beside the overlay and the parameters and stays in view, whole, wherever the page is
+    scrolled to edit them."""
     from site_helpers import screenshot
 
     data = generate(3).procedure.to_dict()  # a tall facade: at the panel's width it would be taller than the window
