@@ -6,6 +6,7 @@ import {unitIndices} from "./proposals.js";
 import {grayPixels} from "./render.js";
 
 const $ = (sel) => document.querySelector(sel);
+const WALL = new Set(["facade", "background"]);  // never part of a unit of elements
 
 export function mountProposing(ed) {
   // run again by Enter in the threshold field (keys.js), with the new threshold; the old proposals go
@@ -35,11 +36,14 @@ export function mountProposing(ed) {
   // find copies (facaid.completion.copies on the server): where the selected unit, a window with what is drawn around it,
   // repeats in the photo
   async function findCopies() {
-    if (!ed.ui.selection.size) {
-      return ed.status("Find copies looks for copies of the selected unit: select a window and " +
-        "what belongs to it (sill, blind, hood) first.", "error");
+    // a unit is elements: the wall (a facade rectangle) or background selected with them is left out of it
+    const elements = [...ed.ui.selection].filter((id) => !WALL.has(ed.seg.get(id)?.label));
+    if (!elements.length) {
+      return ed.status("Find copies looks for copies of the selected unit: a unit is elements (a window and what " +
+        "belongs to it: sill, blind, hood), not the wall. Select them first: a box started on the wall takes what " +
+        "it touches but the wall; locking the facade class (Objects) keeps clicks off the wall too.", "error");
     }
-    const drawn = ed.seg.toJSON(), unit = unitIndices(ed.seg, ed.ui.selection);
+    const drawn = ed.seg.toJSON(), unit = unitIndices(ed.seg, elements);
     await propose({...drawn, unit}, drawn, "find copies", (n, copies) => n
       ? `${copies} ${copies === 1 ? "copy" : "copies"} of the unit (${n} proposal${n === 1 ? "" : "s"}), scored by ` +
         "how alike they look: click one to reject its copy, " +

@@ -170,3 +170,30 @@ test("assist: a grid of copies with gaps; accepting proposals adds those not rej
     {label: "sill", x0: 0, y0: 0, x1: 5, y1: 5, score: 0.9, reason: "grid", accepted: false}]),
   [{label: "sill", x0: 0, y0: 0, x1: 5, y1: 5}]);
 });
+
+test("select: a press on the wall starts a box, not a move of the facade; a click on the wall selects it", () => {
+  const {seg} = scene();  // a facade rectangle under two windows
+  const [facade, a, b] = [...seg.rects.values()].map((r) => r.id);
+  const ctx = context(seg, {selection: new Set([a])});
+  const {gesture, selection} = press("select", at(10, 10), ctx, {});
+  assert.equal(gesture.kind, "marquee");
+  assert.equal(selection.size, 0);
+  gesture.move(at(90, 60));
+  assert.deepEqual([...gesture.up(context(seg, {selection})).selection].sort(), [a, b].sort());  // not the wall
+  const click = press("select", at(10, 10), context(seg), {}).gesture;
+  click.move(at(11, 11));
+  assert.deepEqual([...click.up(context(seg)).selection], [facade]);
+  // once selected, a press inside it grabs it as any selection
+  assert.equal(press("select", at(10, 10), context(seg, {selection: new Set([facade])}), {}).gesture.kind, "move");
+});
+
+test("select: Shift on a thin sill within reach of the selected window's handle adds the sill, not a resize", () => {
+  const {seg, history} = scene();
+  history.execute(new AddRects([{label: "sill", x0: 18, y0: 50, x1: 42, y1: 53}]));
+  const [, a, , sill] = [...seg.rects.values()].map((r) => r.id);
+  const ctx = context(seg, {selection: new Set([a])});
+  assert.equal(press("select", at(39, 51), ctx, {}).gesture.kind, "resize");  // the window's corner handle
+  const {gesture, selection} = press("select", at(39, 51, {shift: true}), ctx, {});
+  assert.equal(gesture.kind, "move");
+  assert.deepEqual([...selection].sort(), [a, sill].sort());
+});

@@ -40,7 +40,7 @@ def proposals(page) -> list[dict]:
 def test_find_copies_proposes_the_unit_and_one_click_takes_a_row_or_a_column(lattice_editor, tmp_path):
     page = lattice_editor
     page.click("#copies")  # nothing selected: it says what to select
-    assert "select a window and what belongs to it" in page.text_content("#status")
+    assert "a unit is elements (a window and what belongs to it" in page.text_content("#status")
     page.keyboard.press("v")
     x0, y0, x1, y1 = GRID[7]
     page.mouse.click(*screen(page, x0 + 10, y0 + 10))
@@ -82,3 +82,31 @@ def test_find_copies_proposes_the_unit_and_one_click_takes_a_row_or_a_column(lat
     # Enter adds the rest; the rejected row is remembered and not proposed again
     page.keyboard.press("Enter")
     assert len(rects(page)) == 3 + 2 * copies - 12 + 0 and proposals(page) == []
+
+
+def test_a_box_started_on_the_drawn_wall_takes_the_unit_not_the_wall(lattice_editor, tmp_path):
+    """Issue 68, item 2: once a facade rectangle was drawn, a box that started inside it grabbed the facade (a move
+    of the wall), and Find copies then said the unit was the wall. A box started on the wall takes what it touches
+    but the wall; a click on the wall still selects it, and Find copies leaves the wall out of a unit."""
+    page = lattice_editor
+    page.keyboard.press("v")
+    x0, y0, x1, y1 = GRID[7]
+    sx0, sy0, sx1, sy1 = sill_of(GRID[7])
+    start, end = screen(page, x0 - 12, y0 - 12), screen(page, x0 + 10, sy0 + 2)  # from the wall over both
+    page.mouse.move(*start)
+    page.mouse.down()
+    page.mouse.move(*end, steps=5)
+    page.mouse.up()
+    chosen = page.evaluate(f"[...{E}.ui.selection].map((id) => {E}.seg.get(id).label).sort()")
+    assert chosen == ["sill", "window"]
+    assert [(r["x0"], r["y0"]) for r in rects(page) if r["label"] == "facade"] == [(0, 0)]  # the wall did not move
+    screenshot(page.locator("#canvas"), "marquee-on-the-wall.png", tmp_path)
+    page.click("#copies")
+    page.wait_for_function(f"{E}.ui.proposals.length > 0")
+    assert "copies of the unit" in page.text_content("#status")
+    page.keyboard.press("Escape")
+    page.mouse.click(*screen(page, 20, 20))  # a click on the wall selects it
+    assert page.evaluate(f"[...{E}.ui.selection].map((id) => {E}.seg.get(id).label)") == ["facade"]
+    page.click("#copies")  # the wall alone is no unit: it says what a unit is, and how to leave the wall out
+    status = page.text_content("#status")
+    assert "not the wall" in status and "locking the facade class" in status
