@@ -3,7 +3,7 @@
 // (`match.js`), and the command that adds the proposals the user kept.
 import {AddRects, Batch, DeleteRects, repeatRects} from "./commands.js";
 import {contains, intersects, translate} from "./geometry.js";
-import {findSimilar} from "./match.js";
+import {findSimilar, matchNear} from "./match.js";
 
 /** Copies of rectangle `id` in `cols` x `rows` with the given gaps (image pixels) between them. */
 export function repeatCommand(seg, id, {cols, rows, gapX, gapY}) {
@@ -53,10 +53,15 @@ export function facadeBounds(seg, examples) {
     x1: Math.max(...walls.map((f) => f.x1)), y1: Math.max(...walls.map((f) => f.y1)), facade: true};
 }
 
+const FOLLOW = 0.6;  // how alike the first example a place of the photo must look to take a copy
+const REACH = 0.25;  // of the pitch: how far from where the pitch puts it a copy's place is looked for
+
 /** Copies of two examples of one class at their pitch (the second's offset from the first), both ways along it
  * until they would leave the facade (`facadeBounds`); a place where that class is already drawn (half the copy
- * covered) is skipped. {command, message} or {error}. */
-export function repeatByPitch(seg, ids) {
+ * covered) is skipped. With the photo's gray levels (`gray`), each copy goes where the photo shows one, looked for
+ * within `REACH` of the pitch from the last (`matchNear`: a facade's bays are rarely evenly spaced), and the copies
+ * stop where it shows none. {command, message} or {error}. */
+export function repeatByPitch(seg, ids, gray = null) {
   if (ids.length !== 2) {
     return {error: `Repeat to the edge measures the pitch between two rectangles of one class, and ${ids.length} ` +
       `${ids.length === 1 ? "is" : "are"} selected.`};
@@ -67,21 +72,36 @@ export function repeatByPitch(seg, ids) {
   const [dx, dy] = [b.x0 - a.x0, b.y0 - a.y0];
   const bounds = facadeBounds(seg, [a, b]);
   const same = [...seg.rects.values()].filter((r) => r.label === a.label);
+  const reach = {x: Math.round(REACH * Math.abs(dx)) + 2, y: Math.round(REACH * Math.abs(dy)) + 2};
   const copies = [];
-  let skipped = 0;
+  let skipped = 0, unseen = 0;
   for (const [from, sign] of [[b, 1], [a, -1]]) {
-    for (let k = 1; ; k++) {
-      const c = translate(from, sign * k * dx, sign * k * dy);
-      if (!inside(c, bounds) || copies.length >= MAX_COPIES) break;
+    for (let last = from; copies.length < MAX_COPIES;) {
+      let c = translate(last, sign * dx, sign * dy);
+      if (!inside(c, bounds)) break;
+      if (gray) {
+        const found = matchNear(gray, a, c, reach);
+        if (!found || found.score < FOLLOW || !inside(found, bounds)) {
+          unseen++;
+          break;
+        }
+        c = {x0: found.x0, y0: found.y0, x1: found.x1, y1: found.y1};
+      }
       if (same.some((r) => overlap(r, c) * 2 >= area(c))) skipped++;
       else copies.push({label: a.label, ...c});
+      last = c;
     }
   }
   const edge = bounds.facade ? "the facade's edge" : "the image's edge";
   const had = skipped ? `; ${skipped} ${skipped === 1 ? "place" : "places"} already had one` : "";
-  if (!copies.length) return {error: `Nothing added: no free place at a pitch of ${dx}, ${dy} px before ${edge}${had}.`};
+  const none = unseen ? `where it shows none (${unseen === 1 ? "one way" : "both ways"}) or ` : "";
+  const where = gray ? ` where the photo shows one, up to ${none}${edge}` : `, to ${edge}`;
+  if (!copies.length) {
+    return {error: `Nothing added: no free place at a pitch of ${dx}, ${dy} px${gray ? " that the photo shows" : ""} ` +
+      `before ${edge}${had}.`};
+  }
   return {command: new AddRects(copies, "repeat to the edge"), message: `Added ${copies.length} ${a.label} ` +
-    `${copies.length === 1 ? "copy" : "copies"} at a pitch of ${dx}, ${dy} px, to ${edge}${had}.`};
+    `${copies.length === 1 ? "copy" : "copies"} at a pitch of ${gray ? "about " : ""}${dx}, ${dy} px${where}${had}.`};
 }
 
 /** Rectangle `id` cut into `n` columns or rows (`direction`) with `gap` whole pixels between them, replacing it in

@@ -11,7 +11,7 @@ import {buildObjectList} from "./object-list.js";
 import {freeView, layersNote, objectGroups, pickable, pickableSelection, toggleLayer} from "./objects.js";
 import {buildPalette, markActive} from "./panel.js";
 import {mountProposing} from "./proposing.js";
-import {drawScene} from "./render.js";
+import {drawScene, grayPixels} from "./render.js";
 import {download, makeApi} from "./server.js";
 import {DraftKeeper, loadPhoto} from "./session.js";
 import {mountPointer} from "./tools/pointer.js";
@@ -256,7 +256,10 @@ on("#redo", "click", () => history.redo());
 on("#delete", "click", removeSelected);
 on("#duplicate", "click", duplicate);
 on("#repeat", "click", repeatSelected);
-on("#repeat-edge", "click", () => carryOut(repeatByPitch(seg, [...ui.selection])));
+on("#repeat-edge", "click", () => {  // following the photo where there is one
+  if (photo && !gray) gray = grayPixels(photo, seg.width, seg.height);
+  carryOut(repeatByPitch(seg, [...ui.selection], gray));
+});
 on("#split", "click", () => carryOut(splitCommand(seg, [...ui.selection], {n: Number($("#split-n").value),
   direction: $("#split-dir").value, gap: Number($("#split-gap").value)}), true));
 on("#similar", "click", similar);

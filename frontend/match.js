@@ -93,3 +93,51 @@ export function findSimilar(gray, box, {threshold = 0.8, maxResults = 100, exclu
   }
   return out;
 }
+
+/**
+ * Where the photo (`gray`) looks most like `box` within `radius` ({x, y}, image pixels) of `at` (a box of its
+ * size): {x0, y0, x1, y1, score} (normalized cross-correlation), or null where no place of that size fits. Both are
+ * compared at a scale where the box is at most `side` pixels across, so a search costs the same at any size.
+ */
+export function matchNear(gray, box, at, radius, {side = 40} = {}) {
+  const w = box.x1 - box.x0, h = box.y1 - box.y0;
+  const step = Math.max(1, Math.ceil(Math.max(w, h) / side));
+  const template = patch(gray, box.x0, box.y0, w, h, step);
+  if (!template) return null;
+  const score = (t, x0, y0, every) => {
+    const here = patch(gray, x0, y0, w, h, every);
+    if (!here) return null;
+    let dot = 0;
+    for (let k = 0; k < here.v.length; k++) dot += t.v[k] * here.v[k];
+    return {x0, y0, x1: x0 + w, y1: y0 + h, score: dot / (t.norm * here.norm)};
+  };
+  let best = null;
+  for (let oy = -radius.y; oy <= radius.y; oy += step) {
+    for (let ox = -radius.x; ox <= radius.x; ox += step) {
+      const c = score(template, Math.round(at.x0 + ox), Math.round(at.y0 + oy), step);
+      if (c && (!best || c.score > best.score)) best = c;
+    }
+  }
+  if (!best || step === 1) return best;
+  const whole = patch(gray, box.x0, box.y0, w, h, 1);  // to the pixel, every pixel, around the coarse best
+  let fine = null;
+  for (let oy = 1 - step; oy < step; oy++) {
+    for (let ox = 1 - step; ox < step; ox++) {
+      const c = score(whole, best.x0 + ox, best.y0 + oy, 1);
+      if (c && (!fine || c.score > fine.score)) fine = c;
+    }
+  }
+  return fine || best;
+}
+
+/** The gray levels of a w x h box at (x0, y0), every `step`-th pixel, less their mean, with their norm; null where
+ * the box leaves the image or is flat. */
+function patch(gray, x0, y0, w, h, step) {
+  if (x0 < 0 || y0 < 0 || x0 + w > gray.width || y0 + h > gray.height) return null;
+  const v = [];
+  for (let y = y0; y < y0 + h; y += step) for (let x = x0; x < x0 + w; x += step) v.push(gray.data[y * gray.width + x]);
+  const mean = v.reduce((s, a) => s + a, 0) / v.length;
+  let norm = 0;
+  for (let k = 0; k < v.length; k++) { v[k] -= mean; norm += v[k] * v[k]; }
+  return norm < 1e-6 ? null : {v, norm: Math.sqrt(norm)};
+}

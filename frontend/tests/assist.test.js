@@ -122,3 +122,22 @@ test("split: refused when the pieces do not fit, for bad counts or gaps, and for
   assert.match(splitCommand(seg, [2], {n: 2, direction: "rows", gap: -1}).error, /0 or more/);
   assert.match(splitCommand(seg, [2, 3], {n: 2, direction: "rows", gap: 0}).error, /and 2 are selected/);
 });
+
+test("repeat to the edge with the photo: each copy where the photo shows one, stopping at bare wall", () => {
+  // a wall (180) with windows (dark glass, a light cross) whose spacing is uneven: 40 px, then 48 px, then none
+  const [w, h, xs] = [300, 100, [20, 60, 108, 148, 196]];
+  const data = new Float32Array(w * h).fill(180);
+  for (const x0 of xs) {
+    for (let y = 30; y < 60; y++) {
+      for (let x = x0; x < x0 + 20; x++) data[y * w + x] = x === x0 + 10 || y === 45 ? 200 : 40;
+    }
+  }
+  const seg = new Segmentation(w, h);
+  seg.insert({label: "window", x0: 20, y0: 30, x1: 40, y1: 60});
+  seg.insert({label: "window", x0: 60, y0: 30, x1: 80, y1: 60});
+  const plan = repeatByPitch(seg, [1, 2], {width: w, height: h, data});
+  assert.deepEqual(plan.command.records.map((r) => r.x0), [108, 148, 196]);  // not 100, 140, 180, 220, 260
+  assert.equal(plan.message, "Added 3 window copies at a pitch of about 40, 0 px where the photo shows one, up to " +
+    "where it shows none (one way) or the image's edge.");
+  assert.deepEqual(repeatByPitch(seg, [1, 2]).command.records.map((r) => r.x0), [100, 140, 180, 220, 260]);
+});

@@ -348,7 +348,8 @@ def test_repeat_to_the_edge_from_two_examples_and_split_into_columns_each_one_un
     select_window(page, 200, 60)
     select_window(page, 340, 60, shift=True)
     page.click("#repeat-edge")
-    assert page.text_content("#status") == "Added 1 window copy at a pitch of 140, 0 px, to the facade's edge."
+    assert page.text_content("#status") == ("Added 1 window copy at a pitch of about 140, 0 px where the photo shows "
+                                            "one, up to the facade's edge.")  # the photo's own pitch
     windows = sorted((r["x0"], r["y0"], r["x1"], r["y1"]) for r in rects(page) if r["label"] == "window")
     assert windows == [(60, 60, 120, 150), (200, 60, 260, 150), (340, 60, 400, 150)]
     assert page.evaluate(f"{E}.history.done.length") == steps + 1
