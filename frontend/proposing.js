@@ -90,13 +90,16 @@ export function mountProposing(ed) {
   }
 
   function acceptProposals() {
+    const shown = ed.ui.proposals.length;
     ed.ui.rejected.push(...rejectedOf(ed.ui.proposals));
     const cmd = acceptCommand(ed.ui.proposals, ed.ui.proposalsFrom);
     ed.ui.proposals = [];
     if (cmd) ed.run(cmd);
     const added = cmd ? cmd.records.length : 0;
-    ed.status(cmd ? `Added ${added} proposal${added === 1 ? "" : "s"}.` : "Nothing was added: " +
-      "every proposal was rejected.", cmd ? "success" : "");
+    // "every proposal was rejected" only where there were some: else there was nothing to accept
+    ed.status(cmd ? `Added ${added} proposal${added === 1 ? "" : "s"}.` : shown ? "Nothing was added: " +
+      `every proposal (${shown}) was rejected.` : "Nothing to accept: there are no proposals. Ask for some first " +
+      "(Complete, Find copies or Find similar).", cmd ? "success" : "");
     ed.changed();
   }
   return {similar, findCopies, completeNow, acceptProposals};
