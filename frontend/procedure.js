@@ -4,6 +4,7 @@
 // selects its node in the tree and the parameters that stand for it; a click on a parameter's name or a node's
 // outlines what it stands for in the picture.
 import {accuracyText, mountHistory} from "./procedure-history.js";
+import {drawRanges, rangesAsked, variantCaption} from "./procedure-variations.js";
 import {treeElement} from "./procedure-tree.js";
 import {leafAt, leavesUnder, parametersOf, pictureToProcedure} from "./selection.js";
 import {busy, patientFetch} from "./server.js";
@@ -141,45 +142,6 @@ function firstMessage(answer) {
   return "";
 }
 
-// Ranges for variations, one row per named parameter that can change (of the saved procedure, which the server
-// varies): both ends given, the variations draw it within them.
-let rangesDrawn = false;
-function drawRanges(parameters) {
-  if (rangesDrawn) return;  // the rows keep what the user typed
-  rangesDrawn = true;
-  document.querySelector("#ranges tbody").replaceChildren(...parameters.filter((p) => p.min !== p.max).map((p) => {
-    const tr = document.createElement("tr");
-    tr.dataset.name = p.name;
-    const th = document.createElement("th");
-    th.textContent = p.label;
-    const cells = ["from", "to"].map((end) => {
-      const input = document.createElement("input");
-      input.type = "number"; input.name = `${p.name}-${end}`; input.min = p.min; input.max = p.max;
-      input.step = p.integer ? 1 : 0.5; input.placeholder = p.integer ? String(p.value) : p.value.toFixed(1);
-      input.style.width = "6rem";
-      const td = document.createElement("td");
-      td.append(input);
-      return td;
-    });
-    const unit = document.createElement("td");
-    unit.className = "meta"; unit.textContent = p.unit === "px" ? "px" : "";
-    tr.append(th, ...cells, unit);
-    return tr;
-  }));
-}
-
-// {name: [from, to]} of the rows with both ends given; a string naming the problem when a row has one end only
-function rangesAsked() {
-  const out = {};
-  for (const tr of document.querySelectorAll("#ranges tbody tr")) {
-    const [lo, hi] = [...tr.querySelectorAll("input")].map((i) => i.value);
-    if (lo === "" && hi === "") continue;
-    if (lo === "" || hi === "") return `${tr.querySelector("th").textContent}: give both ends of the range`;
-    out[tr.dataset.name] = [Number(lo), Number(hi)];
-  }
-  return out;
-}
-
 function drawNamed(parameters) {
   drawRanges(parameters);
   document.querySelector("#named tbody").replaceChildren(...parameters.map((p) => {
@@ -299,18 +261,6 @@ document.getElementById("save")?.addEventListener("click", async () => {
     : `not saved: ${JSON.stringify(body)}`;
   if (r.ok) { showSaved(body); versions.refresh(); }
 });
-
-/** What a variant is, in words: "7 floors, 8 tiles a floor · resized to 828 × 739 px" (its counts, then what
- * made it, then the parameters a range drew: ``drawn``). */
-function variantCaption(v, drawn) {
-  const c = v.meta?.counts || {};
-  const plural = (n, one, many) => `${n} ${n === 1 ? one : many}`;
-  const counts = [c.floors != null ? plural(c.floors, "floor", "floors") : "",
-    c.bays != null ? `${plural(c.bays, "tile", "tiles")} a floor` : ""].filter(Boolean).join(", ");
-  const how = {resize: `resized to ${Math.round(v.width)} × ${Math.round(v.height)} px`, count: "a count changed",
-    swap: "floors or tiles swapped"}[v.meta?.variation] || "";
-  return [counts, how, drawn].filter(Boolean).join(" · ") || "a variant";
-}
 
 // A tree (the edited one, or a variation) as a procedure of the user's whose parent is this one; its page opens.
 async function saveAsNew(data) {
