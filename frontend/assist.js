@@ -138,7 +138,8 @@ export function acceptCommand(proposals, name = "find similar") {
 }
 
 /** The proposals the user rejected (clicked away), as rectangles to pass back to completion so that it does not
- * propose them again. */
+ * propose them again; a dimmed one left as it came (not taken) was never proposed, and is not rejected. */
 export function rejectedOf(proposals) {
-  return proposals.filter((p) => p.accepted === false).map(({label, x0, y0, x1, y1}) => ({label, x0, y0, x1, y1}));
+  return proposals.filter((p) => p.accepted === false && !p.dimmed)
+    .map(({label, x0, y0, x1, y1}) => ({label, x0, y0, x1, y1}));
 }

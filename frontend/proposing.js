@@ -54,9 +54,17 @@ export function mountProposing(ed) {
   // completion (facaid.complete on the server): the elements not drawn yet, from the rows and columns drawn so far
   async function completeNow() {
     const drawn = ed.seg.toJSON();
-    await propose({...drawn}, drawn, "complete", (n) => n ? `${n} proposals: click one to ` +
-      'reject it, Shift+click to add it alone, Enter or "Accept" to add the rest.'
-      : `Nothing to propose yet: draw a few elements of a row and a column${rejectedNote()}.`);
+    await propose({...drawn}, drawn, "complete", (n, _, answer) => {
+      const dim = answer.dimmed?.length || 0;
+      const dimmed = dim ? `${dim} ${n ? "more " : ""}place${dim === 1 ? "" : "s"} the photo does not confirm, ` +
+        "dimmed with their scores: click one to take it" : "";
+      if (n) {
+        return `${n} proposals: click one to reject it, Shift+click to add it alone, Enter or "Accept" to add ` +
+          `the rest${dim ? `; ${dimmed}` : ""}.`;
+      }
+      const tried = answer.tried?.length ? ` Tried: ${answer.tried.join("; ")}.` : "";
+      return `${dim ? `Nothing proposed for sure; ${dimmed}` : "Nothing to propose"}${rejectedNote()}.${tried}`;
+    });
   }
 
   // the places rejected before are never proposed again in this session: said where nothing comes back
@@ -73,14 +81,16 @@ export function mountProposing(ed) {
     body.rejected = ed.ui.rejected;
     ed.ui.completing = true;
     try {
-      const {proposals} = await ed.api(`/api/v1/photos/${ed.photoCode}/complete`,
+      const answer = await ed.api(`/api/v1/photos/${ed.photoCode}/complete`,
         {method: "POST", body: JSON.stringify(body)});
       if (JSON.stringify(ed.seg.toJSON()) !== JSON.stringify(drawn)) {
         return ed.status(`The drawing changed meanwhile: ${from === "complete" ? "press C" : "ask"} again.`);
       }
-      ed.ui.proposals = proposals;
+      // the places the photo does not confirm come dimmed, not taken: a click takes one (`toggleRejected`)
+      ed.ui.proposals = [...answer.proposals, ...(answer.dimmed || []).map((p) => ({...p, dimmed: true,
+        accepted: false}))];
       ed.ui.proposalsFrom = from;
-      ed.status(message(proposals.length, new Set(proposals.map((p) => p.copy)).size));
+      ed.status(message(answer.proposals.length, new Set(answer.proposals.map((p) => p.copy)).size, answer));
     } catch (err) {
       ed.status(`No proposals: ${err.message}`, "error");
     } finally {

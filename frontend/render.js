@@ -56,7 +56,10 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
       for (const [hx, hy] of Object.values(handlePoints(r))) ctx.fillRect(sx(hx) - 3, sy(hy) - 3, 7, 7);
     }
   }
-  for (const p of ui.proposals) stroke(p, p.accepted === false ? "#888" : "#ffeb3b", 2, [6, 4]);
+  for (const p of ui.proposals) {  // a dimmed one (the photo does not confirm it) thin until taken
+    stroke(p, p.accepted === false ? (p.dimmed ? "#bbb" : "#888") : "#ffeb3b", p.dimmed && !p.accepted ? 1 : 2,
+      p.dimmed && !p.accepted ? [2, 3] : [6, 4]);
+  }
   drawScores(ctx, ui.proposals, sx, sy, view.scale);
   for (const c of chips(ui.proposals, (x, y) => [sx(x), sy(y)])) {  // one click: a whole row or column
     const off = c.members.every((p) => p.accepted === false);

@@ -41,7 +41,10 @@ a drawn one:
 Proposals outside the drawn facade rectangles' bounds (the image when none is drawn), cut by the image's edge, over
 a drawn element of the same class, mostly under a drawn element of a class that paints over them, or near a
 ``rejected`` box are left out; those scored below ``min_score`` (`facaid.defaults.DEFAULT_MIN_SCORE`) are not
-returned. The figures are of the simulated annotator (`facaid.evaluation.assist`, `bench/bench_assist.py`).
+returned by `complete`. `explained` returns them too, from `DIM_SCORE` up (the places the structure gives and the
+photo does not confirm, which the editor shows dimmed for a person to take), and where nothing is proposed says in
+words what was tried: how long each kind's rows and columns are, and whether either has a pitch. The figures are of
+the simulated annotator (`facaid.evaluation.assist`, `bench/bench_assist.py`).
 """
 
 from __future__ import annotations
@@ -420,6 +423,27 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
     ``rejected`` boxes (the same contract) are not proposed again. See the module's docstring. Raises
     `SegmentationError` (a ValueError) naming the field for a bad segmentation, `RejectedError` (a ValueError)
     for a bad rejected box, ValueError for more than `MAX_DRAWN` rectangles or ``min_score`` outside [0, 1]."""
+    return explained(segmentation, photo, rejected=rejected, min_score=min_score).proposals
+
+
+DIM_SCORE = 0.3  # places scored this or more, under ``min_score``, are returned dimmed: the person may take them
+MAX_DIMMED = 60
+
+
+@dataclass
+class Completion:
+    """What `explained` found: the ``proposals`` (as `complete` returns them), the places scored under
+    ``min_score`` but at least `DIM_SCORE` (``dimmed``: the structure proposes them and the photo does not confirm
+    them, shown for the person to take), and in words what was ``tried`` where nothing is proposed."""
+
+    proposals: list[dict]
+    dimmed: list[dict]
+    tried: list[str]
+
+
+def explained(segmentation: Segmentation | dict, photo: Any = None, *, rejected: list[dict] | None = None,
+              min_score: float = DEFAULT_MIN_SCORE) -> Completion:
+    """`complete`, with the places under ``min_score`` and what was tried (a `Completion`)."""
     seg, props = proposals_for(segmentation, rejected, min_score)
     types = _types(props.drawn)
     for t in types:
@@ -443,7 +467,31 @@ def complete(segmentation: Segmentation | dict, photo: Any = None, *, rejected: 
             p.update(x0=int(box[0]), y0=int(box[1]), x1=int(box[2]), y1=int(box[3]))
         elif i in props.photo:
             p["photo"] = props.photo[i]
-        if p["score"] >= min_score:
-            out.append(p)
+        out.append(p)
     out.sort(key=lambda p: (-p["score"], p["y0"], p["x0"]))
+    kept = [p for p in out if p["score"] >= min_score]
+    dimmed = [p for p in out if min(DIM_SCORE, min_score) <= p["score"] < min_score][:MAX_DIMMED]
+    return Completion(kept, dimmed, [] if kept else _tried(types, bool(dimmed)))
+
+
+def _tried(types: list[_Type], dimmed: bool) -> list[str]:
+    """In words, for the kinds of element drawn most (at most four): how long their rows and columns are, and
+    whether either has a pitch (`_pitch`: three in a line, the gaps agreeing), which the structure needs to
+    propose; and whether the photo left places unconfirmed."""
+    out = []
+    for t in sorted(types, key=lambda t: -len(t.boxes))[:4]:
+        b = t.boxes
+        lines = {}
+        for what, (lo, hi, at, size) in {"row": (1, 3, 0, t.width), "column": (0, 2, 1, t.height)}.items():
+            found = aligned_lines(b[:, lo], b[:, hi])
+            longest = max((len(r) for r in found), default=0)
+            pitch = next((p for r in found if len(r) >= 2 and (p := _pitch(b[r, at].tolist(), size)) is not None),
+                         None)
+            lines[what] = (f"a {what} with a pitch of {pitch:.0f} px" if pitch is not None else
+                           f"no {what} with a pitch (the longest has {longest}; a pitch needs 3 in a {what} whose "
+                           f"gaps agree within {100 * PITCH_TOLERANCE:.0f} %)")
+        out.append(f"{LABELS[t.label]}s of {t.width:.0f} x {t.height:.0f} px, {len(b)} drawn: {lines['row']}, "
+                   f"{lines['column']}")
+    if dimmed:
+        out.append("the places the structure gives that the photo does not confirm are shown dimmed")
     return out

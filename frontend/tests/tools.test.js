@@ -197,3 +197,12 @@ test("select: Shift on a thin sill within reach of the selected window's handle 
   assert.equal(gesture.kind, "move");
   assert.deepEqual([...selection].sort(), [a, sill].sort());
 });
+
+test("assist: a dimmed proposal is not taken until clicked, and never passed back as rejected", () => {
+  const dim = {label: "window", x0: 10, y0: 10, x1: 20, y1: 20, score: 0.42, dimmed: true, accepted: false};
+  const sure = {label: "window", x0: 40, y0: 10, x1: 50, y1: 20, score: 0.9};
+  assert.deepEqual(acceptCommand([dim, sure]).records.map((r) => r.x0), [40]);
+  assert.deepEqual(rejectedOf([dim, {...sure, accepted: false}]).map((r) => r.x0), [40]);
+  const taken = {...dim, accepted: true};  // clicked: taken
+  assert.deepEqual(acceptCommand([taken, sure]).records.map((r) => r.x0), [10, 40]);
+});

@@ -185,3 +185,28 @@ def test_as_drawn_makes_the_wall_one_rectangle_and_keeps_the_label_map():
 
 def _box(rects):
     return min(r.x0 for r in rects), min(r.y0 for r in rects), max(r.x1 for r in rects), max(r.y1 for r in rects)
+
+
+def test_places_under_the_bar_come_dimmed_and_nothing_proposed_says_what_was_tried():
+    """Issue 68, item 1: a row of three windows and a column drawn (b0333's trial) gave the grid's crossings, which
+    the photo did not confirm, and the editor said only "draw a few elements of a row and a column". The places
+    under ``min_score`` come back dimmed, with their scores, and where nothing is proposed the words say what was
+    tried."""
+    from facaid.completion import DIM_SCORE, explained
+
+    windows = _grid(4, 4)
+    drawn = [windows[i] for i in (0, 1, 2, 4, 8)]  # a row of three and a column of three
+    seg = Segmentation(600, 500, (WALL, *drawn))
+    sure = explained(seg)
+    assert sure.proposals and not sure.tried  # the structure alone: the crossings proposed
+    unsure = explained(seg, min_score=0.95)  # as when the photo confirms none of them
+    assert unsure.proposals == [] and _boxes(sure.proposals) <= _boxes(unsure.dimmed)
+    assert all(DIM_SCORE <= p["score"] < 0.95 for p in unsure.dimmed)
+    assert unsure.tried[0] == "windows of 60 x 60 px, 5 drawn: a row with a pitch of 100 px, a column with a pitch " \
+                              "of 100 px"
+    assert "dimmed" in unsure.tried[-1]
+    two = explained(Segmentation(600, 500, (WALL, windows[0], windows[1])))
+    assert two.proposals == [] and two.dimmed == []
+    assert two.tried == ["windows of 60 x 60 px, 2 drawn: no row with a pitch (the longest has 2; a pitch needs 3 in "
+                         "a row whose gaps agree within 10 %), no column with a pitch (the longest has 1; a pitch "
+                         "needs 3 in a column whose gaps agree within 10 %)"]

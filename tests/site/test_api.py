@@ -239,7 +239,11 @@ def test_completion_proposes_what_is_not_drawn_and_refuses_bad_input(facade_phot
     assert {k: p[k] for k in ("label", "x0", "y0", "x1", "y1")} == full[1 + 5]
     assert p["score"] >= 0.85 and p["reason"] in ("grid", "floor")
     body["rejected"] = [{k: p[k] for k in ("label", "x0", "y0", "x1", "y1")}]
-    assert as_alice.post(url, body, format="json").json()["proposals"] == []
+    nothing = as_alice.post(url, body, format="json").json()
+    assert nothing["proposals"] == [] and nothing["dimmed"] == []  # a rejected place is not even dimmed
+    assert nothing["tried"][0].startswith("windows of ") and "with a pitch" in nothing["tried"][0]  # in words
+    unsure = as_alice.post(url, {**body, "rejected": [], "min_score": 0.99}, format="json").json()
+    assert unsure["proposals"] == [] and unsure["dimmed"][0]["score"] == p["score"]  # under the bar: dimmed
     assert as_alice.get(seg_url(photo)).json()["count"] == 1  # nothing stored
     for bad, field, message in (
         ({**_drawn_grid(w + 10, h)}, "segmentation", "but the photo is"),

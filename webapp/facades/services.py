@@ -21,7 +21,7 @@ from django.utils import timezone
 from PIL import Image
 from rest_framework.exceptions import APIException, ValidationError
 
-from facaid.completion import RejectedError, complete
+from facaid.completion import RejectedError, explained
 from facaid.completion.copies import UnitError, find_copies
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE
 from facaid.formats import interchange
@@ -216,12 +216,14 @@ def segmentation_file(photo: Photo, format: str, version: str | None = None) -> 
     return name, interchange.CONTENT_TYPES[format], interchange.write(seg, format, image=photo.file_name(rectified))
 
 
-def complete_segmentation(photo: Photo, data) -> list[dict]:
-    """Proposals for what is not drawn yet (`facaid.complete`) in a segmentation of the photo: the body is the
-    segmentation JSON, optionally with ``rejected`` (rectangles not to propose again), ``min_score`` and
-    ``use_photo`` (default true: the photo the segmentation is drawn on confirms or rejects each proposal). With
-    ``unit`` (indices of its rectangles: a window and what is drawn around it), the copies of that unit the photo
-    shows instead (`facaid.completion.copies.find_copies`)."""
+def complete_segmentation(photo: Photo, data) -> dict:
+    """Proposals for what is not drawn yet (`facaid.completion.explained`) in a segmentation of the photo:
+    ``{"proposals", "dimmed", "tried"}`` (the places the photo does not confirm, shown for the person to take, and in
+    words what was tried where nothing is proposed). The body is the segmentation JSON, optionally with
+    ``rejected`` (rectangles not to propose again), ``min_score`` and ``use_photo`` (default true: the photo the
+    segmentation is drawn on confirms or rejects each proposal). With ``unit`` (indices of its rectangles: a window
+    and what is drawn around it), the copies of that unit the photo shows instead
+    (`facaid.completion.copies.find_copies`: ``{"proposals"}``)."""
     seg = _segmentation_of(photo, data, "segmentation").segmentation
     rejected = data.get("rejected") or []
     unit = data.get("unit")
@@ -241,8 +243,9 @@ def complete_segmentation(photo: Photo, data) -> list[dict]:
             levels = appearance.levels(f, seg.width, seg.height)
     try:
         if unit is not None:
-            return find_copies(seg, levels, unit, rejected=rejected, min_score=float(min_score))
-        return complete(seg, levels, rejected=rejected, min_score=float(min_score))
+            return {"proposals": find_copies(seg, levels, unit, rejected=rejected, min_score=float(min_score))}
+        found = explained(seg, levels, rejected=rejected, min_score=float(min_score))
+        return {"proposals": found.proposals, "dimmed": found.dimmed, "tried": found.tried}
     except RejectedError as exc:
         raise ValidationError({"rejected": str(exc)}) from None
     except UnitError as exc:

@@ -114,7 +114,9 @@ def photo_propose_corners(request, code):
 @extend_schema(request={"application/json": dict}, responses={200: dict},
                summary="Propose the elements not drawn yet (facaid.complete): the body is the segmentation drawn so "
                        "far, with optional 'rejected' rectangles and 'min_score'; returns {'proposals': [{label, x0, "
-                       "y0, x1, y1, score, reason}]}; nothing is stored")
+                       "y0, x1, y1, score, reason}], 'dimmed': [the places scored under min_score, from 0.3], "
+                       "'tried': [what was tried, in words, where nothing is proposed]}; with 'unit', the copies "
+                       "of that unit: {'proposals'}; nothing is stored")
 @api_view(["POST"])
 @throttle_classes(HEAVY)
 @permission_classes([AllowAny])
@@ -123,5 +125,5 @@ def photo_complete(request, code):
     photo = access.get_photo_for_user(request.user, code)
     if not isinstance(request.data, dict):
         raise ValidationError({"segmentation": "must be a JSON object"})
-    return Response({"proposals": services.complete_segmentation(photo, request.data)})
+    return Response(services.complete_segmentation(photo, request.data))
 
