@@ -379,7 +379,8 @@ def _repeats(levels: appearance.Levels, props: Proposals) -> None:
 def _photo_check(levels: appearance.Levels, props: Proposals) -> dict[int, tuple[float, float, np.ndarray]]:
     """{item: (score, similarity, box)} for the proposals the photo has a say on: each is moved to where it looks
     most like the drawn elements of its class (`appearance.refine`); one that looks like them scores at least
-    `PHOTO_CONFIRMED`, one that does not half its structural score; a flat place or class keeps its score."""
+    `PHOTO_CONFIRMED`, one that does not half its structural score and stays where the structure put it; a flat
+    place or class keeps its score."""
     out: dict[int, tuple[float, float]] = {}
     items = [i for i, item in enumerate(props.items) if item[2] >= PHOTO_CANDIDATE and not item[3].startswith("repeat")]
     for label in sorted({props.items[i][0] for i in items}):
@@ -391,7 +392,10 @@ def _photo_check(levels: appearance.Levels, props: Proposals) -> dict[int, tuple
                 continue
             score = props.items[i][2]
             bar = VETO if score >= PHOTO_CONFIRMED else PHOTO_MATCH  # a sure structure: the photo only vetoes
-            score = max(score, PHOTO_CONFIRMED) if sim >= bar else 0.5 * score
+            if sim < bar:  # not confirmed: where the structure puts it (the best of nearby places is any of them)
+                score, box = 0.5 * score, props.boxes[i]
+            else:
+                score = max(score, PHOTO_CONFIRMED)
             out[i] = (round(float(score), 3), round(float(sim), 3), box)
     return out
 
