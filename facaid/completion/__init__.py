@@ -54,6 +54,9 @@ from typing import Any
 
 import numpy as np
 
+from facaid.completion.kinds import MIN_GAPS as MIN_GAPS  # re-exported: the docstring names them
+from facaid.completion.kinds import PITCH_TOLERANCE as PITCH_TOLERANCE
+from facaid.completion.kinds import SIZE_TOLERANCE, Kind, kinds, pitch, tried
 from facaid.defaults import DEFAULT_MIN_SCORE
 from facaid.labels import BACKGROUND, FACADE, GLASS, LABELS, PRIORITY
 from facaid.photo import appearance, repeats
@@ -64,13 +67,10 @@ MAX_PROPOSALS = 2_000  # proposals gathered at most in one call
 MAX_FILL = 16  # two drawn lines at most this many pitches apart are filled between
 MAX_TYPES = 200  # with more types than this (no facade has them), companions are not looked for
 MAX_SEARCH_TYPES = 64  # the photo is searched for at most this many types, those drawn most often (CMP: 58 at most)
-SIZE_TOLERANCE = 0.2  # elements of one class whose width and height agree within this share are one type
 SAME_PLACE = 0.5  # IoU at which two proposals are the same element
 OVERLAP = 0.2  # a proposal whose area lies this much over drawn elements of its class is not made
 REJECTED_PLACE = 0.3  # IoU at which a proposal repeats a rejected one
-MIN_GAPS = 2  # a pitch is measured from at least this many gaps that agree
 EXTEND = 1  # rows and columns continue by at most this many pitches beyond the drawn ones
-PITCH_TOLERANCE = 0.1  # the gaps of a row (column) agree within this share of the smallest, or it has no pitch
 COMPANION_SHARE = 1.0  # a companion is proposed when at least this share of its element's drawn copies have one
 COMPANION_MIN = 4  # ... and at least this many have one
 COMPANION_TOUCH = 3  # pixels: a companion overlaps its element or lies at most this far from it
@@ -97,52 +97,6 @@ COPY_SLOPE = 0.3  # ... and what each unit of NCC above that adds
 
 class RejectedError(ValueError):
     """A rejected rectangle that breaks the segmentation contract; the message names it (``rejected[i]``)."""
-
-
-@dataclass
-class _Type:
-    label: int
-    boxes: np.ndarray  # (n, 4) float x0, y0, x1, y1 of the drawn elements
-    width: float
-    height: float
-
-
-def _types(rows: np.ndarray) -> list[_Type]:
-    """Drawn elements grouped by class and size, the biggest first within a class."""
-    out: list[_Type] = []
-    for label in np.unique(rows[:, 0]).tolist():
-        boxes = rows[rows[:, 0] == label, 1:].astype(float)
-        area = _area(boxes)
-        groups: list[list[int]] = []
-        sizes = np.zeros((0, 2))  # each group's first (largest) member's width and height
-        for i in np.argsort(-area, kind="stable").tolist():
-            w, h = boxes[i, 2] - boxes[i, 0], boxes[i, 3] - boxes[i, 1]
-            fits = np.flatnonzero((np.abs(w - sizes[:, 0]) <= SIZE_TOLERANCE * sizes[:, 0])
-                                  & (np.abs(h - sizes[:, 1]) <= SIZE_TOLERANCE * sizes[:, 1]))
-            if len(fits):
-                groups[fits[0]].append(i)
-            else:
-                groups.append([i])
-                sizes = np.vstack([sizes, [w, h]])
-        for g in groups:
-            b = boxes[g]
-            out.append(_Type(int(label), b, float(np.median(b[:, 2] - b[:, 0])), float(np.median(b[:, 3] - b[:, 1]))))
-    return out
-
-
-def _pitch(starts: list[float], size: float) -> float | None:
-    """The spacing of a row's (column's) elements: the median gap between neighbours, gaps that are about a
-    multiple of the smallest read as that many pitches. None with fewer than `MIN_GAPS` gaps (three elements) or
-    gaps that do not agree."""
-    s = sorted(starts)
-    gaps = [b - a for a, b in zip(s[:-1], s[1:], strict=True) if b - a >= 0.5 * size]
-    if len(gaps) < MIN_GAPS:
-        return None
-    unit = min(gaps)
-    steps = [g / max(1, round(g / unit)) for g in gaps]
-    if max(steps) - min(steps) > PITCH_TOLERANCE * unit:
-        return None  # uneven spacing (pairs of windows, a wider middle bay): no pitch to extend by
-    return float(np.median(steps))
 
 
 def _positions(observed: list[float], pitch: float | None, lo: float, hi: float, size: float,
@@ -263,7 +217,7 @@ class Proposals:
             self.photo[i] = round(float(photo), 3)
 
 
-def _lattice(t: _Type, props: Proposals) -> None:
+def _lattice(t: Kind, props: Proposals) -> None:
     """The type's rows and columns, each continued by the pitch measured along it, crossed: every crossing
     where nothing of the type is drawn is proposed (scored by how many of its two lines were drawn in)."""
     b = t.boxes
@@ -272,8 +226,8 @@ def _lattice(t: _Type, props: Proposals) -> None:
     x_hi, y_hi = float(region[:, 2].max()), float(region[:, 3].max())
     rows = aligned_lines(b[:, 1], b[:, 3])
     cols = aligned_lines(b[:, 0], b[:, 2])
-    pitches_x = [p for r in rows if len(r) >= 2 and (p := _pitch(b[r, 0].tolist(), t.width)) is not None]
-    pitches_y = [p for c in cols if len(c) >= 2 and (p := _pitch(b[c, 1].tolist(), t.height)) is not None]
+    pitches_x = [p for r in rows if len(r) >= 2 and (p := pitch(b[r, 0].tolist(), t.width)) is not None]
+    pitches_y = [p for c in cols if len(c) >= 2 and (p := pitch(b[c, 1].tolist(), t.height)) is not None]
     px = float(np.median(pitches_x)) if pitches_x else None
     py = float(np.median(pitches_y)) if pitches_y else None
     if px is None and py is None:
@@ -295,7 +249,7 @@ def _lattice(t: _Type, props: Proposals) -> None:
             props.add(t.label, np.array([x0, y0, x1, y1]), score, reason)
 
 
-def _floors(t: _Type, props: Proposals) -> None:
+def _floors(t: Kind, props: Proposals) -> None:
     """Two neighbouring rows of the type, one begun in the other's columns: the fuller one's other columns are
     proposed in the row begun, at its height."""
     b = t.boxes
@@ -321,7 +275,7 @@ def _spans(lo: np.ndarray, hi: np.ndarray, lines: list[np.ndarray], pitch: float
             for v, seen in _positions(list(drawn), pitch, start, stop, size)]
 
 
-def _companions(types: list[_Type], props: Proposals) -> None:
+def _companions(types: list[Kind], props: Proposals) -> None:
     """Elements drawn on or against another type's elements, proposed at the same offset for the rest of them."""
     if len(types) > MAX_TYPES:
         return
@@ -349,7 +303,7 @@ def _companions(types: list[_Type], props: Proposals) -> None:
                 props.add(s.label, anchor + offset, round(0.3 + 0.5 * share, 3), f"with {LABELS[a.label]}")
 
 
-def _search(levels: appearance.Levels, types: list[_Type], props: Proposals) -> None:
+def _search(levels: appearance.Levels, types: list[Kind], props: Proposals) -> None:
     """Where the photo looks like a type's drawn elements (`facaid.photo.appearance.search`, NCC at least
     `SEARCH_MATCH`), anywhere in the facade: each such place is proposed at the type's size (``looks like``). The
     `MAX_SEARCH_TYPES` types drawn most often are searched for (in their order), so that a call costs at most that
@@ -449,7 +403,7 @@ def explained(segmentation: Segmentation | dict, photo: Any = None, *, rejected:
               min_score: float = DEFAULT_MIN_SCORE) -> Completion:
     """`complete`, with the places under ``min_score`` and what was tried (a `Completion`)."""
     seg, props = proposals_for(segmentation, rejected, min_score)
-    types = _types(props.drawn)
+    types = kinds(props.drawn)
     for t in types:
         _floors(t, props)
     for t in types:
@@ -475,27 +429,4 @@ def explained(segmentation: Segmentation | dict, photo: Any = None, *, rejected:
     out.sort(key=lambda p: (-p["score"], p["y0"], p["x0"]))
     kept = [p for p in out if p["score"] >= min_score]
     dimmed = [p for p in out if min(DIM_SCORE, min_score) <= p["score"] < min_score][:MAX_DIMMED]
-    return Completion(kept, dimmed, [] if kept else _tried(types, bool(dimmed)))
-
-
-def _tried(types: list[_Type], dimmed: bool) -> list[str]:
-    """In words, for the kinds of element drawn most (at most four): how long their rows and columns are, and
-    whether either has a pitch (`_pitch`: three in a line, the gaps agreeing), which the structure needs to
-    propose; and whether the photo left places unconfirmed."""
-    out = []
-    for t in sorted(types, key=lambda t: -len(t.boxes))[:4]:
-        b = t.boxes
-        lines = {}
-        for what, (lo, hi, at, size) in {"row": (1, 3, 0, t.width), "column": (0, 2, 1, t.height)}.items():
-            found = aligned_lines(b[:, lo], b[:, hi])
-            longest = max((len(r) for r in found), default=0)
-            pitch = next((p for r in found if len(r) >= 2 and (p := _pitch(b[r, at].tolist(), size)) is not None),
-                         None)
-            lines[what] = (f"a {what} with a pitch of {pitch:.0f} px" if pitch is not None else
-                           f"no {what} with a pitch (the longest has {longest}; a pitch needs 3 in a {what} whose "
-                           f"gaps agree within {100 * PITCH_TOLERANCE:.0f} %)")
-        out.append(f"{LABELS[t.label]}s of {t.width:.0f} x {t.height:.0f} px, {len(b)} drawn: {lines['row']}, "
-                   f"{lines['column']}")
-    if dimmed:
-        out.append("the places the structure gives that the photo does not confirm are shown dimmed")
-    return out
+    return Completion(kept, dimmed, [] if kept else tried(types, bool(dimmed)))
