@@ -40,14 +40,14 @@ export function rangesAsked() {
   return out;
 }
 
-/** What a variant is, in words: "7 floors, 8 tiles a floor · resized to 828 × 739 px" (its counts, then what
+/** What a variant is, in words: "7 upper floors, 8 tiles a floor · resized to 828 × 739 px" (its counts, then what
  * made it, then the parameters a range drew: ``drawn``). */
 export function variantCaption(v, drawn) {
   const c = v.meta?.counts || {};
   const plural = (n, one, many) => `${n} ${n === 1 ? one : many}`;
-  const counts = [c.floors != null ? plural(c.floors, "floor", "floors") : "",
+  const counts = [c.floors != null ? plural(c.floors, "upper floor", "upper floors") : "",
     c.bays != null ? `${plural(c.bays, "tile", "tiles")} a floor` : ""].filter(Boolean).join(", ");
-  const how = {resize: `resized to ${Math.round(v.width)} × ${Math.round(v.height)} px`, count: "a count changed",
-    swap: "floors or tiles swapped"}[v.meta?.variation] || "";
+  const how = {resize: `resized to ${Math.round(v.width)} × ${Math.round(v.height)} px`,
+    count: "one repeat's count changed", swap: "a floor or tile swapped for another"}[v.meta?.variation] || "";
   return [counts, how, drawn].filter(Boolean).join(" · ") || "a variant";
 }

@@ -100,16 +100,18 @@ export function mountProposing(ed) {
   }
 
   function acceptProposals() {
-    const shown = ed.ui.proposals.length;
+    const shown = ed.ui.proposals.length, dim = ed.ui.proposals.filter((p) => p.dimmed && p.accepted === false).length;
     ed.ui.rejected.push(...rejectedOf(ed.ui.proposals));
     const cmd = acceptCommand(ed.ui.proposals, ed.ui.proposalsFrom);
     ed.ui.proposals = [];
     if (cmd) ed.run(cmd);
     const added = cmd ? cmd.records.length : 0;
     // "every proposal was rejected" only where there were some: else there was nothing to accept
-    ed.status(cmd ? `Added ${added} proposal${added === 1 ? "" : "s"}.` : shown ? "Nothing was added: " +
-      `every proposal (${shown}) was rejected.` : "Nothing to accept: there are no proposals. Ask for some first " +
-      "(Complete, Find copies or Find similar).", cmd ? "success" : "");
+    const untaken = dim ? `the ${dim} dimmed place${dim === 1 ? " is" : "s are"} added only when clicked` : "";
+    ed.status(cmd ? `Added ${added} proposal${added === 1 ? "" : "s"}.` : shown > dim ? "Nothing was added: " +
+      `every proposal (${shown - dim}) was rejected${dim ? `, and ${untaken}` : ""}.` : shown ? `Nothing was added: ` +
+      `${untaken}.` : "Nothing to accept: there are no proposals. Ask for some first (Complete, Find copies or " +
+      "Find similar).", cmd ? "success" : "");
     ed.changed();
   }
   return {similar, findCopies, completeNow, acceptProposals};

@@ -67,6 +67,7 @@ def test_the_demo_account_cannot_change_the_demo(demo, as_demo):
     # the pages say so, and offer the owner's buttons to nobody
     page = as_demo.get(f"/procedures/{code}").content.decode()
     assert 'id="demo-note"' in page and 'id="save"' not in page and 'id="save-new"' in page
+    assert "Fork it" in page and "log in</a> or" not in page  # logged in: the fork is on the page
     assert as_demo.post(f"/procedures/{code}/delete").status_code == 403
     assert Procedure.objects.filter(code=code).exists()
 
@@ -121,3 +122,5 @@ def test_the_demo_made_now_is_on_the_first_page_at_once(client):
     assert proc.versions.get(version=1).kind == "created"
     page = client.get("/").content.decode()
     assert 'id="try-demo"' in page and proc.get_absolute_url() in page and "Nothing public yet" not in page
+    shown = client.get(proc.get_absolute_url()).content.decode()  # anonymous: what works, and how to keep a copy
+    assert "work without an account" in shown and "log in</a> or" in shown and "Fork it, or" not in shown

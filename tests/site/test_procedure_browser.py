@@ -72,9 +72,10 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
 
     page.click("#vary")
     page.wait_for_function("document.querySelectorAll('#variants .card img').length === 8")
-    # issue 68: a caption says what the variant is, "7 floors, 8 tiles a floor · resized to 828 × 739 px"
+    # issue 68: a caption says what the variant is, "7 upper floors, 8 tiles a floor · resized to 828 × 739 px"
     captions = page.eval_on_selector_all("#variants .card .meta", "els => els.map(e => e.textContent)")
-    said = r"\d+ floors?, \d+ tiles? a floor · (resized to \d+ × \d+ px|a count changed|floors or tiles swapped)"
+    said = (r"\d+ upper floors?, \d+ tiles? a floor · (resized to \d+ × \d+ px|one repeat's count changed|"
+            r"a floor or tile swapped for another)")
     assert all(re.fullmatch(said, c) for c in captions), captions
     if shot := os.environ.get("FACAID_PAGE_SCREENSHOT"):  # docs/img/procedure-page.png: the page, tree closed
         page.click("#advanced summary")

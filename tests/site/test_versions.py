@@ -203,6 +203,9 @@ def test_save_as_new_and_saved_variations_have_lineage_and_titles_of_their_own(f
     assert plain["title"] == "Rivoli · variant 2" and plain["version"] == 1 and plain["data"] == proc.data
     assert _history(as_alice, Procedure.objects.get(code=plain["code"]))[0]["note"] == \
         "saved as a new procedure from version 1 of “Rivoli”"
+    unedited = as_alice.post(_url(proc, "save-as-new"), {"data": proc.data}, format="json").json()  # as the page
+    assert _history(as_alice, Procedure.objects.get(code=unedited["code"]))[0]["note"] == \
+        "saved as a new procedure from version 1 of “Rivoli”"  # sends it, not edited: no edit is said
     fork = as_bob.post(_url(proc, "fork"), {}, format="json").json()
     assert _history(as_bob, Procedure.objects.get(code=fork["code"]))[0]["note"] == "forked from version 1 of “Rivoli”"
     named = as_alice.post(_url(proc, "save-as-new"), {"title": "Rivoli, five floors"}, format="json").json()

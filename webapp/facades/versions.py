@@ -160,7 +160,8 @@ def save_as_new(user, proc: Procedure, data: dict | None = None, title: str = ""
     current = proc.current_version()
     meta = tree.get("meta") if isinstance(tree.get("meta"), dict) else {}
     made = "a variation" if isinstance(meta.get("variation"), str) and meta["variation"] else "an edit"
-    note = (f"saved as a new procedure from version {current.version if current else 1} of “{proc}”" if data is None
+    same = data is None or tree_digest(data) == proc.digest  # the page sends the tree it shows, edited or not
+    note = (f"saved as a new procedure from version {current.version if current else 1} of “{proc}”" if same
             else f"saved from {made} of version {current.version if current else 1} of “{proc}”")
     title = title or new_title(user, proc, tree)
     # its edits checked before the transaction writes (SQLite's one writer is not held for them)
