@@ -224,8 +224,9 @@ def best_reading(flat: Segmentation):
         fitted = fit_sizes(proc, flat)
         verdicts = list(check_edits(fitted.procedure, MORE).values())
         fitted.procedure.meta["group"] = list(group)
-        if key is None or reading_key(verdicts, fitted.accuracy) > key:
-            best, key = fitted, reading_key(verdicts, fitted.accuracy)
+        mine = reading_key(verdicts, fitted.accuracy)
+        if key is None or mine > key:
+            best, key = fitted, mine
         if all(v.clean for v in verdicts):
             break
     return best

@@ -158,7 +158,7 @@ def vary(proc: Procedure, n: int = 8, seed: int = 0,
     return out
 
 
-COUNTS = ("floors", "bays")  # what a variant's meta says it has ("counts"): its caption, "7 floors, 8 tiles a floor"
+COUNTS = ("floors", "bays")  # a variant's meta "counts": its caption, "7 upper floors, 8 tiles a floor"
 
 
 def _counts(proc: Procedure, names: tuple[str, ...]) -> dict[str, float]:

@@ -42,7 +42,6 @@ def tiny():
     return model, Tokenizer(config)
 
 
-
 def pytest_xdist_node_collection_finished(node, ids):
     """With ``-n``, say how many tests run as soon as a worker has collected them (``-q`` hides xdist's count)."""
     config = node.config

@@ -56,7 +56,7 @@ import numpy as np
 
 from facaid.completion.kinds import MIN_GAPS as MIN_GAPS  # re-exported: the docstring names them
 from facaid.completion.kinds import PITCH_TOLERANCE as PITCH_TOLERANCE
-from facaid.completion.kinds import SIZE_TOLERANCE, Kind, kinds, pitch, tried
+from facaid.completion.kinds import SIZE_TOLERANCE, Kind, kinds, lines, tried
 from facaid.defaults import DEFAULT_MIN_SCORE
 from facaid.labels import BACKGROUND, FACADE, GLASS, LABELS, PRIORITY
 from facaid.photo import appearance, repeats
@@ -224,10 +224,8 @@ def _lattice(t: Kind, props: Proposals) -> None:
     region = props.walls
     x_lo, y_lo = float(region[:, 0].min()), float(region[:, 1].min())
     x_hi, y_hi = float(region[:, 2].max()), float(region[:, 3].max())
-    rows = aligned_lines(b[:, 1], b[:, 3])
-    cols = aligned_lines(b[:, 0], b[:, 2])
-    pitches_x = [p for r in rows if len(r) >= 2 and (p := pitch(b[r, 0].tolist(), t.width)) is not None]
-    pitches_y = [p for c in cols if len(c) >= 2 and (p := pitch(b[c, 1].tolist(), t.height)) is not None]
+    rows, pitches_x = lines(t, "x")
+    cols, pitches_y = lines(t, "y")
     px = float(np.median(pitches_x)) if pitches_x else None
     py = float(np.median(pitches_y)) if pitches_y else None
     if px is None and py is None:
@@ -428,5 +426,5 @@ def explained(segmentation: Segmentation | dict, photo: Any = None, *, rejected:
         out.append(p)
     out.sort(key=lambda p: (-p["score"], p["y0"], p["x0"]))
     kept = [p for p in out if p["score"] >= min_score]
-    dimmed = [p for p in out if min(DIM_SCORE, min_score) <= p["score"] < min_score][:MAX_DIMMED]
+    dimmed = [p for p in out if DIM_SCORE <= p["score"] < min_score][:MAX_DIMMED]
     return Completion(kept, dimmed, [] if kept else tried(types, bool(dimmed)))

@@ -64,24 +64,29 @@ def pitch(starts: list[float], size: float) -> float | None:
     return float(np.median(steps))
 
 
+def lines(t: Kind, along: str) -> tuple[list[np.ndarray], list[float]]:
+    """The kind's rows (``along`` "x": elements side by side) or columns ("y"), as index arrays into its boxes, and
+    the pitches of those that have one (`pitch`), in their order."""
+    lo, hi, at, size = (1, 3, 0, t.width) if along == "x" else (0, 2, 1, t.height)
+    found = aligned_lines(t.boxes[:, lo], t.boxes[:, hi])
+    return found, [p for r in found if len(r) >= 2 and (p := pitch(t.boxes[r, at].tolist(), size)) is not None]
+
+
 def tried(types: list[Kind], dimmed: bool) -> list[str]:
     """In words, for the kinds of element drawn most (at most four): how long their rows and columns are, and
     whether either has a pitch (`pitch`: three in a line, the gaps agreeing), which the structure needs to
     propose; and whether the photo left places unconfirmed."""
     out = []
     for t in sorted(types, key=lambda t: -len(t.boxes))[:4]:
-        b = t.boxes
-        lines = {}
-        for what, (lo, hi, at, size) in {"row": (1, 3, 0, t.width), "column": (0, 2, 1, t.height)}.items():
-            found = aligned_lines(b[:, lo], b[:, hi])
+        said = {}
+        for what, along in (("row", "x"), ("column", "y")):
+            found, steps = lines(t, along)
             longest = max((len(r) for r in found), default=0)
-            step = next((p for r in found if len(r) >= 2 and (p := pitch(b[r, at].tolist(), size)) is not None),
-                        None)
-            lines[what] = (f"a {what} with a pitch of {step:.0f} px" if step is not None else
-                           f"no {what} with a pitch (the longest has {longest}; a pitch needs 3 in a {what} whose "
-                           f"gaps agree within {100 * PITCH_TOLERANCE:.0f} %)")
-        out.append(f"{LABELS[t.label]}s of {t.width:.0f} x {t.height:.0f} px, {len(b)} drawn: {lines['row']}, "
-                   f"{lines['column']}")
+            said[what] = (f"a {what} with a pitch of {steps[0]:.0f} px" if steps else
+                          f"no {what} with a pitch (the longest has {longest}; a pitch needs 3 in a {what} whose "
+                          f"gaps agree within {100 * PITCH_TOLERANCE:.0f} %)")
+        out.append(f"{LABELS[t.label]}s of {t.width:.0f} x {t.height:.0f} px, {len(t.boxes)} drawn: {said['row']}, "
+                   f"{said['column']}")
     if dimmed:
         out.append("the places the structure gives that the photo does not confirm are shown dimmed")
     return out

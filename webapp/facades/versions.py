@@ -160,12 +160,14 @@ def save_as_new(user, proc: Procedure, data: dict | None = None, title: str = ""
     current = proc.current_version()
     meta = tree.get("meta") if isinstance(tree.get("meta"), dict) else {}
     made = "a variation" if isinstance(meta.get("variation"), str) and meta["variation"] else "an edit"
-    same = data is None or tree_digest(data) == proc.digest  # the page sends the tree it shows, edited or not
+    digest = tree_digest(tree)
+    same = digest == proc.digest  # the page sends the tree it shows, edited or not
     note = (f"saved as a new procedure from version {current.version if current else 1} of “{proc}”" if same
             else f"saved from {made} of version {current.version if current else 1} of “{proc}”")
     title = title or new_title(user, proc, tree)
-    # its edits checked before the transaction writes (SQLite's one writer is not held for them)
-    checks = editcheck.checked(None, tree, tree_digest(tree))[editcheck.KEY]
+    # its edits checked before the transaction writes (SQLite's one writer is not held for them); the parent's
+    # verdicts where the tree is the parent's
+    checks = editcheck.checked(proc.metrics, tree, digest)[editcheck.KEY]
     return services.fork_procedure(user, proc, data, note[:200], measure=lambda p: _measured(p, checks), title=title)
 
 
