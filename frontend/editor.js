@@ -143,6 +143,12 @@ function draw() {
   if (seg) drawScene(ctx, {canvas, photo, seg, view, ui, fill: Number($("#fill").value)});
 }
 
+/** The photo's gray levels (`render.grayPixels`), made once it is first asked for; null without a photo. */
+function photoGray() {
+  if (photo && !gray) gray = grayPixels(photo, seg.width, seg.height);
+  return gray;
+}
+
 /** The cursor's image position and the size of a single selected rectangle, in image pixels. */
 function readout(x, y) {
   const one = ui.selection.size === 1 ? seg.get([...ui.selection][0]) : null;
@@ -167,7 +173,7 @@ function setTool(tool) {
 // --- the editor's parts (tools/pointer.js, proposing.js, editor-files.js) share the state and its echo -------------
 const ed = {api, photoCode, root, canvas, ui, view, status, run, changed, draw, toImage, toScreen,
   get info() { return info; }, get photo() { return photo; }, get seg() { return seg; },
-  get history() { return history; }, get gray() { return gray; }, set gray(g) { gray = g; },
+  get history() { return history; }, photoGray,
   get rectifying() { return rectifying; }, set rectifying(r) { rectifying = r; }};
 const {similar, findCopies, completeNow, acceptProposals} = mountProposing(ed);
 const {importJSON, saveNow, submitNow, openRectify, applyRectify} = mountFiles(ed);
@@ -256,10 +262,7 @@ on("#redo", "click", () => history.redo());
 on("#delete", "click", removeSelected);
 on("#duplicate", "click", duplicate);
 on("#repeat", "click", repeatSelected);
-on("#repeat-edge", "click", () => {  // following the photo where there is one
-  if (photo && !gray) gray = grayPixels(photo, seg.width, seg.height);
-  carryOut(repeatByPitch(seg, [...ui.selection], gray));
-});
+on("#repeat-edge", "click", () => carryOut(repeatByPitch(seg, [...ui.selection], photoGray())));
 on("#split", "click", () => carryOut(splitCommand(seg, [...ui.selection], {n: Number($("#split-n").value),
   direction: $("#split-dir").value, gap: Number($("#split-gap").value)}), true));
 on("#similar", "click", similar);

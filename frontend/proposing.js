@@ -3,7 +3,6 @@
 // back so that they are not proposed again. `ed` is what the editor's parts share (editor.js).
 import {acceptCommand, rejectedOf, similarProposals} from "./assist.js";
 import {unitIndices} from "./proposals.js";
-import {grayPixels} from "./render.js";
 
 const $ = (sel) => document.querySelector(sel);
 const WALL = new Set(["facade", "background"]);  // never part of a unit of elements
@@ -23,8 +22,7 @@ export function mountProposing(ed) {
     if (!(field.value !== "" && threshold >= Number(field.min) && threshold <= Number(field.max))) {
       return ed.status(`The threshold must be a number from ${field.min} to ${field.max}.`, "error");
     }
-    ed.gray = ed.gray || grayPixels(ed.photo, ed.seg.width, ed.seg.height);
-    ed.ui.proposals = similarProposals(ed.gray, ed.seg, source, threshold);
+    ed.ui.proposals = similarProposals(ed.photoGray(), ed.seg, source, threshold);
     [ed.ui.proposalsFrom, ed.ui.similarSource] = ["find similar", source];
     const n = ed.ui.proposals.length;
     ed.status(n ? `${n} proposals at threshold ${threshold}: click one to reject it; ` +
@@ -106,13 +104,19 @@ export function mountProposing(ed) {
     ed.ui.proposals = [];
     if (cmd) ed.run(cmd);
     const added = cmd ? cmd.records.length : 0;
-    // "every proposal was rejected" only where there were some: else there was nothing to accept
-    const untaken = dim ? `the ${dim} dimmed place${dim === 1 ? " is" : "s are"} added only when clicked` : "";
-    ed.status(cmd ? `Added ${added} proposal${added === 1 ? "" : "s"}.` : shown > dim ? "Nothing was added: " +
-      `every proposal (${shown - dim}) was rejected${dim ? `, and ${untaken}` : ""}.` : shown ? `Nothing was added: ` +
-      `${untaken}.` : "Nothing to accept: there are no proposals. Ask for some first (Complete, Find copies or " +
-      "Find similar).", cmd ? "success" : "");
+    ed.status(cmd ? `Added ${added} proposal${added === 1 ? "" : "s"}.` : nothingAdded(shown, dim), cmd ? "success" : "");
     ed.changed();
   }
   return {similar, findCopies, completeNow, acceptProposals};
+}
+
+/** Why Enter added nothing, of `shown` proposals of which `dim` were dimmed and not taken: "every proposal was
+ * rejected" only where there were some. */
+function nothingAdded(shown, dim) {
+  if (!shown) {
+    return "Nothing to accept: there are no proposals. Ask for some first (Complete, Find copies or Find similar).";
+  }
+  const untaken = dim ? `the ${dim} dimmed place${dim === 1 ? " is" : "s are"} added only when clicked` : "";
+  if (shown === dim) return `Nothing was added: ${untaken}.`;
+  return `Nothing was added: every proposal (${shown - dim}) was rejected${dim ? `, and ${untaken}` : ""}.`;
 }

@@ -57,8 +57,8 @@ export function drawScene(ctx, {canvas, photo, seg, view, ui, fill}) {
     }
   }
   for (const p of ui.proposals) {  // a dimmed one (the photo does not confirm it) thin until taken
-    stroke(p, p.accepted === false ? (p.dimmed ? "#bbb" : "#888") : "#ffeb3b", p.dimmed && !p.accepted ? 1 : 2,
-      p.dimmed && !p.accepted ? [2, 3] : [6, 4]);
+    const faint = p.dimmed && !p.accepted;
+    stroke(p, faint ? "#bbb" : p.accepted === false ? "#888" : "#ffeb3b", faint ? 1 : 2, faint ? [2, 3] : [6, 4]);
   }
   drawScores(ctx, ui.proposals, sx, sy, view.scale);
   for (const c of chips(ui.proposals, (x, y) => [sx(x), sy(y)])) {  // one click: a whole row or column
