@@ -7,6 +7,7 @@ import math
 import numpy as np
 from PIL import Image
 
+from facaid.photo.nodata import LEFT_IN, clear_of, data_edges, held, nodata_mask, off_wedges
 from facaid.photo.vanishing import (
     Family,
     affine_frame,
@@ -275,12 +276,12 @@ def _upright(pts: np.ndarray) -> bool:
     return bool(np.all(np.minimum(angles, 90 - angles) <= UPRIGHT_DEG))
 
 
-def _widened(pts: np.ndarray, segs: np.ndarray, picture: np.ndarray) -> np.ndarray:
+def _widened(pts: np.ndarray, segs: np.ndarray, picture: np.ndarray, nodata: np.ndarray) -> np.ndarray:
     """A fronto-parallel facade's box (work pixels) moved out to the photo's edge on each side where the band between
     them is more of the facade: its colour that of the box (`COLOUR`: the wall goes on beyond the outermost
     windows) or as many lines per area (`BUSY`). The outermost strong lines of a rectified photo are often a
     window column's or a shop sign's, inside the facade (issue 57: the proposal cut a bay or a floor off most
-    rectified photos)."""
+    rectified photos). The photo's edge is where its data ends: a no-data wedge (``nodata``) is no band's."""
     h, w = picture.shape[:2]
     x0, y0 = pts[:, 0].min(), pts[:, 1].min()
     x1, y1 = pts[:, 0].max(), pts[:, 1].max()
@@ -292,20 +293,23 @@ def _widened(pts: np.ndarray, segs: np.ndarray, picture: np.ndarray) -> np.ndarr
         return float(segs[inside, 4].sum() / area)
 
     def colour(a, b, c, d) -> np.ndarray:
-        region = picture[int(b) : max(int(b) + 1, int(d)), int(a) : max(int(a) + 1, int(c))]
+        rows, cols = slice(int(b), max(int(b) + 1, int(d))), slice(int(a), max(int(a) + 1, int(c)))
+        region = picture[rows, cols][~nodata[rows, cols]]
         if not region.size:
             return np.full(picture.shape[2], np.inf)
         return np.median(region.reshape(-1, picture.shape[2]), axis=0)
 
     box, wall = density(x0, y0, x1, y1), colour(x0, y0, x1, y1)
     out = np.array([x0, y0, x1, y1], dtype=float)
-    for i, band in enumerate(((0, y0, x0, y1), (x0, 0, x1, y0), (x1, y0, w, y1), (x0, y1, x1, h))):
+    edges = data_edges(nodata, (x0, y0, x1, y1))
+    for i, band in enumerate(((edges[0], y0, x0, y1), (x0, edges[1], x1, y0), (x1, y0, edges[2], y1),
+                              (x0, y1, x1, edges[3]))):
         if min(band[2] - band[0], band[3] - band[1]) < 1:
             continue
         same = bool(np.isfinite(wall).all()) and float(np.abs(colour(*band) - wall).max()) <= COLOUR
         busy = box > 0 and density(*band) >= BUSY * box
         if same or busy:
-            out[i] = (0, 0, w, h)[i]
+            out[i] = edges[i]
     return np.array([[out[0], out[1]], [out[2], out[1]], [out[2], out[3]], [out[0], out[3]]])
 
 
@@ -325,7 +329,9 @@ def propose_corners(image: Image.Image) -> dict:
     vanishing points lie at infinity, the facade is bounded by each family's outermost strong lines (of at least
     `STRONG` times the strongest one's length). A family without two such lines is bounded by the photo's edges.
     ``confidence`` is the share of the quadrilateral's four sides that detected segments cover (0 for a side that
-    is the photo's edge); ``notes`` say what was guessed. Never raises for an image PIL decoded."""
+    is the photo's edge); ``notes`` say what was guessed. No-data wedges at the photo's edges (an earlier
+    rectification's pure black or white) are no facade: their borders do not vote, and the quadrilateral is moved off
+    them (`facaid.photo.nodata`). Never raises for an image PIL decoded."""
     w, h = image.size
     if min(w, h) < 1:
         return _fallback(w, h, "the photo is empty")
@@ -333,8 +339,28 @@ def propose_corners(image: Image.Image) -> dict:
     gh, gw = channels[0].shape
     if min(gw, gh) < MIN_WORK_SIDE:
         return _fallback(w, h, f"the photo is too small or too narrow to find lines in ({w}x{h})")
+    nodata = nodata_mask(channels[0])
+    found = _from_lines((w, h), channels, nodata)
+    if nodata.any():
+        scale = np.array([w / gw, h / gh])
+        pts = np.array(found["corners"]) / scale
+        cleared = clear_of(pts, nodata)
+        if np.abs(cleared - pts).max() * scale.max() > 0.5:
+            found["corners"] = [[round(float(x), 2), round(float(y), 2)] for x, y in cleared * scale]
+            found["notes"].append("the photo's no-data wedges at its edges (pure black, white or flat grey) are "
+                                  "left out")
+        elif held(pts, nodata) > LEFT_IN:
+            found["notes"].append("the facade runs deep into the photo's no-data wedges (pure black, white or flat "
+                                  "grey): they are left in, not to cut off a floor; drag a corner to leave them out")
+    return found
+
+
+def _from_lines(size: tuple[int, int], channels: list[np.ndarray], nodata: np.ndarray) -> dict:
+    """`propose_corners` from the photo's work channels, but for its no-data wedges' own step."""
+    w, h = size
+    gh, gw = channels[0].shape
     segs = detect_segments(*channels)
-    segs = segs[segs[:, 4] >= MIN_LENGTH * max(gw, gh)]
+    segs = off_wedges(segs[segs[:, 4] >= MIN_LENGTH * max(gw, gh)], nodata)
     rng = np.random.default_rng(0)  # the same photo, the same proposal
     hs, vs = split_families(segs)
     fh = _family(hs, (gw, gh), rng)
@@ -389,7 +415,7 @@ def propose_corners(image: Image.Image) -> dict:
         notes.append("the photo looks fronto-parallel already (the facade's lines are upright): rectifying it "
                      "changes little beyond the crop")
         scale = np.array([w / gw, h / gh])
-        pts = _widened(pts / scale, segs, np.stack(channels, axis=-1)) * scale
+        pts = _widened(pts / scale, segs, np.stack(channels, axis=-1), nodata) * scale
 
     outside = (pts < -0.5) | (pts > np.array([w, h]) + 0.5)
     if outside.any():

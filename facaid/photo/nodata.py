@@ -1,0 +1,122 @@
+"""No-data regions of a photo: the pure black, white or grey wedges an earlier rectification leaves at its edges, which
+the corner proposal (`facaid.photo.rectify.propose_corners`) must neither follow nor take in.
+
+A wedge is a region of almost pure black or white, or of one flat grey (some tools fill with grey), that touches
+the photo's edge, larger than a speck and nearly convex (its edges are straight: an overexposed sky is not one). Its
+straight border with the photo is a strong line that outvotes the facade's own, so the segments along it are dropped
+(`off_wedges`); and the proposal is moved off it as a rectangle of the facade's plane (`clear_of`), so that
+rectifying from it crops the facade and never skews it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+DARK, LIGHT = 8, 248  # luminance at most (at least) this is no data
+FLAT = 1  # or a region whose every pixel's 3 x 3 neighbourhood spans at most this many grey levels
+SPECK = 0.002  # of the photo's area: a smaller region at the edge is a speck, not a wedge
+MOST = 0.5  # a photo more black (white) than this is a dark (bright) picture, not one with wedges
+SOLID = 0.9  # a wedge fills at least this share of its convex hull (its edges are straight)
+NEAR = 3  # work pixels: a segment whose middle lies this near a wedge is its border
+LEFT_IN = 0.002  # of the quadrilateral's area: the no data it may still hold (JPEG's ringing at the border)
+KEEP = 0.9  # a wedge deep in the facade, to clear which would leave less of the quadrilateral, stays in it
+GRID = 200  # cells a side of the facade's plane that the proposal is cleared on
+
+
+def nodata_mask(luma: np.ndarray) -> np.ndarray:
+    """The no-data pixels of a photo's luminance (uint8): its wedges (see the module's docstring)."""
+    import cv2
+
+    out = np.zeros(luma.shape, dtype=bool)
+    square = np.ones((3, 3), np.uint8)
+    flat = (cv2.dilate(luma, square).astype(int) - cv2.erode(luma, square)) <= FLAT
+    for mask in (luma <= DARK, luma >= LIGHT, flat):
+        n, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=4)
+        edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+        for k in edge[edge > 0]:
+            if stats[k, cv2.CC_STAT_AREA] < SPECK * luma.size:
+                continue
+            region = labels == k
+            ys, xs = np.nonzero(region)
+            hull = cv2.convexHull(np.stack([xs, ys], axis=1).astype(np.int32))
+            if stats[k, cv2.CC_STAT_AREA] >= SOLID * max(1.0, cv2.contourArea(hull) + cv2.arcLength(hull, True) / 2):
+                out |= region
+    return out if out.mean() <= MOST else np.zeros(luma.shape, dtype=bool)
+
+
+def off_wedges(segments: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """The segments (N, 5: x1, y1, x2, y2, length, in the mask's pixels) but those along a wedge's border: whose
+    middle lies within `NEAR` pixels of no data."""
+    if not mask.any() or not len(segments):
+        return segments
+    near = _grown(mask, NEAR)
+    h, w = mask.shape
+    mx = np.clip(((segments[:, 0] + segments[:, 2]) / 2).round().astype(int), 0, w - 1)
+    my = np.clip(((segments[:, 1] + segments[:, 3]) / 2).round().astype(int), 0, h - 1)
+    return segments[~near[my, mx]]
+
+
+def held(pts: np.ndarray, mask: np.ndarray) -> float:
+    """The share of the quadrilateral ``pts`` (TL, TR, BR, BL, in the mask's pixels) that is no data."""
+    import cv2
+
+    inside = np.zeros(mask.shape, dtype=np.uint8)
+    cv2.fillPoly(inside, [pts.round().astype(np.int32)], 1)
+    area = int(inside.sum())
+    return float((inside.astype(bool) & mask).sum() / area) if area else 0.0
+
+
+def clear_of(pts: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """The quadrilateral ``pts`` (TL, TR, BR, BL, in the mask's pixels) moved off the no data, as a rectangle of the
+    facade's own plane: in the frame where ``pts`` is the unit square (`GRID` cells a side), the side whose next
+    `GRID`-th in takes out the most no data for what it gives up moves in, until at most `LEFT_IN` of the rest is no
+    data. So a thin wedge along the top takes the top down by its own height, and the proposal stays the facade's
+    rectangle: rectified from it, the facade is only cropped, never skewed. A wedge deep in the facade, which would
+    leave less than `KEEP` of it, stays in it (the caller says so): a floor cut off costs more than a black corner."""
+    import cv2
+
+    pts = pts.astype(np.float32)
+    if not mask.any():
+        return pts.astype(float)
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32)
+    to_photo = cv2.getPerspectiveTransform(square, pts)
+    centres = (np.arange(GRID, dtype=np.float32) + 0.5) / GRID
+    u, v = np.meshgrid(centres, centres)
+    where = cv2.perspectiveTransform(np.stack([u, v], axis=-1).reshape(-1, 1, 2), to_photo).reshape(GRID, GRID, 2)
+    h, w = mask.shape
+    bad = mask[np.clip(where[..., 1].round().astype(int), 0, h - 1), np.clip(where[..., 0].round().astype(int), 0,
+                                                                              w - 1)]
+    top, bottom, left, right = 0, GRID, 0, GRID
+    while bad[top:bottom, left:right].sum() > LEFT_IN * (bottom - top) * (right - left):
+        if (bottom - top) * (right - left) < KEEP * GRID * GRID:
+            return pts.astype(float)  # a wedge deep in the facade: the facade stays whole, the wedge in it
+        cut = {"top": bad[top, left:right].mean(), "bottom": bad[bottom - 1, left:right].mean(),
+               "left": bad[top:bottom, left].mean(), "right": bad[top:bottom, right - 1].mean()}
+        side = max(cut, key=cut.get)
+        top, bottom = top + (side == "top"), bottom - (side == "bottom")
+        left, right = left + (side == "left"), right - (side == "right")
+    rect = np.array([[left, top], [right, top], [right, bottom], [left, bottom]], np.float32) / GRID
+    return cv2.perspectiveTransform(rect.reshape(-1, 1, 2), to_photo).reshape(4, 2).astype(float)
+
+
+def data_edges(nodata: np.ndarray, box) -> tuple[float, float, float, float]:
+    """How far out from ``box`` (x0, y0, x1, y1, work pixels) the photo's data reaches on each side, across the
+    box's span: to the nearest line beyond it that is mostly no data, else to the photo's edge."""
+    h, w = nodata.shape
+    x0, y0, x1, y1 = (int(np.clip(round(v), 0, m)) for v, m in zip(box, (w, h, w, h), strict=True))
+    rows, cols = slice(y0, max(y0 + 1, y1)), slice(x0, max(x0 + 1, x1))
+    left = np.flatnonzero(nodata[rows, :x0].mean(axis=0) > 0.5)
+    top = np.flatnonzero(nodata[:y0, cols].mean(axis=1) > 0.5)
+    right = np.flatnonzero(nodata[rows, x1:].mean(axis=0) > 0.5)
+    bottom = np.flatnonzero(nodata[y1:, cols].mean(axis=1) > 0.5)
+    return (float(left.max() + 1) if len(left) else 0.0, float(top.max() + 1) if len(top) else 0.0,
+            float(x1 + right.min()) if len(right) else float(w), float(y1 + bottom.min()) if len(bottom) else float(h))
+
+
+def _grown(mask: np.ndarray, by: int) -> np.ndarray:
+    import cv2
+
+    return cv2.dilate(mask.astype(np.uint8), np.ones((2 * by + 1, 2 * by + 1), np.uint8)) > 0
+
+
+__all__ = ["clear_of", "data_edges", "held", "nodata_mask", "off_wedges"]
