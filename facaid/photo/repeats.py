@@ -67,9 +67,11 @@ def _crop(norm: np.ndarray, box: np.ndarray) -> tuple[np.ndarray, tuple[int, int
     return (patch, (mx, my)) if patch.std() > 1e-3 else None
 
 
-def _votes(norm: np.ndarray, patch: np.ndarray, at: tuple[int, int], axis: int) -> list[tuple[int, float]]:
-    """Shifts along ``axis`` (0: x, 1: y) where ``patch`` (whose top-left is ``at``) looks like itself, with
-    their NCC: the peaks of the response along its own row (column), none within the patch's size of another."""
+def _votes(norm: np.ndarray, patch: np.ndarray, at: tuple[int, int], axis: int,
+           margin: tuple[int, int]) -> list[tuple[int, float]]:
+    """Shifts along ``axis`` (0: x, 1: y) where ``patch`` (whose top-left is ``at``, with ``margin`` of context
+    around the element) looks like itself, with their NCC: the peaks of the response along its own row (column),
+    none within the element's own size of another (two windows of a pair nearly touch: their contexts overlap)."""
     import cv2
 
     ph, pw = patch.shape
@@ -85,7 +87,7 @@ def _votes(norm: np.ndarray, patch: np.ndarray, at: tuple[int, int], axis: int) 
     profile = r.max(axis=0) if axis == 0 else r.max(axis=1)
     profile = np.where(np.isfinite(profile), profile, -1.0)
     own = x if axis == 0 else y
-    size = pw if axis == 0 else ph
+    size = max(1, pw - 2 * margin[0] if axis == 0 else ph - 2 * margin[1])
     out = []
     taken = np.zeros(len(profile), dtype=bool)
     for i in np.argsort(-profile, kind="stable").tolist():
@@ -139,11 +141,23 @@ class _Reading:
             patch, (mx, my) = c
             at = (round(b[0]) - mx, round(b[1]) - my)
             for axis in (0, 1):
-                votes[axis].extend((s, v, k) for s, v in _votes(self.norm, patch, at, axis))
+                votes[axis].extend((s, v, k) for s, v in _votes(self.norm, patch, at, axis, (mx, my)))
         tol = TOLERANCE * max(self.norm.shape)
         sx, sy = _shifts(votes[0], tol, support), _shifts(votes[1], tol, support)
         return ([(dx, 0) for dx in sx] + [(0, dy) for dy in sy]
                 + [(dx, dy) for dx in sx[:MAX_SUMS] for dy in sy[:MAX_SUMS]])
+
+    def own_shifts(self, k: int) -> list[tuple[int, int]]:
+        """Where element ``k`` alone looks like itself along its own row and column (working pixels), exactly, and
+        their sums: the places a copy of it stands that the drawn elements' shared repeats (clustered, the best
+        supported kept) may have rounded off or left out."""
+        if self.crops[k] is None:
+            return []
+        patch, (mx, my) = self.crops[k]
+        at = (round(self.boxes[k, 0]) - mx, round(self.boxes[k, 1]) - my)
+        sx = [s for s, _ in _votes(self.norm, patch, at, 0, (mx, my))][:MAX_SHIFTS]
+        sy = [s for s, _ in _votes(self.norm, patch, at, 1, (mx, my))][:MAX_SHIFTS]
+        return [(dx, 0) for dx in sx] + [(0, dy) for dy in sy] + [(dx, dy) for dx in sx for dy in sy]
 
     def _core(self, k: int) -> np.ndarray | None:
         """Element ``k``'s patch without its context, None where that is too small or flat: read once, for every
@@ -169,13 +183,13 @@ class _Reading:
         if a < 0 or t < 0 or a + pw + 2 * JITTER > w or t + ph + 2 * JITTER > h:
             return None
         r = cv2.matchTemplate(self.norm[t: t + ph + 2 * JITTER, a: a + pw + 2 * JITTER], patch, cv2.TM_CCOEFF_NORMED)
+        core = self._core(k)  # the element alone: what its context shares with its neighbours'
+        if core is not None:  # the place where both look most like it: the context's best alone may miss the core
+            there = self.norm[t + my: t + ph + 2 * JITTER - my, a + mx: a + pw + 2 * JITTER - mx]
+            r = np.minimum(r, cv2.matchTemplate(there, core, cv2.TM_CCOEFF_NORMED))
         r = np.where(np.isfinite(r), r, -1.0)
         iy, ix = divmod(int(r.argmax()), r.shape[1])
         sim = float(r[iy, ix])
-        core = self._core(k)  # the element alone: what its context shares with its neighbours'
-        if core is not None:
-            there = self.norm[t + iy + my: t + iy + ph - my, a + ix + mx: a + ix + pw - mx]
-            sim = min(sim, float(cv2.matchTemplate(there, core, cv2.TM_CCOEFF_NORMED)[0, 0]))
         dx, dy = (a + ix - x) / self.to_work[0], (t + iy - y) / self.to_work[1]  # in the segmentation's pixels
         return self.drawn[k, 1:] + np.array([dx, dy, dx, dy]), sim
 
@@ -237,7 +251,8 @@ def unit_copies(levels: Levels, drawn: np.ndarray, unit: np.ndarray) -> list[Cop
     if reading.flat:
         return []
     out = []
-    for shift in reading.shifts(1):
+    shifts = reading.shifts(1)
+    for shift in dict.fromkeys(shifts + [s for s in reading.own_shifts(0) if s not in set(shifts)]):
         head = reading.carry(0, shift)
         if head is None or head[1] < MATCH:
             continue
