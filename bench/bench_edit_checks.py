@@ -87,7 +87,7 @@ def saves(trees: dict, repeat: int) -> None:
     from django.core.management import call_command
     from rest_framework.test import APIClient
 
-    from facaid.parameters import named_parameters, set_parameter
+    from facaid.editing.parameters import named_parameters, set_parameter
     from webapp.facades import editcheck
     from webapp.facades.models import Procedure
 

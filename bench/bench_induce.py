@@ -1,4 +1,4 @@
-"""Structure induction (`facaid.induce`) on generated facades, clean and with hand-drawn-like jitter.
+"""Structure induction (`facaid.reading.induce`) on generated facades, clean and with hand-drawn-like jitter.
 
     .venv/bin/python bench/bench_induce.py [--count 40] [--sigma 0.004] [--snap 0.01] [--tolerance 0.15]
 
@@ -22,8 +22,8 @@ from facaid.augmentation import jitter
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
 from facaid.grammar.decompose import procedure_from_segmentation
-from facaid.induce import induce_procedure
 from facaid.metrics import procedure_accuracy
+from facaid.reading.induce import induce_procedure
 from facaid.segmentation import flatten
 from facaid.sizing import fit_sizes
 

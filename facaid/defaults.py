@@ -4,8 +4,8 @@ imports nothing (the web process and the command-line parser need them without l
 # Best-of-K decoding: the greedy candidate and K - 1 samples at TEMPERATURE, ranked by
 # `facaid.decoding.rank_key`. On 200 held-out facades (dataset seed 3000) the exact-structure rate was 58.0 %
 # greedy, 62-63 % best of 8 and 61.5-64.5 % best of 16 (two draws of samples). The K rows share the input's
-# cross-attention (`facaid.decoder.DecoderState`), so decoding 16 costs about 2.8x the greedy latency on 2 CPU cores and
-# 8 about 1.9x; `facaid.reconstruct` takes as long with 16 as with 8 (bench/bench_reconstruct.py).
+# cross-attention (`facaid.model.decoder.DecoderState`), so decoding 16 costs about 2.8x the greedy latency on
+# 2 CPU cores and 8 about 1.9x; `facaid.reconstruct` takes as long with 16 as with 8 (bench/bench_reconstruct.py).
 DEFAULT_K = 16
 MAX_K = 32  # the most candidates a job may ask for
 TEMPERATURE = 0.7  # exact structure 64.5 % at 0.7 against 61.5 % at 1.0 (same facades, best of 16)

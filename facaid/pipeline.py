@@ -7,7 +7,7 @@ A second chance: when the sized best candidate reproduces less than ``retry_belo
 structure is likely wrong (sizing cannot change counts or labels), so ``retry_k`` more samples are decoded and
 every candidate gets the geometric fit alone; the best of those is sized fully and kept if it does better.
 Before that (unless a prefix is given or ``induce`` is off) the structure induced straight from the segmentation
-(`facaid.induce`: guillotine cuts folded into repeats) is sized too and kept if it does better, and then
+(`facaid.reading.induce`: guillotine cuts folded into repeats) is sized too and kept if it does better, and then
 the sampling is skipped. ``result.source`` says which kind of structure won.
 
 Two structures (``structure``): the model's, where it wins, is compact and editable already (a generated facade);
@@ -42,11 +42,11 @@ from facaid.defaults import DEFAULT_K, STRUCTURES, TEMPERATURE
 from facaid.editing.check import MORE, check_edits
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
-from facaid.induce import induce_procedure
 from facaid.labels import FACADE
 from facaid.metrics import element_leaves, procedure_accuracy, unexplained
 from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
+from facaid.reading.induce import induce_procedure
 from facaid.reading.lattice import readings
 from facaid.segmentation import Segmentation, flatten, flatten_array, rasterize
 from facaid.sizing import fit_sizes, forget_tables
@@ -74,7 +74,7 @@ class Reconstruction:
     iou: dict[str, float]
     timings: dict[str, float] = field(default_factory=dict)  # seconds per stage
     retried: bool = False  # the second chance ran (the first sized candidate was below retry_below)
-    source: str = "model"  # "model" (a decoded candidate) or "induced" (facaid.induce)
+    source: str = "model"  # "model" (a decoded candidate) or "induced" (facaid.reading.induce)
     shortcut: bool = False  # the decoded structure was far behind the induced one and was not sized
     denoised: bool = False  # the model's structure was kept over a closer-fitting induced one (reads_through_noise)
     structure: str = "exact"  # what ``procedure`` is: "editable" (floors of tiles: the model's or the lattice's)

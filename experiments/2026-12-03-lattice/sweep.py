@@ -17,7 +17,7 @@ import numpy as np
 from facaid.augmentation import annotator_noise
 from facaid.evaluation.real import load_records
 from facaid.grammar.execute import to_segmentation
-from facaid.induce import induce_procedure
+from facaid.reading.induce import induce_procedure
 from facaid.metrics import compression, pixel_accuracy
 from facaid.paths import DEFAULT_CMP
 from facaid.segmentation import flatten, rasterize

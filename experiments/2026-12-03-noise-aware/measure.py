@@ -17,7 +17,7 @@ from facaid.evaluation.real import load_records
 from facaid.generator import generate
 from facaid.generator.stats import irregularity
 from facaid.grammar.execute import to_segmentation
-from facaid.induce import induce_procedure
+from facaid.reading.induce import induce_procedure
 from facaid.labels import BACKGROUND, FACADE
 from facaid.metrics import compression, pixel_accuracy
 from facaid.paths import DEFAULT_CMP

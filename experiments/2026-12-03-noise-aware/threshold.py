@@ -13,7 +13,7 @@ import json
 from facaid.augmentation import annotator_noise
 from facaid.evaluation.real import load_records
 from facaid.grammar.execute import to_segmentation
-from facaid.induce import induce_procedure
+from facaid.reading.induce import induce_procedure
 from facaid.metrics import element_leaves, pixel_accuracy, unexplained
 from facaid.pipeline import default_model, reconstruct
 from facaid.segmentation import flatten, rasterize

@@ -14,7 +14,7 @@ from facaid.augmentation import annotator_noise
 from facaid.evaluation.real import load_records
 from facaid.grammar.execute import execute_with_boxes, to_segmentation
 from facaid.grammar.procedure import Procedure, ProcedureError
-from facaid.induce import induce_procedure
+from facaid.reading.induce import induce_procedure
 from facaid.metrics import compression, element_leaves, pixel_accuracy
 from facaid.paths import DEFAULT_CMP
 from facaid.pipeline import default_model, reconstruct

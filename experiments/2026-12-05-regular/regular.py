@@ -1,6 +1,6 @@
 """Regular structures: a compact procedure read off a label map that tolerates an annotator's noise.
 
-`facaid.induce` cuts only where no rectangle is crossed and folds only siblings of exactly one shape, so on a
+`facaid.reading.induce` cuts only where no rectangle is crossed and folds only siblings of exactly one shape, so on a
 hand-made annotation (edges a few pixels apart, a blind open here and closed there) it copies every element:
 about one leaf per annotated rectangle. This module reads the same label map the way a person writes a facade:
 
@@ -25,8 +25,8 @@ from __future__ import annotations
 import numpy as np
 
 from facaid.grammar.procedure import Procedure, ProcedureError
-from facaid.induce import _node as to_node
-from facaid.induce import _Tree as InducedTree
+from facaid.reading.induce import _node as to_node
+from facaid.reading.induce import _Tree as InducedTree
 from facaid.labels import LABELS
 from facaid.segmentation import Segmentation, rasterize
 

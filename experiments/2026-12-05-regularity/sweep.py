@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from facaid.evaluation.real import load_records
-from facaid.induce import induce_procedure
+from facaid.reading.induce import induce_procedure
 from facaid.metrics import compression, element_leaves
 from facaid.paths import DEFAULT_CMP
 from facaid.segmentation import flatten

@@ -9,7 +9,7 @@ from PIL import Image, ImageDraw
 from facaid.editing.check import judge, label_map
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.formats.render import colorize
-from facaid.parameters import named_parameters, set_parameter
+from facaid.editing.parameters import named_parameters, set_parameter
 from facaid.paths import DEFAULT_CMP
 from facaid.reading.lattice import read_lattice
 from facaid.segmentation import flatten, rasterize

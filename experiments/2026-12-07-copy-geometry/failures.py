@@ -10,7 +10,7 @@ from facaid.reading import lattice
 from facaid.evaluation.editability import flat_rows, lattice as rows_cols
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.grammar.procedure import Procedure
-from facaid.parameters import named_parameters, set_parameter
+from facaid.editing.parameters import named_parameters, set_parameter
 from facaid.paths import DEFAULT_CMP
 from facaid.segmentation import flatten
 from facaid.sizing import fit_sizes

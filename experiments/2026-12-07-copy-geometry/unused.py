@@ -15,7 +15,7 @@ from facaid.evaluation.editability import flat_rows, lattice as rows_cols
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure, Size
 from facaid.grammar.repeats import along_path
-from facaid.parameters import named_parameters, set_parameter
+from facaid.editing.parameters import named_parameters, set_parameter
 from facaid.segmentation import rasterize
 
 ap = argparse.ArgumentParser()

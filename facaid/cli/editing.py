@@ -9,10 +9,10 @@ from facaid.cli.common import CliError, read_json, write_json
 
 
 def cmd_vary(args: argparse.Namespace) -> None:
+    from facaid.editing.variation import vary
     from facaid.formats.render import render_segmentation, side_by_side
     from facaid.grammar.execute import to_segmentation
     from facaid.grammar.procedure import Procedure
-    from facaid.variation import vary
 
     proc = Procedure.from_dict(read_json(args.input))
     variants = vary(proc, args.n, args.seed, dict(args.range) if args.range else None)
@@ -52,8 +52,8 @@ def add_vary(sub) -> None:
 
 
 def cmd_params(args: argparse.Namespace) -> None:
+    from facaid.editing.parameters import named_parameters, set_parameters
     from facaid.grammar.procedure import Procedure
-    from facaid.parameters import named_parameters, set_parameters
 
     proc = Procedure.from_dict(read_json(args.input))
     if args.set:

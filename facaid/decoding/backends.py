@@ -1,7 +1,7 @@
 """What computes the next token's logits for the decoding loop: one interface over two backends.
 
 - the C step (`facaid.native`), where it builds: K rows in shards on torch's threads;
-- `facaid.decoder.DecoderState`: the model's own decoder blocks stepped with their key/value cache.
+- `facaid.model.decoder.DecoderState`: the model's own decoder blocks stepped with their key/value cache.
 Both give the logits of the teacher-forced `FacaidModel.decode` (to about 1e-5; tests/decoding/test_native_step.py,
 tests/decoding/test_decoding.py).
 """
@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import torch
 
-from facaid.decoder import DecoderState
 from facaid.decoding.step import native_decoder
 from facaid.model import FacaidModel
+from facaid.model.decoder import DecoderState
 
 
 class Stepper:

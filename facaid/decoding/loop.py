@@ -31,7 +31,7 @@ class Candidate:
     accuracy: float | None = None  # pixel accuracy against the input, when scored
     count_error: int | None = None  # elements too many or too few against the input, when scored
     error: str | None = None  # why an unconstrained sequence is invalid
-    swaps: int = 0  # subtrees swapped in from other candidates (`facaid.composition`), 0 for a decoded one
+    swaps: int = 0  # subtrees swapped in from other candidates (`facaid.decoding.composition`), 0 for a decoded one
 
 
 def prefix_from_procedure(tokenizer: Tokenizer, proc: Procedure, nodes: int) -> list[int]:
@@ -56,7 +56,7 @@ def decode(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentation, *, k: in
     ids are then those of the merged tree, its log-probability that of the decoded sequence.
 
     With ``sample``, the first ``greedy`` rows are still decoded greedily, in the same batch as the samples.
-    The rows step with the model's decoder blocks and their key/value cache (`facaid.decoder.DecoderState`), or
+    The rows step with the model's decoder blocks and their key/value cache (`facaid.model.decoder.DecoderState`), or
     with ``native`` with the C step of `facaid.native` when it is available (the same logits to about 1e-5);
     K > 1 rows in shards on torch's threads, torch held to one thread meanwhile.
 

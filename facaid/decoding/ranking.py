@@ -3,14 +3,14 @@
 `ranked_candidates` decodes the greedy candidate and K-1 samples in one batch (`facaid.decoding.loop.decode`),
 ranks them by pixel accuracy in whole points, less a point for every element too many or too few, then
 likelihood (`rank_key`), and puts first the best candidate composed with the others region by region
-(`facaid.composition`); `best_of_k` keeps the first.
+(`facaid.decoding.composition`); `best_of_k` keeps the first.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from facaid.composition import compose as compose_candidates
+from facaid.decoding.composition import compose as compose_candidates
 from facaid.decoding.loop import Candidate, decode
 from facaid.defaults import DEFAULT_K, TEMPERATURE
 from facaid.grammar.execute import execute, to_segmentation
@@ -56,7 +56,7 @@ def ranked_candidates(model: FacaidModel, tokenizer: Tokenizer, seg: Segmentatio
     decoded then, the same ones as in one batch with it.
 
     With ``compose`` (and K > 1, no ``prefix``), the first candidate becomes its composition with the others
-    (`facaid.composition.compose`: each region's best subtree) when that differs from it; the composition
+    (`facaid.decoding.composition.compose`: each region's best subtree) when that differs from it; the composition
     carries the log-probability of the candidate it started from and ``swaps`` > 0. The candidates follow."""
     if greedy is None:
         candidates = decode(model, tokenizer, seg, k=k, sample=k > 1, greedy=1, temperature=temperature, seed=seed,

@@ -2,7 +2,7 @@
 
 Greedy decoding takes a few hundred steps of one token, and a step is some 80 torch operations on vectors of
 128: their fixed cost, not the arithmetic, sets the time. `NativeDecoder` does the whole step in one call of a
-small C function (the same arithmetic as `facaid.decoder.DecoderState.step`; the tests check the logits to
+small C function (the same arithmetic as `facaid.model.decoder.DecoderState.step`; the tests check the logits to
 1e-5). It takes K rows of one input: greedy decoding steps one row (0.56x the torch step's time), best of K
 steps K rows split into `threads` shards, each shard one call on its own thread (ctypes lets go of the GIL for
 the call), while torch itself is held to one thread (`torch_threads`), so that its OpenMP workers, which spin
@@ -22,8 +22,8 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import torch
 
-from facaid.decoder import DecoderState
 from facaid.model import FacaidModel
+from facaid.model.decoder import DecoderState
 from facaid.native import load
 
 _pool: ThreadPoolExecutor | None = None

@@ -28,11 +28,11 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from facaid.editing.parameters import named_parameters, set_parameter
 from facaid.editing.windows import WIDE, centre_bands, lattice, window_boxes
 from facaid.grammar.execute import first_boxes, flat_rows, label_map
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID
-from facaid.parameters import named_parameters, set_parameter
 from facaid.segmentation import region_boxes
 
 KEEP = 0.98  # share of the old pixels a new floor leaves where they were

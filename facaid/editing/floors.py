@@ -8,12 +8,12 @@ import json
 
 import numpy as np
 
+from facaid.editing.resizing import copy_lengths
 from facaid.grammar.execute import first_boxes, flat_rows
 from facaid.grammar.procedure import Node, Override, Procedure, Size
 from facaid.grammar.repeats import copies_moved
 from facaid.labels import LABEL_ID
 from facaid.metrics import scaled_procedure_map
-from facaid.resizing import copy_lengths
 from facaid.segmentation import region_boxes
 
 TWIN = 0.9  # a floor another repeats this closely is as good to take out as any other such (the judge's likeness)

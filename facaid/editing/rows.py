@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from facaid.editing.resizing import repeat_unit
 from facaid.grammar.execute import label_map
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.procedure import Node, Override, Procedure, Size
-from facaid.resizing import repeat_unit
 
 
 def building_of(proc: Procedure, path: str) -> str:

@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from facaid.editing.check import check_edits
+from facaid.editing.parameters import named_parameters, set_parameter
 from facaid.editing.windows import lattice, pitches, segmentation_lattice, window_boxes
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE
 from facaid.metrics import appears
-from facaid.parameters import named_parameters, set_parameter
 from facaid.segmentation import region_boxes
 
 KEPT = 0.5  # an element is kept when the procedure paints at least this share of its pixels with its label

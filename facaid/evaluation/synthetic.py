@@ -210,7 +210,7 @@ def summarize(records: list[dict], seed: int, best_of: int = 0) -> dict:
     best = None
     if best_of > 1:
         blat = [r["best"]["latency"] for r in records]
-        best = {"k": best_of, "temperature": TEMPERATURE, "composed": True,  # `facaid.composition`
+        best = {"k": best_of, "temperature": TEMPERATURE, "composed": True,  # `facaid.decoding.composition`
                 **ted_figures(best_teds),
                 "latency_ms": {"median": 1000 * statistics.median(blat),
                                "p90": 1000 * float(np.percentile(blat, 90))},

@@ -16,8 +16,8 @@ How the grammar maps:
   (named ``…_mx`` / ``…_my``).
 - CGA's y axis goes up where the procedure's goes down: every split along y lists its children bottom to top.
 - A leaf paints its label's palette colour (``Background`` is ``NIL``): the rules to replace with real geometry.
-- The named lengths of `facaid.parameters` (floor height, ...) are ``attr``s with a ``@Range``, and the parts they
-  stand for are sized by them; no part of a split is under `MIN_PART_M` (its neighbour takes its length).
+- The named lengths of `facaid.editing.parameters` (floor height, ...) are ``attr``s with a ``@Range``, and the
+  parts they stand for are sized by them; no part of a split is under `MIN_PART_M` (its neighbour takes its length).
 """
 
 from __future__ import annotations
@@ -119,16 +119,16 @@ def _camel(word: str) -> str:
 
 
 MIN_PART_M = 0.01  # no part of a split is written shorter than this: it goes to its neighbour
-ROUNDING = 0.006  # pixels: a named length is given to 2 decimals (`facaid.parameters`)
+ROUNDING = 0.006  # pixels: a named length is given to 2 decimals (`facaid.editing.parameters`)
 
 
 def _attributes(proc: Procedure, boxes: dict, scale: float) -> tuple[list[tuple[str, str, float, float, float]],
                                                                       dict[int, str]]:
-    """The named lengths (`facaid.parameters`) as CGA attributes: (name, label, metres, low, high) each, and the
+    """The named lengths (`facaid.editing.parameters`) as CGA attributes: (name, label, metres, low, high) each, and the
     nodes whose size is that attribute: those whose length is the parameter's to its rounding (a hundredth of a
     pixel); one a fraction of a pixel off keeps its own length, as a floating size beside others would otherwise
     share its split in other proportions than the procedure's."""
-    from facaid.parameters import AXES, named_parameters
+    from facaid.editing.parameters import AXES, named_parameters
 
     attrs, uses = [], {}
     nodes = dict(proc.nodes())

@@ -1,5 +1,5 @@
 """Guillotine cuts: cutting a set of rectangles into two groups along a full line, the operation behind the exact
-decomposition (`facaid.grammar.decompose`), the induced structures (`facaid.induce`) and the sizing optimizer's
+decomposition (`facaid.grammar.decompose`), the induced structures (`facaid.reading.induce`) and the sizing optimizer's
 starting partition (`facaid.sizing`).
 
 Rectangles are int64 rows ``(label, x0, y0, x1, y1)``; an axis is addressed by the columns of its low and high

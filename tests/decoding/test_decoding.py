@@ -160,10 +160,10 @@ def test_decode_greedy_sampling_and_prefix(tiny_model):
 @pytest.mark.parametrize("k, padded, shared", [(1, False, False), (3, False, False), (2, True, False),
                                                (3, False, True)])
 def test_decoder_state_steps_give_the_teacher_forced_logits(tiny_model, k, padded, shared):
-    """`facaid.decoder`: the blocks stepped with their key/value cache (one token a row, K rows on one memory row
+    """`facaid.model.decoder`: the blocks stepped with their key/value cache (one token a row, K rows on one memory row
     or their own) compute what the teacher-forced pass over the whole sequence computes."""
-    from facaid.decoder import DecoderState
     from facaid.model import batch_inputs, batch_outputs
+    from facaid.model.decoder import DecoderState
 
     samples = [generate(s) for s in (4, 5)[: 2 if padded else 1]]
     rows = [TOK.encode_segmentation(s.segmentation) for s in samples]
@@ -198,8 +198,8 @@ def biased_model(tiny_model):
 
 @pytest.mark.parametrize("k, shared, padded", [(1, False, False), (3, True, False), (2, False, True)])
 def test_decoder_state_applies_the_box_bias(tiny_model, biased_model, k, shared, padded):
-    from facaid.decoder import DecoderState
     from facaid.model import batch_inputs, batch_outputs
+    from facaid.model.decoder import DecoderState
 
     samples = [generate(4), generate(5)] if padded else [generate(4)] * k
     rects, mask = batch_inputs([TOK.encode_segmentation(s.segmentation) for s in samples])

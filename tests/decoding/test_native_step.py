@@ -4,11 +4,11 @@ import pytest
 import torch
 
 import facaid.native
-from facaid.decoder import DecoderState
 from facaid.decoding import decode
 from facaid.decoding import step as native
 from facaid.generator import generate
 from facaid.model import batch_inputs, batch_outputs
+from facaid.model.decoder import DecoderState
 from facaid.training.surgery import with_box_bias
 
 pytestmark = pytest.mark.skipif(native.library() is None, reason="no C compiler to build the native step")

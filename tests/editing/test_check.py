@@ -4,10 +4,10 @@ import numpy as np
 from grammar_helpers import example, tile
 
 from facaid.editing.check import band_holds, band_lattice, check_edits, insertion, judge, judge_insert, label_map
+from facaid.editing.parameters import set_parameter
 from facaid.generator import generate_procedure
 from facaid.grammar.procedure import Node, Override, Procedure, Size
 from facaid.labels import LABEL_ID
-from facaid.parameters import set_parameter
 
 
 def floors_map(n: int, odd: int | None = None) -> np.ndarray:
@@ -141,8 +141,8 @@ def test_a_floor_fewer_leaves_the_copy_that_alone_lays_out_the_floors_pattern():
     from grammar_helpers import facade
 
     from facaid.editing.floors import plain_floor
+    from facaid.editing.parameters import _floor_repeats, _Instances, normalised
     from facaid.grammar.procedure import Node, Size
-    from facaid.parameters import _floor_repeats, _Instances, normalised
 
     def row(window: str) -> Node:
         out = Node.repeat("x", 5, [(Size("flt", 60), tile(window=window))], role="floor")

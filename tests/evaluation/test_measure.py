@@ -4,10 +4,10 @@ matrix counted in blocks."""
 import numpy as np
 import pytest
 
+from facaid.editing.variation import vary
 from facaid.generator import generate
 from facaid.labels import LABELS
 from facaid.metrics import class_iou, confusion, measure, procedure_accuracy, procedure_iou
-from facaid.variation import vary
 
 
 @pytest.mark.parametrize("seed", [0, 3, 4])

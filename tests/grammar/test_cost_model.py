@@ -11,6 +11,7 @@ from grammar_helpers import doc, example, nested, probe, random_exceptions
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from facaid.editing.parameters import named_parameters
 from facaid.formats.cga import procedure_cga
 from facaid.generator import generate_procedure
 from facaid.grammar.checks import least_units, least_units_of_json
@@ -19,7 +20,6 @@ from facaid.grammar.layout import count_expansion, expand_over, layout
 from facaid.grammar.limits import MAX_INSTANCES
 from facaid.grammar.procedure import Node, Override, Procedure, ProcedureError, Size
 from facaid.grammar.repeats import expanded_count, pattern_child
-from facaid.parameters import named_parameters
 
 
 def units(node, w: float, h: float, pending: list | None = None) -> int:

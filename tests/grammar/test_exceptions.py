@@ -12,6 +12,7 @@ import torch
 from grammar_helpers import example, facade, leaf, plain_facade, random_exceptions, tile
 
 import facaid.grammar as grammar_pkg
+from facaid.editing.parameters import named_parameters, normalised, set_parameter
 from facaid.generator import generate_procedure
 from facaid.grammar.differentiable import compile_plan, execute_plan
 from facaid.grammar.execute import execute, first_boxes, flat_rows, leaf_array
@@ -27,7 +28,6 @@ from facaid.grammar.procedure import (
 from facaid.grammar.repeats import copies_moved, most_typical, recount
 from facaid.labels import LABEL_ID
 from facaid.native import rects
-from facaid.parameters import named_parameters, normalised, set_parameter
 from facaid.segmentation import flatten_array_numpy, rasterize, region_boxes
 from facaid.tokenizer import Tokenizer
 

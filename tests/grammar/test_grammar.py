@@ -279,10 +279,10 @@ def test_the_cost_model_counts_every_instance_and_refuses_a_crafted_tree_before_
 
 
 def test_a_work_budget_bounds_the_trees_one_request_makes():
+    from facaid.editing.parameters import set_parameters
     from facaid.generator import generate_procedure
     from facaid.grammar.budget import WorkLimitError, spent, work_budget
     from facaid.grammar.layout import count_expansion
-    from facaid.parameters import set_parameters
 
     proc = generate_procedure(3)
     cost = count_expansion(proc.root, proc.width, proc.height).instances

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from facaid.composition import compose, single_regions
+from facaid.decoding.composition import compose, single_regions
 from facaid.evaluation.ted import tree_edit_distance
 from facaid.grammar import Node, Procedure, Size
 from facaid.grammar.execute import to_segmentation

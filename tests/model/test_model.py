@@ -36,7 +36,7 @@ def test_padding_does_not_change_a_sequence():
 
 
 def test_cached_and_uncached_decoding_agree():
-    from facaid.decoder import DecoderState
+    from facaid.model.decoder import DecoderState
 
     model, tok = tiny()
     model.eval()

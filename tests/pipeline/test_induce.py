@@ -1,16 +1,16 @@
 import numpy as np
 import pytest
 
+from facaid.editing.variation import resize
 from facaid.generator import generate
 from facaid.grammar.decompose import procedure_from_segmentation
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure, validate
-from facaid.induce import induce_procedure
 from facaid.labels import LABEL_ID
 from facaid.metrics import procedure_accuracy
 from facaid.pipeline import reconstruct
+from facaid.reading.induce import induce_procedure
 from facaid.segmentation import Rect, Segmentation, flatten, rasterize
-from facaid.variation import resize
 
 
 def _grid(jitter: int = 0, seed: int = 0) -> Segmentation:

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from facaid.cli import main
+from facaid.editing.parameters import NAMES, named_parameters, normalised, set_parameter, set_parameters
 from facaid.formats.cga import procedure_cga
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.procedure import Node, Procedure, Size
 from facaid.labels import LABEL_ID
-from facaid.parameters import NAMES, named_parameters, normalised, set_parameter, set_parameters
 from facaid.segmentation import rasterize
 
 
@@ -208,7 +208,7 @@ def test_cli_lists_and_sets(tmp_path, capsys):
 
 
 def test_variations_draw_named_parameters_from_ranges(tmp_path):
-    from facaid.variation import vary
+    from facaid.editing.variation import vary
 
     proc = _built()
     variants = vary(proc, 8, seed=3, ranges={"floors": (4, 7), "floor_height": (40, 50)})

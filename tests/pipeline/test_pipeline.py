@@ -46,7 +46,7 @@ def test_a_real_facade_comes_back_editable_with_the_exact_one_beside(tiny):
     and bays to edit; the exact one rides along, and ``structure="exact"`` swaps them."""
     from grammar_helpers import real_like
 
-    from facaid.parameters import named_parameters
+    from facaid.editing.parameters import named_parameters
 
     model, tok = tiny
     seg = real_like()

@@ -5,11 +5,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from facaid.cli import main
+from facaid.editing.parameters import named_parameters
+from facaid.editing.variation import change_count, resize, swap, vary, with_count, with_size
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar import Procedure, ProcedureError, execute, validate
 from facaid.labels import LABEL_ID, LABELS
-from facaid.parameters import named_parameters
-from facaid.variation import change_count, resize, swap, vary, with_count, with_size
 
 
 def windows(proc):

@@ -5,13 +5,13 @@ import numpy as np
 import pytest
 from grammar_helpers import real_like
 
+from facaid.editing.parameters import named_parameters, set_parameter
 from facaid.evaluation.editability import editability, kept_elements, segmentation_lattice
 from facaid.generator import generate
 from facaid.grammar.execute import execute, flat_rows, to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.labels import GLASS, LABEL_ID
 from facaid.metrics import pixel_accuracy
-from facaid.parameters import named_parameters, set_parameter
 from facaid.reading import lattice
 from facaid.segmentation import Segmentation, flatten, rasterize, region_boxes
 from facaid.sizing import fit_sizes

@@ -13,11 +13,11 @@ import pytest
 from grammar_helpers import doc
 
 from facaid.editing.check import Verdict, check_edits
+from facaid.editing.parameters import named_parameters
+from facaid.editing.variation import vary
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
 from facaid.grammar.layout import count_expansion
-from facaid.parameters import named_parameters
-from facaid.variation import vary
 from webapp.facades import editcheck
 from webapp.facades.models import Procedure
 

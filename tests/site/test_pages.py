@@ -217,9 +217,9 @@ def test_the_front_page_shows_a_newcomer_what_it_does_from_the_demo(alice, bob):
     and a first step: sign up and upload, or try the demo without an account."""
     from django.core.cache import caches
 
+    from facaid.editing.parameters import named_parameters
     from facaid.generator import generate
     from facaid.grammar import Procedure as Tree
-    from facaid.parameters import named_parameters
     from webapp.facades.example import VARIANTS
 
     home = Client().get("/").content.decode()

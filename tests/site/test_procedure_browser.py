@@ -15,9 +15,9 @@ import pytest
 from grammar_helpers import probe
 from site_helpers import collect_errors, login
 
+from facaid.editing.variation import vary
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
-from facaid.variation import vary
 from webapp.facades import versions
 from webapp.facades.models import Procedure, Segmentation
 
@@ -239,7 +239,7 @@ def test_a_re_run_that_fits_worse_is_shown_beside_the_version_it_continued(live_
 def test_named_parameters_first_the_tree_in_advanced(live_server, alice, browser, tmp_path):
     """The named parameters are shown first and the raw tree is closed; a floor more re-renders a facade a floor
     taller, the tree follows, and saving keeps it as version 2."""
-    from facaid.parameters import named_parameters
+    from facaid.editing.parameters import named_parameters
 
     data = generate(3).procedure.to_dict()
     proc = Procedure.objects.create(owner=alice, data=data, visibility="private")
@@ -279,8 +279,8 @@ def test_picture_and_tree_select_each_other(live_server, alice, browser, tmp_pat
     """A click on a window in the picture selects its node in the tree (the advanced panel opens on it) and the
     parameters that stand for it, and outlines every copy it draws; a click on a parameter's name or on a node
     outlines what it stands for; a click on no element clears the selection."""
+    from facaid.editing.parameters import named_parameters
     from facaid.formats.relief import drawn_leaves
-    from facaid.parameters import named_parameters
 
     tree = generate(3).procedure
     proc = Procedure.objects.create(owner=alice, data=tree.to_dict(), visibility="private")
@@ -421,7 +421,7 @@ def test_sharing_asks_whether_to_share_the_photo_and_the_overlay_follows(live_se
 
 def test_the_overlay_hides_while_the_procedure_is_not_the_photos_size(live_server, alice, facade_photo, browser):
     """A newcomer saw a floor more drawn stretched over the photo, as if the reconstruction had broken."""
-    from facaid.parameters import named_parameters
+    from facaid.editing.parameters import named_parameters
 
     _, seg = facade_photo
     proc = _faithful(alice, seg)  # the photo's size

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from facaid.editing.variation import vary
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
 from facaid.grammar import to_segmentation
@@ -18,7 +19,6 @@ from facaid.labels import LABELS
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
-from facaid.variation import vary
 from webapp.facades.models import Job, Procedure, ProcedureVersion, Segmentation, stored_bytes
 from webapp.facades.rendering import DIFFERENT
 

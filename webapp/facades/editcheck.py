@@ -22,9 +22,9 @@ import math
 from time import perf_counter
 
 from facaid.editing.check import SAMPLE, TRIES, check_edits
+from facaid.editing.parameters import Parameter, named_parameters
 from facaid.grammar.budget import WorkLimitError, reserve, seconds_left
 from facaid.grammar.layout import count_expansion
-from facaid.parameters import Parameter, named_parameters
 from webapp.facades.parsing import parse_procedure
 
 log = logging.getLogger(__name__)

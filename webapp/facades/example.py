@@ -9,11 +9,11 @@ import logging
 from django.core.cache import caches
 from rest_framework.exceptions import ValidationError
 
+from facaid.editing.parameters import named_parameters
+from facaid.editing.variation import vary
 from facaid.grammar import to_segmentation
 from facaid.grammar.budget import WorkLimitError, work_budget
 from facaid.grammar.procedure import ProcedureError
-from facaid.parameters import named_parameters
-from facaid.variation import vary
 from webapp.facades.access import DEMO_USERNAME
 from webapp.facades.models import Procedure, Visibility
 from webapp.facades.parsing import parse_procedure

@@ -16,14 +16,14 @@ from rest_framework.exceptions import ValidationError
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
+from facaid.editing.parameters import named_parameters, set_parameters
+from facaid.editing.variation import vary
 from facaid.formats.relief import MAX_MESH_RECTS, drawn_leaves
 from facaid.grammar import to_segmentation
 from facaid.grammar.budget import reserve
 from facaid.grammar.layout import count_expansion
 from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
-from facaid.parameters import named_parameters, set_parameters
-from facaid.variation import vary
 from webapp.facades import access, disclosure, downloads, editcheck, rendering, services, versions
 from webapp.facades.api.common import (
     page,

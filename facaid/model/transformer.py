@@ -1,7 +1,7 @@
 """The encoder-decoder transformer: flattened segmentation rows in, procedure tokens out.
 
-An encoder over the rectangle rows (`facaid.encoder`: bidirectional, BERT-style, or causal as in the paper:
-``FacaidConfig.encoder``) and a GPT-2-style decoder with cross-attention (`facaid.decoder`, written once for
+An encoder over the rectangle rows (`facaid.model.encoder`: bidirectional, BERT-style, or causal as in the paper:
+``FacaidConfig.encoder``) and a GPT-2-style decoder with cross-attention (`facaid.model.decoder`, written once for
 training and decoding), both in plain torch. They take our own embeddings: the five fields of a rectangle are
 embedded separately and summed (one token per rectangle) or laid out as five tokens with a field index; output
 tokens add the embedding of their local index within their node group and of their node's box. `FacaidModel` is
@@ -18,9 +18,9 @@ import torch.nn.functional as F
 from torch import nn
 from transformers import PretrainedConfig, PreTrainedModel
 
-from facaid.decoder import Conv1D, Decoder, padding_mask
-from facaid.encoder import BidirectionalEncoder, CausalEncoder
 from facaid.grammar.procedure import GRAMMAR_VERSION
+from facaid.model.decoder import Conv1D, Decoder, padding_mask
+from facaid.model.encoder import BidirectionalEncoder, CausalEncoder
 from facaid.tokenizer import PAD, Tokenizer, TokenizerConfig
 
 MAX_LOCAL = 72  # rule, role, count, up to 64 sizes, end
@@ -189,7 +189,7 @@ class FacaidModel(PreTrainedModel):
         (`Tokenizer.node_boxes`); they are embedded with the same tables as the input rectangles. With
         ``config.box_bias`` the cross-attention also leans towards the rectangles inside them: pass
         ``memory_boxes`` (`memory_boxes` of the encoded rectangles). Token-by-token decoding runs the same blocks
-        through `facaid.decoder.DecoderState`."""
+        through `facaid.model.decoder.DecoderState`."""
         x = self.embed_outputs(ids, local, boxes)  # (B, T, d)
         if self.box_scale is not None:
             if memory_boxes is None:

@@ -1,6 +1,7 @@
 """Resizing a procedure: fixed sizes keep their pixels, floating ones stretch, repeats lay out as many copies as fit.
 
-Used by variations (`facaid.variation`) and by the named parameters' width and height (`facaid.parameters`).
+Used by variations (`facaid.editing.variation`) and by the named parameters' width and height
+(`facaid.editing.parameters`).
 """
 
 from __future__ import annotations

@@ -335,7 +335,7 @@ def induce_procedure(seg: Segmentation, *, snap: float = 0.01, tolerance: float 
     rects = partition(seg)
     rects = _clean(rects[rects[:, 0] != FACADE], tol)  # the wall is what the elements and background leave
     tree = _Inducer(tol, tolerance, min_px, lookahead).cut(rects, (0, 0, seg.width, seg.height), True)
-    proc = Procedure(seg.width, seg.height, _node(tree), {"source": "facaid.induce"})
+    proc = Procedure(seg.width, seg.height, _node(tree), {"source": "facaid.reading.induce"})
     try:
         return Procedure.from_dict(proc.to_dict())
     except ProcedureError:

@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import random
 
+from facaid.editing.parameters import named_parameters, set_parameters
+from facaid.editing.resizing import box_sizes, copy_procedure, regions, resize
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Node, Procedure, ProcedureError, Size, validate
-from facaid.parameters import named_parameters, set_parameters
-from facaid.resizing import box_sizes, copy_procedure, regions, resize
 
 __all__ = ["change_count", "resize", "swap", "vary", "with_count", "with_size"]
 
@@ -113,7 +113,7 @@ def vary(proc: Procedure, n: int = 8, seed: int = 0,
     holds more floors), with both held it is not resized, and a variant that changed one anyway (a floor swapped
     for one of another facade, with other tiles) is drawn again. Without ``hold`` the draws are as they were.
 
-    With ``ranges`` (named parameter → (low, high), see `facaid.parameters`), each variant instead draws every
+    With ``ranges`` (named parameter → (low, high), see `facaid.editing.parameters`), each variant instead draws every
     named parameter uniformly from its range (whole numbers for counts) and sets them: ``{"floors": (4, 7)}``
     (``hold`` does not apply: the ranges say what changes)."""
     if not 1 <= n <= 64:

@@ -1,4 +1,4 @@
-"""The encoder over the rectangle rows, written here as the decoder is (`facaid.decoder`), in plain torch.
+"""The encoder over the rectangle rows, written here as the decoder is (`facaid.model.decoder`), in plain torch.
 
 Two kinds (`FacaidConfig.encoder`): ``"bidirectional"``, a BERT-style stack (learned positions and a type
 embedding summed with the input and normalized; each layer post-layer-norm self-attention over all positions
@@ -15,7 +15,7 @@ import torch
 import torch.nn.functional as F
 from torch import nn
 
-from facaid.decoder import Decoder, padding_mask
+from facaid.model.decoder import Decoder, padding_mask
 
 BERT_LAYER_NORM_EPS = 1e-12  # BERT's
 

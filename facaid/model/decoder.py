@@ -101,7 +101,7 @@ class Block(nn.Module):
         self.d, self.heads, self.dropout = d, heads, dropout
         self.ln_1 = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
         self.attn = SelfAttention(d)
-        if cross:  # without: a block of the causal encoder (`facaid.encoder.CausalEncoder`)
+        if cross:  # without: a block of the causal encoder (`facaid.model.encoder.CausalEncoder`)
             self.ln_cross_attn = nn.LayerNorm(d, eps=LAYER_NORM_EPS)
             self.crossattention = CrossAttention(d)
         self.ln_2 = nn.LayerNorm(d, eps=LAYER_NORM_EPS)

@@ -20,6 +20,7 @@ import numpy as np
 
 from facaid.editing.floors import as_floors_repeat, plain_floor, unrepeated_floors
 from facaid.editing.growth import grow
+from facaid.editing.resizing import copy_lengths, copy_procedure, repeat_unit, resize
 from facaid.editing.rows import (
     aligned_rows,
     building_of,
@@ -35,7 +36,6 @@ from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
 from facaid.grammar.repeats import copies_moved, copies_where, most_typical, recount
-from facaid.resizing import copy_lengths, copy_procedure, repeat_unit, resize
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]
 
