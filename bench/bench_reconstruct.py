@@ -63,14 +63,14 @@ def main() -> None:
     if args.no_model:
         return
     from facaid.model import load_model
-    from facaid.pipeline import reconstruct
+    from facaid.pipeline import ReconstructOptions, reconstruct
 
     model, tokenizer = load_model(args.checkpoint)
     acc, secs, decoded, retried, induced, shortcut, stages = [], [], [], [], [], [], []
     for s in samples:
         t0 = time.perf_counter()
         try:
-            r = reconstruct(s.segmentation, model=model, tokenizer=tokenizer, k=args.k)
+            r = reconstruct(s.segmentation, ReconstructOptions(k=args.k), model=model, tokenizer=tokenizer)
         except ValueError:
             continue
         secs.append(time.perf_counter() - t0)
@@ -92,14 +92,14 @@ def real(args: argparse.Namespace) -> None:
     from facaid.evaluation.real import load_records
     from facaid.model import load_model
     from facaid.paths import DEFAULT_CMP
-    from facaid.pipeline import reconstruct
+    from facaid.pipeline import ReconstructOptions, reconstruct
 
     model, tokenizer = load_model(args.checkpoint)
     records = load_records(DEFAULT_CMP, min(args.real, 189))  # the dev half
     secs, stages, decoded = [], [], []
     for _, seg in records:
         t0 = time.perf_counter()
-        r = reconstruct(seg, model=model, tokenizer=tokenizer, k=args.k)
+        r = reconstruct(seg, ReconstructOptions(k=args.k), model=model, tokenizer=tokenizer)
         secs.append(time.perf_counter() - t0)
         stages.append(r.timings)
         decoded.append(r.candidates)

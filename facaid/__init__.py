@@ -8,10 +8,10 @@ __version__ = "0.1.0"
 
 def __getattr__(name):
     # `facaid.reconstruct` without importing torch and transformers for every `import facaid`
-    if name == "reconstruct":
-        from facaid.pipeline import reconstruct
+    if name in ("reconstruct", "ReconstructOptions"):
+        from facaid import pipeline
 
-        return reconstruct
+        return getattr(pipeline, name)
     if name == "complete":
         from facaid.completion import complete
 

@@ -1,7 +1,9 @@
-"""`reconstruct`: from a segmentation to a sized procedure that reproduces it.
+"""`reconstruct`: from a segmentation to a sized procedure that reproduces it, as `ReconstructOptions` say.
 
-flatten -> tokenize -> grammar-constrained best-of-K decoding -> sizing -> metrics. The shipped model is
-loaded once per process on first use (CUDA when present) unless a model is passed in.
+The path it takes, a function each: reading (flatten, fit to what the model reads), candidates (grammar-constrained
+best-of-K decoding, `_candidates`), sizing (`_sized`), choice (the exact procedure or the lattice reading first,
+`_chosen`). The shipped model is loaded once per process on first use (CUDA when present) unless a model is passed
+in.
 
 A second chance: when the sized best candidate reproduces less than ``retry_below`` of the pixels, its
 structure is likely wrong (sizing cannot change counts or labels), so ``retry_k`` more samples are decoded and
@@ -111,106 +113,172 @@ def default_model(path: str = str(DEFAULT_CHECKPOINT)) -> tuple[FacaidModel, Tok
     return load_model(Path(path), device)
 
 
-def reconstruct(segmentation: Segmentation | dict, *, model: FacaidModel | None = None,
-                tokenizer: Tokenizer | None = None, k: int = DEFAULT_K, sizing: bool = True, seed: int = 0,
-                prefix: list[int] | None = None, retry_below: float = 0.97, retry_k: int = 8,
-                induce: bool = True, progress: Callable[[float, str], None] | None = None,
-                structure: str = "editable") -> Reconstruction:
-    """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object).
+@dataclass(frozen=True)
+class ReconstructOptions:
+    """How `reconstruct` reads a segmentation (see the module's docstring). ``k``: the candidates decoded (best of
+    K); ``sizing``: whether the winner is sized (off: the decoded structure as it is); ``seed``; ``prefix``: token
+    ids the model continues from (a re-run that keeps a procedure's first nodes; the structure is then the
+    model's); ``retry_below`` and ``retry_k``: the second chance; ``induce``: whether the induced structure
+    competes; ``structure``: which of the two structures is returned first, "editable" or "exact"."""
+
+    k: int = DEFAULT_K
+    sizing: bool = True
+    seed: int = 0
+    prefix: tuple[int, ...] | None = None
+    retry_below: float = 0.97
+    retry_k: int = 8
+    induce: bool = True
+    structure: str = "editable"
+
+    def __post_init__(self) -> None:
+        if self.structure not in STRUCTURES:
+            raise ValueError(f"structure must be one of {', '.join(STRUCTURES)}, got {self.structure!r}")
+        if self.prefix is not None:
+            object.__setattr__(self, "prefix", tuple(self.prefix))
+
+    @property
+    def free(self) -> bool:
+        """Whether the structure is the reader's to choose: the model's, induced or read as a lattice (no prefix)."""
+        return self.prefix is None
+
+
+def reconstruct(segmentation: Segmentation | dict, options: ReconstructOptions | None = None, *,
+                model: FacaidModel | None = None, tokenizer: Tokenizer | None = None,
+                progress: Callable[[float, str], None] | None = None) -> Reconstruction:
+    """Reconstruct a procedure for a segmentation (a `Segmentation` or its JSON object), as ``options`` say
+    (default `ReconstructOptions`), with the shipped model unless ``model`` and ``tokenizer`` are given. The path
+    it takes: reading (flatten, fit to what the model reads), candidates (decoded, and the induced structure where
+    the greedy one is far off), sizing (the winner, the induced structure where it fits closer, the second
+    chance), choice (the exact procedure and the lattice reading: which is returned first).
 
     ``progress(fraction, stage)``, when given, is told each stage as it starts (fractions from 0 to 1, roughly
-    of the time taken): decoding, sizing, and the second chance's sampling when it runs. ``structure``: which of
-    the two structures to return (see the module's docstring), the other as ``alternative``."""
-    if structure not in STRUCTURES:
-        raise ValueError(f"structure must be one of {', '.join(STRUCTURES)}, got {structure!r}")
+    of the time taken)."""
+    opts = options or ReconstructOptions()
     seg = segmentation if isinstance(segmentation, Segmentation) else Segmentation.from_dict(segmentation)
     if model is None or tokenizer is None:
         model, tokenizer = default_model()
     tell = progress or (lambda fraction, stage: None)
-    timings = {}
-    t0 = time.perf_counter()
+    clock = [time.perf_counter()]
+
+    def lap() -> float:
+        clock.append(time.perf_counter())
+        return clock[-1] - clock[-2]
+
+    k = opts.k
     tell(0.0, f"decoding {'up to ' if k > 1 else ''}{k} candidate{'s' if k > 1 else ''}")
     flat = flatten(seg)
     readable = fit_to_model(flat, tokenizer)
-    t1 = time.perf_counter()
-    gate = sizing and induce and prefix is None
-    ranked, induced, read, drawn = _decoded(model, tokenizer, readable, flat, k, seed, prefix, gate)
-    t2 = time.perf_counter()
-    decoded = ranked[0].procedure
-    before = procedure_accuracy(decoded, flat)
-    retried = shortcut = denoised = False
-    source = "model"
-    if sizing:
+    timings = {"flatten": lap()}
+    found = _candidates(model, tokenizer, readable, flat, opts)
+    timings["decode"] = lap()
+    if opts.sizing:
         tell(0.5, "sizing")
-        if gate and before < FAR_OFF and not read:
-            induced, read = induce_procedure(flat), True
-        induced_before = procedure_accuracy(induced, flat) if induced is not None else None
-        if induced_before is not None and induced_before >= before + FAR_BEHIND:
-            fitted = fit_sizes(induced, flat, before=induced_before)  # the model's structure is not sized
-            source, shortcut, before = "induced", True, induced_before
-        else:
-            fitted = fit_sizes(decoded, flat, before=before)
-        if fitted.accuracy < retry_below and induce and prefix is None and not shortcut:
-            if not read:
-                induced = induce_procedure(flat)
-            if induced is not None:
-                other = fit_sizes(induced, flat, before=induced_before)
-                if other.accuracy > fitted.accuracy:
-                    if reads_through_noise(fitted.procedure, other.procedure, flat):
-                        denoised = True  # the induced structure fits closer by copying the annotator's noise
-                    else:
-                        fitted, before, source = other, other.accuracy_before, "induced"
-        if fitted.accuracy < retry_below and retry_k and source == "model" and not denoised:
-            tell(0.75, f"sampling {retry_k} more candidates")
-            retried, drawn = True, drawn + retry_k
-            more = decode(model, tokenizer, readable, k=retry_k, sample=True, greedy=0, seed=seed + 1, prefix=prefix)
-            other = _second_chance(ranked[1:] + more, ranked[0], flat)
-            if other is not None and other.accuracy > fitted.accuracy:
-                fitted, before = other, other.accuracy_before  # before sizing, of that candidate
-        proc, accuracy, iou = fitted.procedure, fitted.accuracy, fitted.iou
+        result = _sized(found, model, tokenizer, readable, flat, opts, tell)
     else:
         from facaid.metrics import procedure_iou
 
-        proc, accuracy, iou = decoded, before, procedure_iou(decoded, flat)
-    t3 = time.perf_counter()
-    proc.meta = {"source": "facaid.reconstruct", "structure": source, "k": k, "accuracy": round(accuracy, 6)}
-    result = Reconstruction(proc, before, accuracy, iou, timings, retried, source, shortcut, denoised,
-                            "editable" if source == "model" else "exact")
-    if sizing and source != "model" and prefix is None:
-        tell(0.9, "reading the floors and bays")
-        editable = best_reading(flat)
-        if editable is not None:
-            editable.procedure.meta = {"source": "facaid.reconstruct", "structure": "lattice", "k": k,
-                                       "accuracy": round(editable.accuracy, 6),
-                                       "group": editable.procedure.meta["group"]}
-            result = _with_editable(result, editable, structure)
-    result.candidates = drawn
+        decoded = found.ranked[0].procedure
+        before = procedure_accuracy(decoded, flat)
+        result = Reconstruction(decoded, before, before, procedure_iou(decoded, flat), candidates=found.drawn,
+                                structure="editable")
+    timings["sizing"] = lap()
+    result.procedure.meta = {"source": "facaid.reconstruct", "structure": result.source, "k": k,
+                             "accuracy": round(result.accuracy, 6)}
+    result = _chosen(result, flat, opts, tell)
     forget_tables()  # the tables its sizings shared
-    t4 = time.perf_counter()
-    timings.update(flatten=t1 - t0, decode=t2 - t1, sizing=t3 - t2, lattice=t4 - t3, total=t4 - t0)
+    timings["lattice"] = lap()
+    result.timings.update(timings, total=clock[-1] - clock[0])
     return result
 
 
-def _decoded(model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation, flat: Segmentation, k: int,
-             seed: int, prefix: list[int] | None,
-             gate: bool) -> tuple[list[Candidate], Procedure | None, bool, int]:
-    """The ranked candidates (`ranked_candidates`), the induced structure and whether it was read (it is read at
-    most once a reconstruction), and how many candidates were decoded. With ``gate`` and K > 1 the greedy
+@dataclass
+class _Candidates:
+    """What decoding found: the ranked candidates, the induced structure and whether it was read (it is read at
+    most once a reconstruction), and how many candidates were decoded."""
+
+    ranked: list[Candidate]
+    induced: Procedure | None
+    read: bool
+    drawn: int
+
+
+def _candidates(model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation, flat: Segmentation,
+                opts: ReconstructOptions) -> _Candidates:
+    """The candidates (`ranked_candidates`). Where the structure is the reader's to choose and K > 1, the greedy
     candidate is decoded first, alone: where it is `FAR_OFF` and the induced structure `FAR_BEHIND` ahead of it
     (an annotation unlike the model's training data: a real facade), the samples are not drawn, as only the
     induced structure is sized then; else the K - 1 samples follow, the same as decoded in one batch with it."""
-    if not gate or k == 1:
-        return (ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix, reference=flat), None,
-                False, k)
+    k, seed, prefix = opts.k, opts.seed, list(opts.prefix) if opts.prefix is not None else None
+    if not (opts.sizing and opts.induce and opts.free) or k == 1:
+        return _Candidates(ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix,
+                                             reference=flat), None, False, k)
     greedy = decode(model, tokenizer, readable, k=1, temperature=TEMPERATURE, seed=seed)[0]
     greedy_before = procedure_accuracy(greedy.procedure, flat)
     induced, read = None, False
     if greedy_before < FAR_OFF:
         induced, read = induce_procedure(flat), True
         if induced is not None and procedure_accuracy(induced, flat) >= greedy_before + FAR_BEHIND:
-            return ranked_candidates(model, tokenizer, readable, k=1, reference=flat, greedy=greedy), induced, True, 1
-    return (ranked_candidates(model, tokenizer, readable, k=k, seed=seed, reference=flat, greedy=greedy), induced,
-            read, k)
+            return _Candidates(ranked_candidates(model, tokenizer, readable, k=1, reference=flat, greedy=greedy),
+                               induced, True, 1)
+    return _Candidates(ranked_candidates(model, tokenizer, readable, k=k, seed=seed, reference=flat, greedy=greedy),
+                       induced, read, k)
+
+
+def _sized(found: _Candidates, model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation,
+           flat: Segmentation, opts: ReconstructOptions, tell: Callable[[float, str], None]) -> Reconstruction:
+    """The best candidate sized (`fit_sizes`), or the induced structure where it fits closer (alone where the
+    decoded one is far behind: the shortcut; not where the model's structure reads through an annotator's noise),
+    or, below ``retry_below``, the best of ``retry_k`` more samples (the second chance)."""
+    decoded = found.ranked[0].procedure
+    before = procedure_accuracy(decoded, flat)
+    induced, read, drawn = found.induced, found.read, found.drawn
+    retried = shortcut = denoised = False
+    source = "model"
+    gate = opts.induce and opts.free
+    if gate and before < FAR_OFF and not read:
+        induced, read = induce_procedure(flat), True
+    induced_before = procedure_accuracy(induced, flat) if induced is not None else None
+    if induced_before is not None and induced_before >= before + FAR_BEHIND:
+        fitted = fit_sizes(induced, flat, before=induced_before)  # the model's structure is not sized
+        source, shortcut, before = "induced", True, induced_before
+    else:
+        fitted = fit_sizes(decoded, flat, before=before)
+    if fitted.accuracy < opts.retry_below and gate and not shortcut:
+        if not read:
+            induced = induce_procedure(flat)
+        if induced is not None:
+            other = fit_sizes(induced, flat, before=induced_before)
+            if other.accuracy > fitted.accuracy:
+                if reads_through_noise(fitted.procedure, other.procedure, flat):
+                    denoised = True  # the induced structure fits closer by copying the annotator's noise
+                else:
+                    fitted, before, source = other, other.accuracy_before, "induced"
+    if fitted.accuracy < opts.retry_below and opts.retry_k and source == "model" and not denoised:
+        tell(0.75, f"sampling {opts.retry_k} more candidates")
+        retried, drawn = True, drawn + opts.retry_k
+        prefix = list(opts.prefix) if opts.prefix is not None else None
+        more = decode(model, tokenizer, readable, k=opts.retry_k, sample=True, greedy=0, seed=opts.seed + 1,
+                      prefix=prefix)
+        other = _second_chance(found.ranked[1:] + more, found.ranked[0], flat)
+        if other is not None and other.accuracy > fitted.accuracy:
+            fitted, before = other, other.accuracy_before  # before sizing, of that candidate
+    return Reconstruction(fitted.procedure, before, fitted.accuracy, fitted.iou, {}, retried, source, shortcut,
+                          denoised, "editable" if source == "model" else "exact", candidates=drawn)
+
+
+def _chosen(result: Reconstruction, flat: Segmentation, opts: ReconstructOptions,
+            tell: Callable[[float, str], None]) -> Reconstruction:
+    """Where the exact structure won (a real facade), the lattice reading beside it (`best_reading`), the one
+    ``opts.structure`` names first."""
+    if not (opts.sizing and result.source != "model" and opts.free):
+        return result
+    tell(0.9, "reading the floors and bays")
+    editable = best_reading(flat)
+    if editable is None:
+        return result
+    editable.procedure.meta = {"source": "facaid.reconstruct", "structure": "lattice", "k": opts.k,
+                               "accuracy": round(editable.accuracy, 6), "group": editable.procedure.meta["group"]}
+    return _with_editable(result, editable, opts.structure)
 
 
 def best_reading(flat: Segmentation):
@@ -245,7 +313,7 @@ def _with_editable(exact: Reconstruction, editable, structure: str) -> Reconstru
         return exact
     return Reconstruction(editable.procedure, editable.accuracy_before, editable.accuracy, editable.iou,
                           exact.timings, exact.retried, "lattice", False, False, "editable", exact.procedure,
-                          exact.accuracy)
+                          exact.accuracy, exact.candidates)
 
 
 def reads_through_noise(model: Procedure, induced: Procedure, seg: Segmentation) -> bool:

@@ -112,7 +112,7 @@ def check_reconstruction(device: str, count: int, k: int, log) -> dict:
     from facaid.generator.dataset import sample_seed
     from facaid.model import load_model
     from facaid.paths import DEFAULT_CHECKPOINT
-    from facaid.pipeline import reconstruct
+    from facaid.pipeline import ReconstructOptions, reconstruct
     from worker.compute import reconstruct as job
 
     cpu = load_model(DEFAULT_CHECKPOINT, "cpu")
@@ -121,9 +121,9 @@ def check_reconstruction(device: str, count: int, k: int, log) -> dict:
     for i in range(count):
         seg = generate(sample_seed(4242, i)).segmentation
         torch.manual_seed(0)
-        a = reconstruct(seg, model=cpu[0], tokenizer=cpu[1], k=k, seed=i)
+        a = reconstruct(seg, ReconstructOptions(k=k, seed=i), model=cpu[0], tokenizer=cpu[1])
         torch.manual_seed(0)
-        b = reconstruct(seg, model=here[0], tokenizer=here[1], k=k, seed=i)
+        b = reconstruct(seg, ReconstructOptions(k=k, seed=i), model=here[0], tokenizer=here[1])
         same, worst = _same_tree(a.procedure.to_dict(), b.procedure.to_dict())
         rows.append({"facade": i, "same_tree": same, "largest_size_difference": round(worst, 4),
                      "accuracy_cpu": a.accuracy, "accuracy_device": b.accuracy,

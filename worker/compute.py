@@ -28,7 +28,7 @@ def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed
     if progress:
         progress(0.05, "loading the model")
     from facaid.decoding import prefix_from_procedure
-    from facaid.pipeline import default_model
+    from facaid.pipeline import ReconstructOptions, default_model
     from facaid.pipeline import reconstruct as run
 
     model, tokenizer = default_model(checkpoint)
@@ -36,8 +36,8 @@ def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed
     if prefix is not None and prefix_nodes > 0:
         prefix_ids = prefix_from_procedure(tokenizer, Procedure.from_dict(prefix), prefix_nodes)
     stages = (lambda fraction, stage: progress(0.2 + 0.8 * fraction, stage)) if progress else None
-    result = run(seg, model=model, tokenizer=tokenizer, k=k, seed=seed, prefix=prefix_ids, progress=stages,
-                 structure=structure)
+    result = run(seg, ReconstructOptions(k=k, seed=seed, prefix=prefix_ids, structure=structure), model=model,
+                 tokenizer=tokenizer, progress=stages)
     out = result.to_dict()
     out["procedure"] = result.procedure.to_dict()
     if result.alternative is not None:

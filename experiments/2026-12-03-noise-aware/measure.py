@@ -21,7 +21,7 @@ from facaid.reading.induce import induce_procedure
 from facaid.labels import BACKGROUND, FACADE
 from facaid.metrics import compression, pixel_accuracy
 from facaid.paths import DEFAULT_CMP
-from facaid.pipeline import default_model, reconstruct
+from facaid.pipeline import ReconstructOptions, default_model, reconstruct
 from facaid.segmentation import flatten, rasterize
 from facaid.sizing import fit_sizes
 
@@ -66,7 +66,7 @@ def row(kind, rid, clean, given, model, tokenizer):
            "input_vs_clean": pixel_accuracy(rasterize(given), truth)}
     seen = rasterize(flat)
     induced = fit_sizes(induce_procedure(flat), flat).procedure
-    r = reconstruct(flat, model=model, tokenizer=tokenizer, k=4, induce=False)
+    r = reconstruct(flat, ReconstructOptions(k=4, induce=False), model=model, tokenizer=tokenizer)
     for name, proc in (("induced", induced), ("model", r.procedure)):
         pred = rasterize(to_segmentation(proc))
         out[name] = {"vs_input": pixel_accuracy(pred, seen), "vs_clean": pixel_accuracy(pred, truth),

@@ -15,7 +15,7 @@ from facaid.evaluation.real import load_records
 from facaid.grammar.execute import to_segmentation
 from facaid.reading.induce import induce_procedure
 from facaid.metrics import element_leaves, pixel_accuracy, unexplained
-from facaid.pipeline import default_model, reconstruct
+from facaid.pipeline import ReconstructOptions, default_model, reconstruct
 from facaid.segmentation import flatten, rasterize
 
 
@@ -31,7 +31,7 @@ def main() -> None:
         for i, (rid, seg) in enumerate(load_records(args.data, args.limit)):
             given = seg if args.perturb is None else annotator_noise(seg, args.perturb * 100_003 + i)
             flat, truth = flatten(given), rasterize(seg)
-            r = reconstruct(flat, model=model, tokenizer=tokenizer, k=4, induce=False)
+            r = reconstruct(flat, ReconstructOptions(k=4, induce=False), model=model, tokenizer=tokenizer)
             pred = rasterize(to_segmentation(r.procedure))
             induced = induce_procedure(flat)
             row = {"id": rid, "unexplained": unexplained(pred, rasterize(flat)),

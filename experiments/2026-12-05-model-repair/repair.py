@@ -17,7 +17,7 @@ from facaid.grammar.procedure import Procedure, ProcedureError
 from facaid.reading.induce import induce_procedure
 from facaid.metrics import compression, element_leaves, pixel_accuracy
 from facaid.paths import DEFAULT_CMP
-from facaid.pipeline import default_model, reconstruct
+from facaid.pipeline import ReconstructOptions, default_model, reconstruct
 from facaid.segmentation import Segmentation, flatten, rasterize
 from facaid.sizing import fit_sizes
 
@@ -93,7 +93,7 @@ for i, (rid, seg) in enumerate(records):
     given = seg if args.perturb is None else annotator_noise(seg, args.perturb * 100_003 + i * args.every)
     gflat = flatten(given)
     t0 = time.perf_counter()
-    alone = reconstruct(gflat, model=model, tokenizer=tok, k=args.k, induce=False, retry_k=0)
+    alone = reconstruct(gflat, ReconstructOptions(k=args.k, induce=False, retry_k=0), model=model, tokenizer=tok)
     t1 = time.perf_counter()
     induced = fit_sizes(induce_procedure(gflat), gflat).procedure
     t2 = time.perf_counter()

@@ -31,7 +31,7 @@ from facaid.grammar.execute import to_segmentation
 from facaid.metrics import element_leaves
 from facaid.model import load_model
 from facaid.paths import DEFAULT_CHECKPOINT
-from facaid.pipeline import reconstruct
+from facaid.pipeline import ReconstructOptions, reconstruct
 from facaid.segmentation import Rect, Segmentation, flatten, rasterize
 
 
@@ -69,7 +69,7 @@ def main() -> None:
                 given_map = rasterize(given)
                 row = {"index": i, "drop": drop, "input": scores(given_map, clean, given_map)}
                 t0 = time.perf_counter()
-                rec = reconstruct(given, model=model, tokenizer=tok, k=args.k, induce=False)
+                rec = reconstruct(given, ReconstructOptions(k=args.k, induce=False), model=model, tokenizer=tok)
                 row["seconds"] = time.perf_counter() - t0
                 row["model"] = scores(rasterize(to_segmentation(rec.procedure)), clean, given_map)
                 row["model"]["leaves"] = element_leaves(rec.procedure)

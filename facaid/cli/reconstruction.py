@@ -14,13 +14,14 @@ def cmd_reconstruct(args: argparse.Namespace) -> None:
     from facaid.formats.render import render_segmentation
     from facaid.grammar.execute import to_segmentation
     from facaid.model import load_model
-    from facaid.pipeline import reconstruct
+    from facaid.pipeline import ReconstructOptions, reconstruct
     from facaid.segmentation import Segmentation
 
     seg = Segmentation.from_dict(read_json(args.input), clip=args.clip)
     model, tokenizer = load_model(args.checkpoint)
-    result = reconstruct(seg, model=model, tokenizer=tokenizer, k=args.k, sizing=not args.no_sizing,
-                         seed=args.seed, induce=not args.no_induce, structure=args.structure)
+    options = ReconstructOptions(k=args.k, sizing=not args.no_sizing, seed=args.seed, induce=not args.no_induce,
+                                 structure=args.structure)
+    result = reconstruct(seg, options, model=model, tokenizer=tokenizer)
     Path(args.out).write_text(result.procedure.to_json(indent=1) + "\n")
     print(f"wrote {args.out}: pixel accuracy {100 * result.accuracy:.2f} % "
           f"(decoded {100 * result.accuracy_decoded:.2f} %), {1000 * result.timings['total']:.0f} ms, "

@@ -31,7 +31,7 @@ from facaid.grammar.execute import to_segmentation
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.metrics import compression, pixel_accuracy
 from facaid.model import FacaidModel
-from facaid.pipeline import reconstruct
+from facaid.pipeline import ReconstructOptions, reconstruct
 from facaid.segmentation import Segmentation, flatten, rasterize
 from facaid.tokenizer import Tokenizer
 
@@ -74,7 +74,8 @@ def evaluate_real(model: FacaidModel, tokenizer: Tokenizer, path: str | Path, *,
         given = seg if perturb is None else annotator_noise(seg, perturb * 100_003 + i)
         given_flat = flat if perturb is None else flatten(given)
         t0 = time.perf_counter()
-        result = reconstruct(given_flat, model=model, tokenizer=tokenizer, k=k, induce=induce, structure=structure)
+        result = reconstruct(given_flat, ReconstructOptions(k=k, induce=induce, structure=structure), model=model,
+                             tokenizer=tokenizer)
         times.append(time.perf_counter() - t0)
         pred = rasterize(to_segmentation(result.procedure))
         trivial = all_wall(target)

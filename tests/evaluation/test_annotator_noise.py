@@ -141,7 +141,7 @@ def test_a_reconstruction_reads_through_the_noise_of_a_generated_facade_annotate
     (a point or two below the input at worst)."""
     from facaid.grammar.execute import to_segmentation
     from facaid.metrics import pixel_accuracy
-    from facaid.pipeline import default_model, reconstruct
+    from facaid.pipeline import ReconstructOptions, default_model, reconstruct
     from facaid.segmentation import flatten, rasterize
 
     model, tokenizer = default_model()
@@ -150,7 +150,7 @@ def test_a_reconstruction_reads_through_the_noise_of_a_generated_facade_annotate
         seg = generate(seed).segmentation
         clean = rasterize(seg)
         noisy = annotator_noise(seg, seed)
-        result = reconstruct(flatten(noisy), model=model, tokenizer=tokenizer, k=4)
+        result = reconstruct(flatten(noisy), ReconstructOptions(k=4), model=model, tokenizer=tokenizer)
         gain = (pixel_accuracy(rasterize(to_segmentation(result.procedure)), clean)
                 - pixel_accuracy(rasterize(noisy), clean))
         gains.append(gain)

@@ -3,7 +3,7 @@ import pytest
 from facaid.generator import generate
 from facaid.grammar import validate
 from facaid.paths import DEFAULT_CHECKPOINT
-from facaid.pipeline import default_model, reconstruct
+from facaid.pipeline import ReconstructOptions, default_model, reconstruct
 
 
 @pytest.mark.skipif(not (DEFAULT_CHECKPOINT / "model.safetensors").is_file(), reason="no shipped checkpoint")
@@ -11,7 +11,7 @@ def test_shipped_model_loads_by_default_and_reconstructs():
     model, tokenizer = default_model()
     assert model.config.grammar == "facaid-split-1"
     seg = generate(21, "tenement").segmentation
-    result = reconstruct(seg, k=2)  # the default model
+    result = reconstruct(seg, ReconstructOptions(k=2))  # the default model
     validate(result.procedure)
     assert result.accuracy >= result.accuracy_decoded
     assert result.accuracy > 0.8
@@ -41,18 +41,18 @@ def test_a_real_annotation_takes_the_shortcut_to_the_induced_structure(cmp_recor
     from facaid.segmentation import Segmentation, flatten
 
     seg = Segmentation.from_dict(cmp_records[0], clip=True)
-    result = reconstruct(seg, k=4, structure="exact")
+    result = reconstruct(seg, ReconstructOptions(k=4, structure="exact"))
     assert result.shortcut and result.source == "induced" and result.structure == "exact"
     assert result.candidates == 1  # the greedy candidate was far off: no samples were drawn
     from facaid.sizing import _TABLES
     assert not _TABLES  # the tables its sizings shared are let go
-    editable = reconstruct(seg, k=4)  # by default: the lattice reading, the exact one beside it
+    editable = reconstruct(seg, ReconstructOptions(k=4))  # by default: the lattice reading, the exact one beside it
     assert (editable.structure, editable.source) == ("editable", "lattice")
     assert editable.alternative_accuracy == result.accuracy and editable.alternative.to_json() == \
         result.procedure.to_json()
     assert result.procedure.meta["structure"] == "induced" and result.accuracy > 0.9
     assert result.accuracy == procedure_accuracy(result.procedure, flatten(seg))
-    longer = reconstruct(seg, k=2, induce=False)  # the model's own structure, sized: far below
+    longer = reconstruct(seg, ReconstructOptions(k=2, induce=False))  # the model's own structure, sized: far below
     assert not longer.shortcut and longer.accuracy_decoded < FAR_OFF
     assert longer.accuracy < result.accuracy  # sizing it would not have closed the gap
 

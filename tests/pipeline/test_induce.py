@@ -8,7 +8,7 @@ from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure, validate
 from facaid.labels import LABEL_ID
 from facaid.metrics import procedure_accuracy
-from facaid.pipeline import reconstruct
+from facaid.pipeline import ReconstructOptions, reconstruct
 from facaid.reading.induce import induce_procedure
 from facaid.segmentation import Rect, Segmentation, flatten, rasterize
 
@@ -90,13 +90,13 @@ def test_degenerate_segmentations_give_valid_procedures():
 def test_reconstruct_keeps_the_induced_structure_when_the_model_fits_badly(tiny):
     model, tok = tiny  # untrained: its structures fit badly
     seg = generate(6).segmentation
-    result = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, structure="exact")
+    result = reconstruct(seg, ReconstructOptions(k=2, retry_k=2, structure="exact"), model=model, tokenizer=tok)
     assert result.source == "induced" and result.to_dict()["source"] == "induced"
     assert result.accuracy > 0.95 and not result.retried  # the induced structure won: no sampling
     assert result.shortcut and result.to_dict()["shortcut"]  # far ahead before sizing: the model's not sized
     assert result.accuracy == procedure_accuracy(result.procedure, flatten(seg))
     assert result.procedure.meta["structure"] == "induced"
-    model_only = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False)
+    model_only = reconstruct(seg, ReconstructOptions(k=2, retry_k=2, induce=False), model=model, tokenizer=tok)
     assert model_only.source == "model" and model_only.accuracy < result.accuracy
 
 

@@ -9,7 +9,7 @@ from facaid.generator import generate
 from facaid.grammar import Procedure, validate
 from facaid.metrics import procedure_accuracy
 from facaid.model import save_model
-from facaid.pipeline import reading_key, reconstruct
+from facaid.pipeline import ReconstructOptions, reading_key, reconstruct
 from facaid.segmentation import flatten
 from facaid.tokenizer import Tokenizer, TokenizerConfig
 
@@ -17,7 +17,7 @@ from facaid.tokenizer import Tokenizer, TokenizerConfig
 def test_reconstruct_returns_a_valid_sized_procedure(tiny):
     model, tok = tiny
     seg = generate(6).segmentation
-    result = reconstruct(seg.to_dict(), model=model, tokenizer=tok, k=2)
+    result = reconstruct(seg.to_dict(), ReconstructOptions(k=2), model=model, tokenizer=tok)
     validate(result.procedure)
     assert result.accuracy >= result.accuracy_decoded
     assert set(result.timings) == {"flatten", "decode", "sizing", "lattice", "total"}
@@ -50,7 +50,7 @@ def test_a_real_facade_comes_back_editable_with_the_exact_one_beside(tiny):
 
     model, tok = tiny
     seg = real_like()
-    editable = reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0)
+    editable = reconstruct(seg, ReconstructOptions(k=1, retry_k=0), model=model, tokenizer=tok)
     assert (editable.structure, editable.source) == ("editable", "lattice")
     assert {"floors", "bays"} <= {p.name for p in named_parameters(editable.procedure)}
     assert editable.accuracy == procedure_accuracy(editable.procedure, flatten(seg)) > 0.94
@@ -59,11 +59,11 @@ def test_a_real_facade_comes_back_editable_with_the_exact_one_beside(tiny):
     assert editable.procedure.meta["group"] == [1, 1]  # the grid as read: its edits are clean
     checks = check_edits(editable.procedure)
     assert checks["floors+1"].clean and checks["bays+1"].clean, checks
-    exact = reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0, structure="exact")
+    exact = reconstruct(seg, ReconstructOptions(k=1, retry_k=0, structure="exact"), model=model, tokenizer=tok)
     assert exact.structure == "exact" and exact.accuracy == editable.alternative_accuracy
     assert exact.alternative.to_json() == editable.procedure.to_json()
     with pytest.raises(ValueError, match="structure must be one of editable, exact"):
-        reconstruct(seg, model=model, tokenizer=tok, k=1, structure="tidy")
+        reconstruct(seg, ReconstructOptions(k=1, structure="tidy"), model=model, tokenizer=tok)
 
 
 def test_fit_to_model_drops_the_smallest_elements():
@@ -96,14 +96,14 @@ def test_evaluate_real_on_cmp_records(tiny, tmp_path, cmp_records, capsys):
 def test_second_chance_sizes_more_candidates_when_the_first_fits_badly(tiny):
     model, tok = tiny  # untrained: its structures fit badly, so the second chance runs
     seg = generate(6).segmentation
-    first = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=0, induce=False)
+    first = reconstruct(seg, ReconstructOptions(k=2, retry_k=0, induce=False), model=model, tokenizer=tok)
     assert not first.retried and first.accuracy < 0.97
-    again = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False)
+    again = reconstruct(seg, ReconstructOptions(k=2, retry_k=2, induce=False), model=model, tokenizer=tok)
     assert again.retried and again.to_dict()["retried"]
     assert again.accuracy >= first.accuracy
     validate(again.procedure)
     assert again.accuracy == procedure_accuracy(again.procedure, flatten(seg))
-    never = reconstruct(seg, model=model, tokenizer=tok, k=2, retry_below=0.0, induce=False)
+    never = reconstruct(seg, ReconstructOptions(k=2, retry_below=0.0, induce=False), model=model, tokenizer=tok)
     assert not never.retried and never.accuracy == first.accuracy
 
 
@@ -111,12 +111,12 @@ def test_progress_hears_each_stage_in_order(tiny):
     model, tok = tiny  # untrained: its structures fit badly, so the second chance samples
     seg = generate(6).segmentation
     heard = []
-    reconstruct(seg, model=model, tokenizer=tok, k=2, retry_k=2, induce=False,
+    reconstruct(seg, ReconstructOptions(k=2, retry_k=2, induce=False), model=model, tokenizer=tok,
                 progress=lambda f, stage: heard.append((f, stage)))
     assert [s for _, s in heard] == ["decoding up to 2 candidates", "sizing", "sampling 2 more candidates"]
     assert [f for f, _ in heard] == sorted(f for f, _ in heard) and heard[0][0] >= 0 and heard[-1][0] < 1
     heard.clear()
-    reconstruct(seg, model=model, tokenizer=tok, k=1, retry_k=0, induce=False,
+    reconstruct(seg, ReconstructOptions(k=1, retry_k=0, induce=False), model=model, tokenizer=tok,
                 progress=lambda f, stage: heard.append((f, stage)))
     assert [s for _, s in heard] == ["decoding 1 candidate", "sizing"]
 
@@ -147,7 +147,7 @@ def test_bad_real_input_gets_a_procedure_or_a_clear_error():
              Segmentation(400, 300, tuple(Rect(2, 20 + 60 * i, 40, 60 + 60 * i, 100) for i in range(5))),
              Segmentation(400, 300, tuple(Rect(2 + i % 9, 0, 0, 400, 300) for i in range(30)))]
     for seg in cases:
-        result = reconstruct(seg, k=2)
+        result = reconstruct(seg, ReconstructOptions(k=2))
         validate(result.procedure)
         assert result.accuracy > 0.99
     rng = random.Random(1)
@@ -156,7 +156,7 @@ def test_bad_real_input_gets_a_procedure_or_a_clear_error():
         x, y = rng.randrange(0, 1990), rng.randrange(0, 1990)
         many.append(Rect(2 + i % 10, x, y, x + rng.randrange(1, 10), y + rng.randrange(1, 10)))
     with pytest.raises(ValueError, match=r"too many rectangles for the model: \d+ after flattening \(at most 640\)"):
-        reconstruct(Segmentation(2000, 2000, tuple(many)), k=2)
+        reconstruct(Segmentation(2000, 2000, tuple(many)), ReconstructOptions(k=2))
 
 
 def test_a_reading_is_ranked_by_its_clean_edits_then_its_accuracy():
@@ -166,3 +166,15 @@ def test_a_reading_is_ranked_by_its_clean_edits_then_its_accuracy():
     both = reading_key([clean, clean], 0.90)
     assert both > grid > pairs
     assert reading_key([clean, broken], 0.96) > grid
+
+
+def test_reconstruct_options_are_one_frozen_object_checked_when_made():
+    """Issue 69: how `reconstruct` reads is one options object, not eleven keywords; a bad one is refused when it is
+    made, naming the problem, and a prefix given as a list is kept as a tuple (the options are hashable)."""
+    options = ReconstructOptions(k=2, prefix=[3, 4])
+    assert options.prefix == (3, 4) and not options.free and hash(options)
+    assert ReconstructOptions().free and ReconstructOptions().structure == "editable"
+    with pytest.raises(ValueError, match="structure must be one of editable, exact, got 'tidy'"):
+        ReconstructOptions(structure="tidy")
+    with pytest.raises(AttributeError):
+        options.k = 3

@@ -356,10 +356,10 @@ def test_floors_plus_one_on_a_real_like_facade_adds_a_row_of_windows(live_server
     from grammar_helpers import real_like
     from site_helpers import screenshot
 
-    from facaid.pipeline import reconstruct
+    from facaid.pipeline import ReconstructOptions, reconstruct
 
     seg = real_like()
-    result = reconstruct(seg, k=2)
+    result = reconstruct(seg, ReconstructOptions(k=2))
     assert result.structure == "editable"
     proc = Procedure.objects.create(owner=alice, title="Real-like facade", data=result.procedure.to_dict(),
                                     accuracy=result.accuracy, metrics={"source": result.source,
