@@ -149,3 +149,12 @@ def test_facaid_has_at_most_12_top_level_modules_and_no_source_file_over_450_lin
     sources += [p for p in (ROOT / "frontend").rglob("*.js") if "tests" not in p.parts]
     long = {str(p.relative_to(ROOT)): n for p in sources if (n := len(p.read_text().splitlines())) > 450}
     assert long == {}
+
+
+def test_every_package_opens_on_a_short_front_door():
+    """Issue 69: a package's `__init__.py` says what it holds and re-exports its names (at most 100 lines); its
+    algorithm lives in named modules."""
+    doors = [p for folder in ("facaid", "webapp", "worker") for p in (ROOT / folder).rglob("__init__.py")
+             if "migrations" not in p.parts]
+    long = {str(p.relative_to(ROOT)): n for p in doors if (n := len(p.read_text().splitlines())) > 100}
+    assert len(doors) > 10 and long == {}

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from facaid.completion import proposals_for
+from facaid.completion.proposals import proposals_for
 from facaid.defaults import DEFAULT_MIN_COPY
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.photo import appearance, repeats

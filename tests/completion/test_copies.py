@@ -74,7 +74,7 @@ def test_completion_carries_the_drawn_elements_along_the_photos_repeats(monkeypa
     """Two windows and their sills drawn in a row and one in the next, on a photo where reflections make every
     window look a little different: the search for look-alikes anywhere (NCC 0.93) finds few of them, the photo's
     repeats carry the drawn ones along the drawn row and column to all of them, and not onto a closed blind."""
-    from facaid import completion
+    from facaid.completion import propose
 
     drawn = [GRID[0], GRID[1], GRID[6]]
     rects = [Rect(FACADE, 0, 0, 700, 520), *(Rect(WINDOW, *b) for b in drawn)]
@@ -86,7 +86,7 @@ def test_completion_carries_the_drawn_elements_along_the_photos_repeats(monkeypa
     assert all(any(_near(p, b) for p in windows) for b in row_and_column), windows
     assert not any(_near(p, GRID[k]) for p in windows for k in CLOSED)
     assert all(p["score"] >= 0.85 for p in windows if p["reason"] == "repeat of window")
-    monkeypatch.setattr(completion, "REPEATS", False)
+    monkeypatch.setattr(propose, "REPEATS", False)
     without = [p for p in complete(seg, photo) if p["label"] == "window"]
     assert len(without) < len(windows) - 3 and not any(p["reason"].startswith("repeat") for p in without)
 

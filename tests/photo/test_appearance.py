@@ -107,7 +107,7 @@ def test_levels_of_a_photo_larger_than_the_working_size_answer_in_the_segmentati
 def test_completion_searches_the_photo_for_a_bounded_number_of_types(monkeypatch):
     """However many types are drawn, the photo is searched for the `MAX_SEARCH_TYPES` drawn most often (issue 56:
     1,690 types on a 16 MP photo took 135 s)."""
-    from facaid import completion
+    from facaid.completion import looks
     from facaid.photo import appearance
 
     calls = []
@@ -121,7 +121,7 @@ def test_completion_searches_the_photo_for_a_bounded_number_of_types(monkeypatch
         rects.append(Rect(WINDOW, x, y, x + w, y + h))
     rects += [Rect(WINDOW, *b) for b in _grid()[:6]]  # and one type drawn six times
     complete(Segmentation(600, 500, tuple(rects)), _photo(_grid()))
-    assert 0 < len(calls) <= completion.MAX_SEARCH_TYPES and (60.0, 60.0) in calls
+    assert 0 < len(calls) <= looks.MAX_SEARCH_TYPES and (60.0, 60.0) in calls
 
 
 def test_the_photo_vetoes_a_sure_structure_only_where_it_looks_unlike_the_drawn(monkeypatch):
@@ -129,10 +129,9 @@ def test_the_photo_vetoes_a_sure_structure_only_where_it_looks_unlike_the_drawn(
     unlike the drawn ones (a darker transom: NCC about 0.81, under the 0.9 that confirms a weaker proposal), and
     goes where it shows something else (issue 57: real copies scored 0.72-0.86 and were halved away). The check
     alone: the photo's repeats, which would propose both windows on their own, are off."""
-    from facaid import completion
-    from facaid.completion import VETO
+    from facaid.completion import VETO, propose
 
-    monkeypatch.setattr(completion, "REPEATS", False)
+    monkeypatch.setattr(propose, "REPEATS", False)
 
     boxes = _grid()
     drawn = [Rect(WINDOW, *b) for i, b in enumerate(boxes) if i != 8]
