@@ -129,7 +129,7 @@ def band_lattice(windows: np.ndarray, at: int, h: int, axis: str) -> int:
     centres = (windows[:, lo] + windows[:, hi]) / 2
     sizes = windows[:, hi] - windows[:, lo]
     inside = (centres >= at) & (centres < at + h) & (sizes <= WIDE * np.median(sizes) if len(sizes) else True)
-    return centre_bands(centres[inside], sizes[inside])
+    return len(centre_bands(centres[inside], sizes[inside]))
 
 
 def band_holds(windows: np.ndarray, at: int, h: int, axis: str) -> int:

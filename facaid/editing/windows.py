@@ -22,12 +22,14 @@ def window_boxes(rows: np.ndarray) -> np.ndarray:
     return region_boxes(rows, GLASS)
 
 
-def centre_bands(centres: np.ndarray, sizes: np.ndarray) -> int:
-    """How many bands the centres make, split where neighbours are over half the median size apart."""
+def centre_bands(centres: np.ndarray, sizes: np.ndarray) -> list[np.ndarray]:
+    """The indices of ``centres`` grouped in bands, in order along the axis: split where neighbouring centres are
+    over half the median size apart. The one band helper of the windows' rows and columns: counted here (`lattice`,
+    `pitch`, the edit check) and read as floors and tiles (`facaid.reading.grid.window_bands`)."""
     if len(centres) == 0:
-        return 0
-    c = np.sort(centres)
-    return int(1 + np.sum(np.diff(c) > 0.5 * np.median(sizes)))
+        return []
+    order = np.argsort(centres, kind="stable")
+    return np.split(order, np.flatnonzero(np.diff(centres[order]) > 0.5 * np.median(sizes)) + 1)
 
 
 def whole_windows(boxes: np.ndarray) -> np.ndarray:
@@ -49,7 +51,7 @@ def pitch(windows: np.ndarray, axis: str) -> float | None:
     if len(windows) == 0:
         return None
     centres, sizes = (windows[:, lo] + windows[:, hi]) / 2, windows[:, hi] - windows[:, lo]
-    if centre_bands(centres, sizes) < 3:
+    if len(centre_bands(centres, sizes)) < 3:
         return None
     across = windows[:, across_hi] - windows[:, across_lo]
     steps = []
@@ -77,8 +79,8 @@ def lattice(rows: np.ndarray, typical: bool = False) -> tuple[int, int]:
     h, wd = w[:, 3] - w[:, 1], w[:, 2] - w[:, 0]
     tall = h > WIDE * np.median(h) if typical else np.zeros(len(w), dtype=bool)
     wide = wd > WIDE * np.median(wd) if typical else np.zeros(len(w), dtype=bool)
-    return (centre_bands(((w[:, 1] + w[:, 3]) / 2)[~tall], h[~tall]),
-            centre_bands(((w[:, 0] + w[:, 2]) / 2)[~wide], wd[~wide]))
+    return (len(centre_bands(((w[:, 1] + w[:, 3]) / 2)[~tall], h[~tall])),
+            len(centre_bands(((w[:, 0] + w[:, 2]) / 2)[~wide], wd[~wide])))
 
 
 def segmentation_lattice(seg: Segmentation) -> tuple[int, int]:

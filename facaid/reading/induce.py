@@ -98,7 +98,7 @@ def _grow(rects: np.ndarray, box: tuple[int, int, int, int], tol: float) -> np.n
     return r[(r[:, 3] > r[:, 1]) & (r[:, 4] > r[:, 2])]
 
 
-def _bands(rects: np.ndarray, lo_col: int, hi_col: int, tol: float) -> tuple[np.ndarray, list]:
+def _overlap_groups(rects: np.ndarray, lo_col: int, hi_col: int, tol: float) -> tuple[np.ndarray, list]:
     """Rectangles grouped along one axis: (rects, [(start, stop, members)]) in order, not overlapping. Two
     rectangles share a band when they overlap by more than their tolerances; within a band, edges within
     tolerance of the band's median edge move onto it (a row of windows drawn a few pixels apart lines up);
@@ -178,7 +178,7 @@ class _Inducer:
         options = []
         for axis in (("y", "x") if prefer_y else ("x", "y")):
             lo_col, hi_col, lo, hi = (2, 4, y0, y1) if axis == "y" else (1, 3, x0, x1)
-            snapped, bands = _bands(rects, lo_col, hi_col, self.tol)
+            snapped, bands = _overlap_groups(rects, lo_col, hi_col, self.tol)
             if len(bands) > 1 or (bands[0][0], bands[0][1]) != (lo, hi):
                 options.append((axis, snapped, bands))
         if depth < self.lookahead:
@@ -189,12 +189,12 @@ class _Inducer:
                 # strict bands (no tolerance) keep rows that overlap at all together: the wings of a building
                 # whose floors do not line up stay whole, to be told apart one level down
                 lo_col, hi_col, lo, hi = (2, 4, y0, y1) if axis == "y" else (1, 3, x0, x1)
-                strict = _bands(rects, lo_col, hi_col, 0.0)
+                strict = _overlap_groups(rects, lo_col, hi_col, 0.0)
                 if 1 < len(strict[1]) < len(next((o[2] for o in options if o[0] == axis), [])):
                     options.append((axis, *strict))
         if not options:
             axis, lo_col, hi_col, lo, hi, cut = least_crossed_cut(rects, box)
-            options.append((axis, *_bands(cut_rects(rects, [cut], lo_col, hi_col), lo_col, hi_col, 0.0)))
+            options.append((axis, *_overlap_groups(cut_rects(rects, [cut], lo_col, hi_col), lo_col, hi_col, 0.0)))
         if depth >= self.lookahead or len(options) == 1:
             return self._split(box, depth, *options[0])
         trees = [self._split(box, depth, *o) for o in options]
