@@ -160,7 +160,7 @@ def main() -> None:
                   f"p95 {1000 * pct(v, 0.95):6.1f} ms")
         # throughput of one CPU worker
         log = open(tmp / "worker.log", "wb")  # noqa: SIM115 (lives as long as the worker)
-        procs.append(subprocess.Popen([sys.executable, "-m", "celery", "-A", "webapp.celery", "worker", "-Q",
+        procs.append(subprocess.Popen([sys.executable, "-m", "celery", "-A", "worker", "worker", "-Q",
                                        "gpu,default", "--pool", "prefork", "--concurrency", "1", "-l", "info"],
                                       cwd=ROOT, env=env,
                                       stdout=log, stderr=subprocess.STDOUT))

@@ -1,2 +1,3 @@
-"""The Celery side of FaçAID: the app and its configuration (`worker.app`) and the computations a job runs
-(`worker.compute`), on plain data. It imports `facaid`, never the site; the site's tasks call into it."""
+"""The worker: its Celery app (`worker.app`, started as ``celery -A worker``), its task (`worker.tasks`) and what a
+job computes on plain data (`worker.compute`), and the demo made before the site opens (``python -m worker demo``). It
+calls `facaid` and stores through the site's models; the site sends it jobs by name and never imports it."""

@@ -64,7 +64,7 @@ def facade_photo(as_alice):
 def redis(tmp_path):
     server = Redis(tmp_path)
     server.start()
-    from worker.app import app
+    from webapp.facades.queue import sender as app
 
     def use(url):  # point the sending side at this server, with fresh connection pools
         app.conf.broker_url = url

@@ -123,7 +123,7 @@ class Worker:
                "FACAID_JOB_RESEND_SECONDS": "2", "PYTHONUNBUFFERED": "1", **environ}
         with open(self.log, "ab") as out:  # the worker keeps its own copy of the descriptor
             self.proc = subprocess.Popen(
-                [sys.executable, "-m", "celery", "-A", "webapp.celery", "worker", "-Q", "gpu,default", "--pool",
+                [sys.executable, "-m", "celery", "-A", "worker", "worker", "-Q", "gpu,default", "--pool",
                  "prefork", "--concurrency", "1", "--without-gossip", "--without-mingle", "-l", "info"],
                 cwd=ROOT, env=env, stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
         deadline = time.time() + 120

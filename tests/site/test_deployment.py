@@ -33,7 +33,7 @@ def test_compose_services_healthchecks_volumes_and_gpu():
     assert "--appendonly" in services["redis"]["command"]
     assert "'X-Forwarded-Proto': 'https'" in services["web"]["healthcheck"]["test"][-1]  # passes https-only too
     assert "gunicorn webapp.wsgi" in services["web"]["command"]
-    assert services["worker"]["command"][:3] == ["celery", "-A", "webapp.celery"]
+    assert services["worker"]["command"][:3] == ["celery", "-A", "worker"]
     assert "gpu" in services["worker"]["command"][services["worker"]["command"].index("-Q") + 1].split(",")
     devices = services["worker"]["deploy"]["resources"]["reservations"]["devices"]
     assert devices[0]["capabilities"] == ["gpu"] and devices[0]["driver"] == "nvidia"

@@ -27,7 +27,7 @@ def shared(as_alice, monkeypatch):
     from site_helpers import upload
 
     from facaid.formats.render import render_segmentation
-    from webapp.facades import tasks
+    from worker import tasks
 
     monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")
     seg = real_like()

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from django.core.exceptions import ImproperlyConfigured
 
-from worker.env import EnvError
+from webapp.env import EnvError
 
 ROOT = Path(__file__).resolve().parents[2]
 SETTINGS = ROOT / "webapp" / "settings.py"
@@ -138,7 +138,8 @@ def test_run_script_exports_the_kept_key_unless_one_is_set_and_serves_plain_http
     assert "SECRET_KEY=${SECRET_KEY:-$(bash scripts/secret-key)}" in text and "export SECRET_KEY" in text
     assert "export FACAID_HTTPS=${FACAID_HTTPS:-0}" in text
     # ... before anything loads the settings
-    first_use = min(text.index(".venv/bin/python manage.py"), text.index(".venv/bin/celery"),
+    first_use = min(text.index(".venv/bin/python manage.py"), text.index(".venv/bin/python -m worker"),
+                    text.index(".venv/bin/celery"),
                     text.index(".venv/bin/gunicorn"))
     assert text.index("export SECRET_KEY") < first_use and text.index("export FACAID_HTTPS") < first_use
 

@@ -220,7 +220,7 @@ def test_save_as_new_and_saved_variations_have_lineage_and_titles_of_their_own(f
 def test_a_re_run_from_a_prefix_is_a_new_version_with_a_warning_when_it_fits_worse(facade_photo, as_alice, alice,
                                                                                   monkeypatch):
     """The job runs in this process, as the worker runs it (`tasks.run_job`), with the shipped model."""
-    from webapp.facades import tasks
+    from worker import tasks
 
     monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")  # the progress beats are enough here
     _, seg = facade_photo
@@ -347,7 +347,7 @@ def _real_like_job(client, structure: str | None = None) -> tuple[Procedure, Job
 
     from facaid.formats.render import render_segmentation
     from tests.site.site_helpers import upload
-    from webapp.facades import tasks
+    from worker import tasks
 
     seg = real_like()
     out = io.BytesIO()

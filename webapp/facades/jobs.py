@@ -12,8 +12,8 @@ from django.db.models import F, Q
 from django.utils import timezone
 
 from webapp.env import env_int
+from webapp.facades import queue
 from webapp.facades.models import Job
-from worker.app import RUN_JOB, app
 
 log = logging.getLogger(__name__)
 
@@ -75,8 +75,7 @@ def send(job_id: int) -> None:
     """Publish the job's task (by name: this module does not import the tasks, which import it), then record
     when: a publish that fails (the broker is down) leaves ``sent`` as it was, so recovery sends the job again at
     its next round instead of after the resend delay."""
-    # no time limits in the message: the worker's own apply (FACAID_JOB_*TIME_LIMIT, worker/app.py)
-    app.send_task(RUN_JOB, args=[job_id], time_limit=None, soft_time_limit=None)
+    queue.send(job_id)
     Job.objects.filter(id=job_id).update(sent=timezone.now())
 
 
@@ -131,7 +130,7 @@ def broker_lost_messages() -> bool:
     """Has the broker's Redis lost its data since the last look (or is this the first look)? Sets the key again."""
     import redis
 
-    client = redis.Redis.from_url(app.conf.broker_url, socket_timeout=5, socket_connect_timeout=5)
+    client = redis.Redis.from_url(queue.sender.conf.broker_url, socket_timeout=5, socket_connect_timeout=5)
     try:
         return bool(client.set(EPOCH_KEY, timezone.now().isoformat(), nx=True))
     finally:

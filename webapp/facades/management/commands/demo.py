@@ -1,7 +1,8 @@
 """``python manage.py demo``: a demo account with a demo facade photo (a photo-like picture of a generated facade,
 `facaid.photo.photolike`), its segmentation and its reconstruction into a public procedure, the front page's example
-(`webapp.facades.example`): queued for the worker, or with ``--now`` made here, as the worker makes it, so that the
-first page a newcomer opens has its example (`scripts/run` does). Does nothing if the account exists."""
+(`webapp.facades.example`): queued for the worker, or with ``--hold`` its job made but not sent, for the worker to run
+at once in its own process before the site opens (``python -m worker demo``, which `scripts/run` runs: the first page
+a newcomer opens has its example). Does nothing if the account exists."""
 
 from __future__ import annotations
 
@@ -24,10 +25,10 @@ class Command(BaseCommand):
 
     def add_arguments(self, parser):
         parser.add_argument("--seed", type=int, default=3, help="generator seed of the demo facade")
-        parser.add_argument("--now", action="store_true",
-                            help="reconstruct it here (seconds), not on the worker: the front page shows it at once")
+        parser.add_argument("--hold", action="store_true",
+                            help="make its job but do not send it (python -m worker demo runs it at once)")
 
-    def handle(self, *args, seed: int, now: bool = False, **options):
+    def handle(self, *args, seed: int, hold: bool = False, **options):
         users = get_user_model()
         if users.objects.filter(username=DEMO_USERNAME).exists():
             self.stdout.write(f"demo account exists: log in as {DEMO_USERNAME} / {DEMO_PASSWORD}")
@@ -44,18 +45,10 @@ class Command(BaseCommand):
                                           rect_count=len(sample.segmentation.rects))
         fields = {"owner": user, "segmentation": seg,
                   "params": {"k": DEFAULT_K, "seed": 0, "visibility": Visibility.PUBLIC}}
-        made = ""
-        if now:
-            from webapp.facades import tasks  # the worker's task, run in this process
-
+        if hold:
             job = Job.objects.create(**fields)
-            tasks.run_job.apply(args=[job.id])
-            job.refresh_from_db()
-            if job.status == Job.Status.DONE:
-                made = "its procedure is made"
-            else:
-                self.stderr.write(f"the demo's reconstruction failed here ({job.message}); the worker will make it")
-        if not made:
+            made = f"its job {job.id} is held for the worker"
+        else:
             jobs.submit(**fields)
             made = "its facade is queued"
         self.stdout.write(f"demo account created: log in as {DEMO_USERNAME} / {DEMO_PASSWORD}; {made}")

@@ -2,7 +2,7 @@
 
 import pytest
 
-from worker.env import EnvError, env_bool, env_int, env_list, env_seconds
+from webapp.env import EnvError, env_bool, env_int, env_list, env_seconds
 
 
 def test_values_and_defaults(monkeypatch):

@@ -1,5 +1,6 @@
-"""Celery tasks of the site. They take job ids, claim the job row, run `worker.compute` and store the result
-in our own rows. The worker also runs job recovery at start and every FACAID_RECOVER_SECONDS."""
+"""The worker's task (`RUN_JOB`, which the site sends by name): it takes a job id, claims the job's row, runs
+`worker.compute` and stores the result through the site's models. The worker also runs the site's job recovery at
+start and every FACAID_RECOVER_SECONDS."""
 
 from __future__ import annotations
 
