@@ -49,7 +49,7 @@ def kinds(rows: np.ndarray) -> list[Kind]:
     return out
 
 
-def pitch(starts: list[float], size: float) -> float | None:
+def spacing(starts: list[float], size: float) -> float | None:
     """The spacing of a row's (column's) elements: the median gap between neighbours, gaps that are about a
     multiple of the smallest read as that many pitches. None with fewer than `MIN_GAPS` gaps (three elements) or
     gaps that do not agree."""
@@ -66,15 +66,15 @@ def pitch(starts: list[float], size: float) -> float | None:
 
 def lines(t: Kind, along: str) -> tuple[list[np.ndarray], list[float]]:
     """The kind's rows (``along`` "x": elements side by side) or columns ("y"), as index arrays into its boxes, and
-    the pitches of those that have one (`pitch`), in their order."""
+    the pitches of those that have one (`spacing`), in their order."""
     lo, hi, at, size = (1, 3, 0, t.width) if along == "x" else (0, 2, 1, t.height)
     found = aligned_lines(t.boxes[:, lo], t.boxes[:, hi])
-    return found, [p for r in found if len(r) >= 2 and (p := pitch(t.boxes[r, at].tolist(), size)) is not None]
+    return found, [p for r in found if len(r) >= 2 and (p := spacing(t.boxes[r, at].tolist(), size)) is not None]
 
 
 def tried(types: list[Kind], dimmed: bool) -> list[str]:
     """In words, for the kinds of element drawn most (at most four): how long their rows and columns are, and
-    whether either has a pitch (`pitch`: three in a line, the gaps agreeing), which the structure needs to
+    whether either has a pitch (`spacing`: three in a line, the gaps agreeing), which the structure needs to
     propose; and whether the photo left places unconfirmed."""
     out = []
     for t in sorted(types, key=lambda t: -len(t.boxes))[:4]:

@@ -41,7 +41,7 @@ def whole_windows(boxes: np.ndarray) -> np.ndarray:
     return boxes[(h >= STRIP * np.median(h)) & (w >= STRIP * np.median(w))]
 
 
-def pitch(windows: np.ndarray, axis: str) -> float | None:
+def window_pitch(windows: np.ndarray, axis: str) -> float | None:
     """The pitch of ``windows`` (boxes x0, y0, x1, y1) along ``axis`` ("y": the floors', "x": the bays'): the median
     distance from a window's centre to the nearest one's beyond it in its column ("y") or row ("x": overlapping it
     across the axis by half the narrower one at least). A person measures a floor from a window to the one above
@@ -67,7 +67,7 @@ def pitch(windows: np.ndarray, axis: str) -> float | None:
 def pitches(rows: np.ndarray) -> tuple[float | None, float | None]:
     """(floor pitch, bay pitch) of a flattened segmentation's rows: `pitch` of its whole windows along y and x."""
     w = whole_windows(window_boxes(rows))
-    return pitch(w, "y"), pitch(w, "x")
+    return window_pitch(w, "y"), window_pitch(w, "x")
 
 
 def lattice(rows: np.ndarray, typical: bool = False) -> tuple[int, int]:
@@ -87,4 +87,5 @@ def segmentation_lattice(seg: Segmentation) -> tuple[int, int]:
     return lattice(flatten_array(seg.width, seg.height, seg.to_array()))
 
 
-__all__ = ["centre_bands", "lattice", "pitch", "pitches", "segmentation_lattice", "whole_windows", "window_boxes"]
+__all__ = ["centre_bands", "lattice", "pitches", "window_pitch", "segmentation_lattice",
+           "whole_windows", "window_boxes"]

@@ -46,8 +46,8 @@ PITCH = 0.15  # floor_height within this share of the window rows' pitch
 def describes(proc: Procedure, rows: np.ndarray) -> dict:
     """Whether the named parameters describe the building of a flattened annotation's ``rows``: ``floor_height``
     within `PITCH` of its floors' pitch (where it has at least three rows of windows: the median step from a window
-    to the next one up its column, `facaid.editing.windows.pitch`), ``tile_width`` the same of its bays' pitch, and
-    no narrower than ``window_width`` (None where there is nothing to judge)."""
+    to the next one up its column, `facaid.editing.windows.window_pitch`), ``tile_width`` the same of its bays' pitch,
+    and no narrower than ``window_width`` (None where there is nothing to judge)."""
     names = {p.name: p.value for p in named_parameters(proc)}
     floor, bay = pitches(rows)
     out = {"floor_pitch": floor, "bay_pitch": bay, "floor_height": names.get("floor_height"),

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from facaid.editing.windows import pitch
+from facaid.editing.windows import window_pitch
 
 
 def stack(x0: float, y0: float, step: float, floors: int, width: float = 20, height: float = 30) -> list:
@@ -17,18 +17,18 @@ def test_the_floor_pitch_is_from_a_window_to_the_next_in_its_column():
     left = stack(10, 50, 100, 4) + stack(60, 50, 100, 4)
     right = stack(200, 90, 110, 4) + stack(250, 90, 110, 4) + stack(300, 90, 110, 4)
     windows = np.array(left + right, dtype=float)
-    assert pitch(windows, "y") == pytest.approx(110)  # 9 steps of 110 px, 6 of 100
-    assert pitch(windows, "x") == pytest.approx(50)
+    assert window_pitch(windows, "y") == pytest.approx(110)  # 9 steps of 110 px, 6 of 100
+    assert window_pitch(windows, "x") == pytest.approx(50)
 
 
 def test_a_dormer_over_a_column_is_no_floor_of_it():
     columns = [stack(x, 100, 90, 3) for x in (10, 60, 110)]
     dormer = [[55, 20, 85, 40]]  # in the roof, over the middle column
     windows = np.array(sum(columns, []) + dormer, dtype=float)
-    assert pitch(windows, "y") == pytest.approx(90)
+    assert window_pitch(windows, "y") == pytest.approx(90)
 
 
 def test_no_pitch_without_three_rows():
     windows = np.array(stack(10, 10, 50, 2) + stack(60, 10, 50, 2), dtype=float)
-    assert pitch(windows, "y") is None
-    assert pitch(np.zeros((0, 4)), "x") is None
+    assert window_pitch(windows, "y") is None
+    assert window_pitch(np.zeros((0, 4)), "x") is None
