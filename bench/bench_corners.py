@@ -4,7 +4,7 @@
     .venv/bin/python bench/bench_corners.py --photos var/cmp_photos_test --half test   # once, for a closing note
 
 For each CMP dev-half photo in ``--photos`` (``cmp_bNNNN.jpg``, the git-ignored cache of the public copy of CMP's
-base set; CMP's photos are rectified facades), `facaid.photo.rectify.propose_corners_file` proposes the facade's four
+base set; CMP's photos are rectified facades), `facaid.photo.corners.propose_corners_file` proposes the facade's four
 corners; the figure is the IoU of that quadrilateral with the annotation's facade box (the bounding box of its
 wall rectangles), counted over the pixels that hold data: the facade as the photo shows it, for the box takes in
 the no-data wedges an earlier rectification left at the photo's corners, which the proposal leaves out
@@ -28,8 +28,9 @@ from PIL import Image, ImageDraw
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.labels import FACADE
 from facaid.paths import DEFAULT_CMP
+from facaid.photo.corners import propose_corners_file
 from facaid.photo.nodata import nodata_mask
-from facaid.photo.rectify import homography, propose_corners_file
+from facaid.photo.rectify import homography
 
 
 def facade_box(seg) -> tuple[int, int, int, int] | None:

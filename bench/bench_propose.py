@@ -1,4 +1,4 @@
-"""The four corners proposed from a photo (`facaid.photo.rectify.propose_corners`) on photo-like pictures of generated
+"""The four corners proposed from a photo (`facaid.photo.corners.propose_corners`) on photo-like pictures of generated
 facades seen in perspective (`facaid.photo.photolike`), whose true corners are known.
 
     .venv/bin/python bench/bench_propose.py [--count 40] [--strength 0.25] [--figure docs/img/rectify-propose.png]
@@ -19,8 +19,8 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from facaid.generator import generate
+from facaid.photo.corners import propose_corners
 from facaid.photo.photolike import facade_box, render_photo, warp
-from facaid.photo.rectify import propose_corners
 
 
 def scene(seed: int, strength: float):

@@ -20,7 +20,8 @@ def _corners_arg(text: str) -> list[list[float]]:
 
 
 def cmd_rectify(args: argparse.Namespace) -> None:
-    from facaid.photo.rectify import output_size, propose_corners, rectify
+    from facaid.photo.corners import propose_corners
+    from facaid.photo.rectify import output_size, rectify
 
     if not (args.propose or args.corners):
         raise CliError("give --propose (find the corners) or --corners (use these)")

@@ -1,5 +1,5 @@
 """No-data regions of a photo: the pure black, white or grey wedges an earlier rectification leaves at its edges, which
-the corner proposal (`facaid.photo.rectify.propose_corners`) must neither follow nor take in.
+the corner proposal (`facaid.photo.corners.propose_corners`) must neither follow nor take in.
 
 A wedge is a region of almost pure black or white, or of one flat grey (some tools fill with grey), that touches
 the photo's edge, larger than a speck and nearly convex (its edges are straight: an overexposed sky is not one). Its

@@ -7,9 +7,9 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from facaid.generator import generate
+from facaid.photo.corners import propose_corners
 from facaid.photo.nodata import clear_of, data_edges, held, nodata_mask
 from facaid.photo.photolike import facade_box, render_photo
-from facaid.photo.rectify import propose_corners
 
 
 def _wedged(seed: int) -> tuple[Image.Image, np.ndarray, tuple[int, int, int, int]]:

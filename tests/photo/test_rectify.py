@@ -1,4 +1,4 @@
-"""Rectification: the four corners proposed from a photo (`facaid.photo.rectify.propose_corners`), checked on photo-like
+"""Rectification: the four corners proposed from a photo (`facaid.photo.corners.propose_corners`), checked on photo-like
 pictures of generated facades seen in perspective (`facaid.photo.photolike`), whose true corners are known."""
 
 from __future__ import annotations
@@ -13,8 +13,9 @@ from PIL import Image
 
 from facaid.cli import main
 from facaid.generator import generate
+from facaid.photo.corners import propose_corners, propose_corners_file
 from facaid.photo.photolike import facade_box, render_photo, warp
-from facaid.photo.rectify import output_size, propose_corners, propose_corners_file, rectify
+from facaid.photo.rectify import output_size, rectify
 
 # seeds 0-11 less the `wings` facades (5, 6), whose box holds sky beside the lower wings: there the true corners
 # are the box's, where the facade's lines end at the tallest wing

@@ -26,7 +26,8 @@ from facaid.completion.copies import UnitError, find_copies
 from facaid.defaults import DEFAULT_K, DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE
 from facaid.formats import interchange
 from facaid.photo import appearance
-from facaid.photo.rectify import propose_corners_file, rectify_file
+from facaid.photo.corners import propose_corners_file
+from facaid.photo.rectify import rectify_file
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades import access, jobs
 from webapp.facades.models import (
@@ -102,7 +103,7 @@ def rectify_photo(photo: Photo, corners) -> Photo:
 
 
 def propose_corners(photo: Photo) -> dict:
-    """The facade's four corners proposed from the original photo's lines (`facaid.photo.rectify.propose_corners`), in
+    """The facade's four corners proposed from the original photo's lines (`facaid.photo.corners.propose_corners`), in
     its pixels, as `rectify` takes them; nothing is stored."""
     with _readable(photo.image) as f:
         return propose_corners_file(f)

@@ -100,7 +100,7 @@ def photo_rectify(request, code):
 
 @extend_schema(request=None, responses={200: dict},
                summary="Propose the facade's four corners from the photo's lines and vanishing points "
-                       "(facaid.photo.rectify.propose_corners): {'corners': [[x, y] x 4] (top-left, top-right, "
+                       "(facaid.photo.corners.propose_corners): {'corners': [[x, y] x 4] (top-left, top-right, "
                        "bottom-right, "
                        "bottom-left, in the original photo's pixels, as rectify takes them), 'confidence' (0..1: the "
                        "share of the four sides that detected lines cover), 'notes', 'lines'}; nothing is stored")
