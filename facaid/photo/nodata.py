@@ -2,10 +2,10 @@
 the corner proposal (`facaid.photo.corners.propose_corners`) must neither follow nor take in.
 
 A wedge is a region of almost pure black or white, or of one flat grey (some tools fill with grey), that touches
-the photo's edge, larger than a speck and nearly convex (its edges are straight: an overexposed sky is not one). Its
-straight border with the photo is a strong line that outvotes the facade's own, so the segments along it are dropped
-(`off_wedges`); and the proposal is moved off it as a rectangle of the facade's plane (`clear_of`), so that
-rectifying from it crops the facade and never skews it.
+the photo's edge, larger than a speck, nearly convex (its edges are straight: a ragged skyline is not one) and
+uniform (a smooth sky's gradient is not one). Its straight border with the photo is a strong line that outvotes the
+facade's own, so the segments along it are dropped where it is slanted (`off_wedges`); and the proposal is moved off
+it as a rectangle of the facade's plane (`clear_of`), so that rectifying from it crops the facade and never skews it.
 """
 
 from __future__ import annotations
@@ -17,6 +17,8 @@ FLAT = 1  # or a region whose every pixel's 3 x 3 neighbourhood spans at most th
 SPECK = 0.002  # of the photo's area: a smaller region at the edge is a speck, not a wedge
 MOST = 0.5  # a photo more black (white) than this is a dark (bright) picture, not one with wedges
 SOLID = 0.9  # a wedge fills at least this share of its convex hull (its edges are straight)
+UNIFORM = 2.0  # ... and its grey levels spread by at most this (standard deviation): a smooth sky's gradient is more
+AXIS_DEG = 2.0  # a segment this near horizontal or vertical along a wedge may be the facade's own line
 NEAR = 3  # work pixels: a segment whose middle lies this near a wedge is its border
 LEFT_IN = 0.002  # of the quadrilateral's area: the no data it may still hold (JPEG's ringing at the border)
 KEEP = 0.9  # a wedge deep in the facade, to clear which would leave less of the quadrilateral, stays in it
@@ -39,21 +41,27 @@ def nodata_mask(luma: np.ndarray) -> np.ndarray:
             region = labels == k
             ys, xs = np.nonzero(region)
             hull = cv2.convexHull(np.stack([xs, ys], axis=1).astype(np.int32))
-            if stats[k, cv2.CC_STAT_AREA] >= SOLID * max(1.0, cv2.contourArea(hull) + cv2.arcLength(hull, True) / 2):
+            hull_area = cv2.contourArea(hull) + cv2.arcLength(hull, True) / 2
+            solid = stats[k, cv2.CC_STAT_AREA] >= SOLID * max(1.0, hull_area)
+            if solid and float(luma[region].std()) <= UNIFORM:
                 out |= region
     return out if out.mean() <= MOST else np.zeros(luma.shape, dtype=bool)
 
 
 def off_wedges(segments: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """The segments (N, 5: x1, y1, x2, y2, length, in the mask's pixels) but those along a wedge's border: whose
-    middle lies within `NEAR` pixels of no data."""
+    """The segments (N, 5: x1, y1, x2, y2, length, in the mask's pixels) but those along a wedge's slanted border:
+    whose middle lies within `NEAR` pixels of no data. A segment within `AXIS_DEG` of the photo's axes stays: the
+    straight roofline under a blown-out sky is the facade's own line, and an earlier rectification's wedges are
+    slanted."""
     if not mask.any() or not len(segments):
         return segments
     near = _grown(mask, NEAR)
     h, w = mask.shape
     mx = np.clip(((segments[:, 0] + segments[:, 2]) / 2).round().astype(int), 0, w - 1)
     my = np.clip(((segments[:, 1] + segments[:, 3]) / 2).round().astype(int), 0, h - 1)
-    return segments[~near[my, mx]]
+    angle = np.degrees(np.arctan2(np.abs(segments[:, 3] - segments[:, 1]), np.abs(segments[:, 2] - segments[:, 0])))
+    upright = (angle <= AXIS_DEG) | (angle >= 90 - AXIS_DEG)
+    return segments[~near[my, mx] | upright]
 
 
 def held(pts: np.ndarray, mask: np.ndarray) -> float:

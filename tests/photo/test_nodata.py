@@ -97,3 +97,27 @@ def test_a_head_on_proposal_widens_to_where_the_data_ends_not_to_the_photo_edge(
     assert data_edges(mask, (100, 50, 300, 250)) == (30.0, 0.0, 400.0, 300.0)
     mask[:, 360:] = True
     assert data_edges(mask, (100, 50, 300, 250))[2] == 360.0
+
+
+def test_a_blown_out_or_smooth_sky_above_a_straight_roofline_keeps_the_roofline():
+    """A white (or smoothly graded) sky over a flat roof touches the photo's edge and is convex like a wedge; the
+    roofline under it is the facade's own line: the proposal is the one the same photo with a textured sky gets (a
+    review found a bay lost on each side)."""
+    g = generate(0)
+    facade = render_photo(g.segmentation, 0).crop(facade_box(g.segmentation))
+    w, h = facade.size
+    rng = np.random.default_rng(0)
+    found = {}
+    for sky in ("textured", "white", "gradient"):
+        photo = np.full((h + 200, w + 240, 3), (150, 165, 185), np.uint8)
+        photo[:] = np.clip(photo + rng.normal(0, 6, photo.shape), 0, 255).astype(np.uint8)
+        if sky == "white":
+            photo[:150] = 255
+        elif sky == "gradient":
+            photo[:150] = np.linspace(200, 235, w + 240, dtype=np.uint8)[None, :, None]
+        image = Image.fromarray(photo)
+        image.paste(facade, (120, 150))
+        found[sky] = np.array(propose_corners(image)["corners"])
+    diagonal = np.hypot(w, h)
+    for sky in ("white", "gradient"):
+        assert np.abs(found[sky] - found["textured"]).max() <= 0.01 * diagonal, (sky, found)
