@@ -29,7 +29,8 @@ import statistics
 import time
 from pathlib import Path
 
-from facaid.completion import DEFAULT_MIN_SCORE, complete
+from facaid.completion import complete
+from facaid.defaults import DEFAULT_MIN_SCORE
 from facaid.evaluation.assist import as_drawn, simulate, summary
 from facaid.evaluation.real import DEV_FACADES, load_records
 from facaid.paths import DEFAULT_CMP
