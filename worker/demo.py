@@ -25,6 +25,8 @@ def make_demo() -> str:
     held.refresh_from_db()
     if held.status == Job.Status.DONE:
         return "the demo's procedure is made"
+    if held.status != Job.Status.FAILED:  # a worker's recovery sent it and that worker claimed it first
+        return "the demo's procedure is being made by the worker"
     print(f"the demo's reconstruction failed here ({held.message}); the worker will make it", file=sys.stderr)
     jobs.submit(owner=held.owner, segmentation=held.segmentation, params=held.params)
     return "the demo's facade is queued for the worker"

@@ -25,7 +25,7 @@ def window_boxes(rows: np.ndarray) -> np.ndarray:
 def centre_bands(centres: np.ndarray, sizes: np.ndarray) -> list[np.ndarray]:
     """The indices of ``centres`` grouped in bands, in order along the axis: split where neighbouring centres are
     over half the median size apart. The one band helper of the windows' rows and columns: counted here (`lattice`,
-    `pitch`, the edit check) and read as floors and tiles (`facaid.reading.grid.window_bands`)."""
+    `window_pitch`, the edit check) and read as floors and tiles (`facaid.reading.grid.window_bands`)."""
     if len(centres) == 0:
         return []
     order = np.argsort(centres, kind="stable")
@@ -65,7 +65,8 @@ def window_pitch(windows: np.ndarray, axis: str) -> float | None:
 
 
 def pitches(rows: np.ndarray) -> tuple[float | None, float | None]:
-    """(floor pitch, bay pitch) of a flattened segmentation's rows: `pitch` of its whole windows along y and x."""
+    """(floor pitch, bay pitch) of a flattened segmentation's rows: `window_pitch` of its whole windows along y and
+    x."""
     w = whole_windows(window_boxes(rows))
     return window_pitch(w, "y"), window_pitch(w, "x")
 

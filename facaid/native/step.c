@@ -1,6 +1,6 @@
 /* One decoder step of FacaidModel's GPT-2 decoder for K rows that read one encoder memory, in plain C.
 
-   The same arithmetic as the torch decoder's cached step (facaid/decoder.py; pre-layer-norm self-attention on a
+   The same arithmetic as the torch decoder's cached step (facaid/model/decoder.py; pre-layer-norm self-attention on a
    key/value cache, cross-attention on the memory with an additive mask, tanh-GELU MLP, final layer norm and
    the output head), written so that the compiler vectorizes every inner loop without reassociating sums:
    matrix-vector products as sums of scaled rows (weights stored (in, out)), keys stored transposed (dh, T) so
