@@ -137,6 +137,11 @@ class ReconstructOptions:
             object.__setattr__(self, "prefix", tuple(self.prefix))
 
     @property
+    def prefix_ids(self) -> list[int] | None:
+        """The prefix as the decoder takes it (a list), or None."""
+        return list(self.prefix) if self.prefix is not None else None
+
+    @property
     def free(self) -> bool:
         """Whether the structure is the reader's to choose: the model's, induced or read as a lattice (no prefix)."""
         return self.prefix is None
@@ -208,7 +213,7 @@ def _candidates(model: FacaidModel, tokenizer: Tokenizer, readable: Segmentation
     candidate is decoded first, alone: where it is `FAR_OFF` and the induced structure `FAR_BEHIND` ahead of it
     (an annotation unlike the model's training data: a real facade), the samples are not drawn, as only the
     induced structure is sized then; else the K - 1 samples follow, the same as decoded in one batch with it."""
-    k, seed, prefix = opts.k, opts.seed, list(opts.prefix) if opts.prefix is not None else None
+    k, seed, prefix = opts.k, opts.seed, opts.prefix_ids
     if not (opts.sizing and opts.induce and opts.free) or k == 1:
         return _Candidates(ranked_candidates(model, tokenizer, readable, k=k, seed=seed, prefix=prefix,
                                              reference=flat), None, False, k)
@@ -256,9 +261,8 @@ def _sized(found: _Candidates, model: FacaidModel, tokenizer: Tokenizer, readabl
     if fitted.accuracy < opts.retry_below and opts.retry_k and source == "model" and not denoised:
         tell(0.75, f"sampling {opts.retry_k} more candidates")
         retried, drawn = True, drawn + opts.retry_k
-        prefix = list(opts.prefix) if opts.prefix is not None else None
         more = decode(model, tokenizer, readable, k=opts.retry_k, sample=True, greedy=0, seed=opts.seed + 1,
-                      prefix=prefix)
+                      prefix=opts.prefix_ids)
         other = _second_chance(found.ranked[1:] + more, found.ranked[0], flat)
         if other is not None and other.accuracy > fitted.accuracy:
             fitted, before = other, other.accuracy_before  # before sizing, of that candidate

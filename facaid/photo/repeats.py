@@ -252,7 +252,7 @@ def unit_copies(levels: Levels, drawn: np.ndarray, unit: np.ndarray) -> list[Cop
         return []
     out = []
     shifts = reading.shifts(1)
-    for shift in dict.fromkeys(shifts + [s for s in reading.own_shifts(0) if s not in set(shifts)]):
+    for shift in dict.fromkeys(shifts + reading.own_shifts(0)):  # the shared repeats first, then the unit's own
         head = reading.carry(0, shift)
         if head is None or head[1] < MATCH:
             continue
