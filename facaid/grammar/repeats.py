@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from facaid.grammar.limits import MAX_COUNT
 
 if TYPE_CHECKING:
-    from facaid.grammar.procedure import Node, Override
+    from facaid.grammar.nodes import Node, Override
 
 
 def expanded_count(node: Node) -> int:
