@@ -16,10 +16,9 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-import numpy as np
-
 from facaid.editing.floors import as_floors_repeat, plain_floor, unrepeated_floors
 from facaid.editing.growth import grow
+from facaid.editing.instances import Instances
 from facaid.editing.resizing import copy_lengths, copy_procedure, repeat_unit, resize
 from facaid.editing.rows import (
     aligned_rows,
@@ -32,7 +31,6 @@ from facaid.editing.rows import (
     wall_rows,
 )
 from facaid.grammar.execute import first_boxes, parameter_lengths
-from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
 from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
 from facaid.grammar.repeats import copies_moved, copies_where, most_typical, recount
@@ -70,48 +68,6 @@ class Parameter:
         return asdict(self)
 
 
-class _Instances:
-    """Every node instance of a procedure: per node, its path, how many instances and the first one's extents."""
-
-    def __init__(self, proc: Procedure):
-        self.path: dict[int, str] = {}
-        self.count: dict[int, int] = {}
-        self.extent: dict[int, tuple[float, float]] = {}  # the first instance's
-        self.extents: dict[int, list[tuple[float, float]]] = {}  # every instance's
-        self.parent_axis: dict[int, str | None] = {}
-        self.outer: dict[int, bool] = {}  # no ancestor with the same role
-        # an exception's node is named by its own path (root/1/!0), as `Node.walk` names it, wherever it is laid out
-        self.own = {id(n): p for p, n in proc.nodes() if "!" in p}
-        self._visit(proc.root, "root", float(proc.width), float(proc.height), None, frozenset())
-
-    def typical(self, key: int) -> tuple[float, float]:
-        """The median extents of a node's instances: a floor's height is the floors' typical height, not the top
-        floor's, which may have one of its own."""
-        ws, hs = zip(*self.extents[key], strict=True)
-        return float(np.median(ws)), float(np.median(hs))
-
-    def _visit(self, node: Node, path: str, w: float, h: float, axis: str | None, roles: frozenset,
-               pending: list | None = None) -> None:
-        key = id(node)
-        if key not in self.path:
-            self.path[key], self.extent[key], self.parent_axis[key] = path, (w, h), axis
-            self.outer[key] = node.role not in roles
-        self.count[key] = self.count.get(key, 0) + 1
-        self.extents.setdefault(key, []).append((w, h))
-        if node.rule == "leaf":
-            return
-        length = w if node.axis == "x" else h
-        sizes, children, _, below, _ = expand_over(node, length, pending)
-        lengths = layout(sizes, length)
-        inner = roles | {node.role} if node.role else roles
-        n = len(node.children)
-        for i, (child, extent) in enumerate(zip(children, lengths, strict=True)):
-            cw, ch = (extent, h) if node.axis == "x" else (w, extent)
-            replaced = id(child) in self.own and child is not node.children[i % n]  # an exception's node: its path
-            child_path = self.own[id(child)] if replaced else f"{path}/{i % n}"
-            self._visit(child, child_path, cw, ch, node.axis, inner, below[i] if below is not None else None)
-
-
 def _nodes(proc: Procedure) -> dict[str, Node]:
     return dict(proc.nodes())
 
@@ -136,7 +92,7 @@ def normalised(proc: Procedure) -> Procedure:
     return out
 
 
-def _floor_repeats(proc: Procedure, inst: _Instances, role: str, axis: str) -> list[tuple[str, Node]]:
+def _floor_repeats(proc: Procedure, inst: Instances, role: str, axis: str) -> list[tuple[str, Node]]:
     """The repeats with a count along ``axis`` that lay out the outermost nodes of ``role`` (for each, the nearest
     such repeat above it), largest count first."""
     nodes = _nodes(proc)
@@ -153,12 +109,12 @@ def _floor_repeats(proc: Procedure, inst: _Instances, role: str, axis: str) -> l
     return sorted(found.items(), key=lambda pn: -pn[1].count)
 
 
-def _count_of(inst: _Instances, proc: Procedure, role: str) -> tuple[int, list[str]]:
+def _count_of(inst: Instances, proc: Procedure, role: str) -> tuple[int, list[str]]:
     nodes = [(p, n) for p, n in proc.nodes() if n.role == role and inst.outer.get(id(n))]
     return sum(inst.count[id(n)] for _, n in nodes), [p for p, _ in nodes]
 
 
-def _bays(proc: Procedure, inst: _Instances) -> tuple[int, list[str]] | None:
+def _bays(proc: Procedure, inst: Instances) -> tuple[int, list[str]] | None:
     """How many tiles the first floor that has any holds as laid out without exceptions (a copy that an exception
     replaces is still a tile of its row), and the paths of its outermost tile nodes."""
     for _, floor in proc.nodes():
@@ -198,7 +154,7 @@ def _typical_tiles(node: Node) -> int:
     return sum(inner)
 
 
-def _margins(proc: Procedure, inst: _Instances) -> list[tuple[str, Node]]:
+def _margins(proc: Procedure, inst: Instances) -> list[tuple[str, Node]]:
     """The side margins: the wall leaves that begin or end a split along x holding tiles (a row of bays between the
     facade's edges), outermost rows only, with their paths."""
     out = []
@@ -215,14 +171,14 @@ def _margins(proc: Procedure, inst: _Instances) -> list[tuple[str, Node]]:
     return out
 
 
-def _most_laid_out(inst: _Instances, nodes: list[tuple[str, Node]]) -> Node:
+def _most_laid_out(inst: Instances, nodes: list[tuple[str, Node]]) -> Node:
     """Of these nodes, the one laid out most often (the first of those): whose size a parameter shows."""
     return max(nodes, key=lambda pn: inst.count[id(pn[1])])[1]
 
 
 def named_parameters(proc: Procedure) -> list[Parameter]:
     """The named parameters this procedure has (those whose roles it holds), in `NAMES` order."""
-    inst = _Instances(proc)
+    inst = Instances(proc)
     out: list[Parameter] = []
     floors, paths = _count_of(inst, proc, "floor")
     if floors:
@@ -286,7 +242,7 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
     out = normalised(proc)
     if name == "bays":  # a row mirrored around its centre bay as the repeat it draws, so that it takes one bay
         out = unmirrored(out)
-    inst = _Instances(out)
+    inst = Instances(out)
     nodes = _nodes(out)
     if name in _LENGTHS or name in _WINDOW or name == "margin":
         axis = AXES[name]
@@ -306,7 +262,7 @@ def set_parameter(proc: Procedure, name: str, value: float) -> Procedure:
         else:
             if not _floor_repeats(out, inst, role, axis) and (run := unrepeated_floors(out, inst)) is not None:
                 as_floors_repeat(*run, inst)  # floors laid out one by one: the repeat they are, to take one more
-                inst = _Instances(out)
+                inst = Instances(out)
             repeats = _floor_repeats(out, inst, role, axis)[:1]
         if not repeats and int(value) != int(p.value):
             raise ValueError(f"{name} cannot change here: no repeat lays out the {role}s (edit the tree instead)")

@@ -141,7 +141,8 @@ def test_a_floor_fewer_leaves_the_copy_that_alone_lays_out_the_floors_pattern():
     from grammar_helpers import facade
 
     from facaid.editing.floors import plain_floor
-    from facaid.editing.parameters import _floor_repeats, _Instances, normalised
+    from facaid.editing.instances import Instances
+    from facaid.editing.parameters import _floor_repeats, normalised
     from facaid.grammar.procedure import Node, Size
 
     def row(window: str) -> Node:
@@ -154,7 +155,7 @@ def test_a_floor_fewer_leaves_the_copy_that_alone_lays_out_the_floors_pattern():
     proc = facade([Override(0, (0,), node=row("blind")), Override(1, (0,), node=row("blind")),
                    Override(2, (0,), node=row("window"))], bays=[Override(2, (0,), size=Size("flt", 90))])
     out = normalised(proc)
-    inst = _Instances(out)
+    inst = Instances(out)
     floors = _floor_repeats(out, inst, "floor", "y")[0][1]
     assert plain_floor(out, floors, inst) == 3  # a floor more repeats the pattern's own copy
     assert plain_floor(out, floors, inst, fewer=True) == 2  # a floor fewer takes its twin
