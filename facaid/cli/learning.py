@@ -38,7 +38,8 @@ def add_train(sub) -> None:
 def cmd_evaluate(args: argparse.Namespace) -> None:
     import torch
 
-    from facaid.evaluation.synthetic import evaluate_synthetic, write_report
+    from facaid.evaluation.synthetic import evaluate_synthetic
+    from facaid.evaluation.synthetic_report import write_report
     from facaid.model import load_model
 
     if args.ceiling and args.best_of < 2:

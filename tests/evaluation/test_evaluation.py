@@ -6,7 +6,8 @@ from facaid.augmentation import changed_fraction, perturb
 from facaid.cli import main
 from facaid.decoding import decode
 from facaid.evaluation.records import RecordsError
-from facaid.evaluation.synthetic import by_style, evaluate_synthetic, nll, write_report
+from facaid.evaluation.synthetic import by_style, evaluate_synthetic, nll
+from facaid.evaluation.synthetic_report import write_report
 from facaid.generator import generate
 from facaid.model import save_model
 from facaid.segmentation import flatten
