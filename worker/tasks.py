@@ -87,10 +87,6 @@ def run_job(self, job_id: int) -> None:
 # a fork's re-run (its owner is not the photo's) whose photo its owner made private before the result was stored
 MADE_PRIVATE = "the photo was made private while this job ran, so nothing of it was stored"
 
-# what a job's result says of its tree, kept in the procedure's metrics beside its accuracy
-JOB_METRICS = ("accuracy_decoded", "iou", "timings", "source", "retried", "shortcut", "structure")
-
-
 # the notes of a real facade's two first versions (`facaid.pipeline.reconstruct`)
 STRUCTURE_NOTES = {"editable": "editable: floors of tiles with exceptions, what the parameters edit",
                    "exact": "exact: the annotation as drawn"}
@@ -128,13 +124,10 @@ def _store(job: Job, result: dict) -> None:
     see the photo."""
     photo, params = job.segmentation.photo, job.params or {}
     # the edits of each tree checked here, before any row is locked (the saves below find them and keep them)
-    metrics = editcheck.checked({k: result[k] for k in JOB_METRICS if k in result}, result["procedure"],
-                                tree_digest(result["procedure"]))
+    metrics = editcheck.checked(result["metrics"], result["procedure"], tree_digest(result["procedure"]))
     other = result.get("alternative")
     if other:
-        other_metrics = {"source": "induced" if other["structure"] == "exact" else "lattice",
-                         "structure": other["structure"]}
-        other_metrics = editcheck.checked(other_metrics, other["procedure"], tree_digest(other["procedure"]))
+        other_metrics = editcheck.checked(other["metrics"], other["procedure"], tree_digest(other["procedure"]))
     with transaction.atomic():
         if Job.objects.select_for_update().filter(id=job.id, status=Job.Status.RUNNING).count() != 1:
             return  # recovered and given to another worker meanwhile
