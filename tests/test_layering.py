@@ -162,3 +162,11 @@ def test_every_package_opens_on_a_short_front_door():
              if "migrations" not in p.parts]
     long = {str(p.relative_to(ROOT)): n for p in doors if (n := len(p.read_text().splitlines())) > 100}
     assert len(doors) > 10 and long == {}
+
+
+def test_frontend_is_a_folder_per_page():
+    """Issue 69: the browser's modules sit in a folder per page (`editor/`, `procedure/`, `job/`) and `common/` for
+    what more than one page imports; at most 8 scripts at `frontend/`'s top level."""
+    top = list((ROOT / "frontend").glob("*.js"))
+    assert len(top) <= 8, sorted(p.name for p in top)
+    assert {"editor", "procedure", "job", "common"} <= {p.name for p in (ROOT / "frontend").iterdir() if p.is_dir()}

@@ -157,7 +157,8 @@ STATIC_URL = "static/"
 STATIC_ROOT = VAR_DIR / "static"
 STATIC_ROOT.mkdir(parents=True, exist_ok=True)  # WhiteNoise warns about a missing one before collectstatic
 WHITENOISE_AUTOREFRESH = env_bool("WHITENOISE_AUTOREFRESH", DEBUG)  # re-read changed files (development)
-STATICFILES_DIRS = [BASE_DIR / "webapp" / "static", ("editor", BASE_DIR / "frontend")]
+# the pages' ES modules (frontend/: editor/, procedure/, job/, common/) as static/app/...
+STATICFILES_DIRS = [BASE_DIR / "webapp" / "static", ("app", BASE_DIR / "frontend")]
 MEDIA_URL = "media/"
 MEDIA_ROOT = Path(env_str("MEDIA_ROOT", str(VAR_DIR / "media")))
 

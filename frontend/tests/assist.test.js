@@ -2,10 +2,10 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {facadeBounds, proposalAt, repeatByPitch, repeatSelection, splitCommand} from "../assist.js";
-import {AddRects} from "../commands.js";
-import {History} from "../history.js";
-import {Segmentation} from "../state.js";
+import {facadeBounds, proposalAt, repeatByPitch, repeatSelection, splitCommand} from "../editor/assist.js";
+import {AddRects} from "../editor/commands.js";
+import {History} from "../editor/history.js";
+import {Segmentation} from "../editor/state.js";
 
 function scene() {
   const seg = new Segmentation(200, 100);

@@ -2,9 +2,9 @@ import assert from "node:assert/strict";
 import {test} from "node:test";
 
 import {AddRects, DeleteRects, ReplaceAll, UpdateRects, duplicateRects, moveRects, repeatRects, setLabel}
-  from "../commands.js";
-import {History} from "../history.js";
-import {Segmentation, SegmentationError} from "../state.js";
+  from "../editor/commands.js";
+import {History} from "../editor/history.js";
+import {Segmentation, SegmentationError} from "../editor/state.js";
 
 function fresh() {
   const seg = new Segmentation(100, 80);

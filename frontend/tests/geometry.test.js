@@ -2,7 +2,7 @@ import assert from "node:assert/strict";
 import {test} from "node:test";
 
 import {clampToImage, handleAt, identical, moveWithin, normalize, repeatRect, resize, snap, throughRectification}
-  from "../geometry.js";
+  from "../editor/geometry.js";
 
 test("normalize and clamp", () => {
   assert.deepEqual(normalize({x0: 5, y0: 9, x1: 1, y1: 2}), {x0: 1, y0: 2, x1: 5, y1: 9});
@@ -44,7 +44,7 @@ test("repeat on a row, a column and a grid", () => {
 });
 
 test("homography maps the four corners and is projective in between", async () => {
-  const {applyHomography, homography, isConvexQuad, rectifiedSize} = await import("../geometry.js");
+  const {applyHomography, homography, isConvexQuad, rectifiedSize} = await import("../editor/geometry.js");
   const src = [[10, 20], [110, 10], [120, 90], [5, 100]];
   const dst = [[0, 0], [100, 0], [100, 80], [0, 80]];
   const h = homography(dst, src);  // output -> source, as the preview samples

@@ -2,10 +2,10 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {AddRects} from "../commands.js";
-import {History} from "../history.js";
-import {boxFields, setBoxCommand} from "../inspect.js";
-import {Segmentation} from "../state.js";
+import {AddRects} from "../editor/commands.js";
+import {History} from "../editor/history.js";
+import {boxFields, setBoxCommand} from "../editor/inspect.js";
+import {Segmentation} from "../editor/state.js";
 
 function scene() {
   const seg = new Segmentation(200, 100);

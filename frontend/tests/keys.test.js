@@ -3,7 +3,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {ACTIONS, POINTER, SHORTCUTS, keyAction, parseCombo, shortcutRows} from "../keys.js";
+import {ACTIONS, POINTER, SHORTCUTS, keyAction, parseCombo, shortcutRows} from "../editor/keys.js";
 
 const state = (extra = {}) => ({selected: 1, proposals: 3, field: null, onButton: false, ...extra});
 

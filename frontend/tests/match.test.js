@@ -1,7 +1,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {findSimilar, toGray} from "../match.js";
+import {findSimilar, toGray} from "../editor/match.js";
 
 function facade(width, height, windows) {
   const data = new Uint8ClampedArray(width * height * 4).fill(200);

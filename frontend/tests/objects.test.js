@@ -2,12 +2,12 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {AddRects} from "../commands.js";
-import {History} from "../history.js";
+import {AddRects} from "../editor/commands.js";
+import {History} from "../editor/history.js";
 import {freeView, layersNote, noFacadeNote, objectGroups, pickable, pickableSelection, shown, toggleLayer}
-  from "../objects.js";
-import {Segmentation} from "../state.js";
-import {press} from "../tools/select.js";
+  from "../editor/objects.js";
+import {Segmentation} from "../editor/state.js";
+import {press} from "../editor/tools/select.js";
 
 function scene() {
   const seg = new Segmentation(200, 100);

@@ -1,7 +1,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {elementOf, elementsUnder, elementText, fitView, keyLight, VIEW_DIRECTION} from "../preview3d-view.js";
+import {elementOf, elementsUnder, elementText, fitView, keyLight, VIEW_DIRECTION} from "../procedure/preview3d-view.js";
 
 const facade = {min: [0, 0, -0.15], max: [12, 18, 0.5]};  // metres: a wall with windows behind, balconies before
 

@@ -2,10 +2,10 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {AddRects} from "../commands.js";
-import {History} from "../history.js";
-import {chipAt, chipMembers, chips, copyOf, lines, toggleRejected, unitIndices} from "../proposals.js";
-import {Segmentation} from "../state.js";
+import {AddRects} from "../editor/commands.js";
+import {History} from "../editor/history.js";
+import {chipAt, chipMembers, chips, copyOf, lines, toggleRejected, unitIndices} from "../editor/proposals.js";
+import {Segmentation} from "../editor/state.js";
 
 /** Copies of a window with its sill on a 3 x 2 lattice (pitch 100 x 120), as "Find copies" answers. */
 function copies() {

@@ -1,7 +1,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {isWithin, leafAt, leavesUnder, parametersOf, pictureToProcedure} from "../selection.js";
+import {isWithin, leafAt, leavesUnder, parametersOf, pictureToProcedure} from "../procedure/selection.js";
 
 // a floor of two tiles (root/1/0 repeated), each a window over a sill, under an attic band
 const leaves = [

@@ -2,7 +2,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {patientFetch} from "../server.js";
+import {patientFetch} from "../common/server.js";
 
 function answers(...statuses) {  // a stand-in for the network: the statuses in turn, each with Retry-After 1
   const asked = [];

@@ -3,11 +3,11 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {AddRects} from "../commands.js";
-import {History} from "../history.js";
-import {Segmentation} from "../state.js";
-import {SNAP_PX} from "../tools/context.js";
-import {press} from "../tools/select.js";
+import {AddRects} from "../editor/commands.js";
+import {History} from "../editor/history.js";
+import {Segmentation} from "../editor/state.js";
+import {SNAP_PX} from "../editor/tools/context.js";
+import {press} from "../editor/tools/select.js";
 
 function scene() {
   const seg = new Segmentation(400, 300);

@@ -3,14 +3,14 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {acceptCommand, rejectedOf, repeatCommand} from "../assist.js";
-import {AddRects} from "../commands.js";
-import {History} from "../history.js";
-import {keyAction} from "../keys.js";
-import {Segmentation} from "../state.js";
-import {HANDLE_PX} from "../tools/context.js";
-import {press} from "../tools/select.js";
-import {PinchGesture, fitView} from "../tools/view.js";
+import {acceptCommand, rejectedOf, repeatCommand} from "../editor/assist.js";
+import {AddRects} from "../editor/commands.js";
+import {History} from "../editor/history.js";
+import {keyAction} from "../editor/keys.js";
+import {Segmentation} from "../editor/state.js";
+import {HANDLE_PX} from "../editor/tools/context.js";
+import {press} from "../editor/tools/select.js";
+import {PinchGesture, fitView} from "../editor/tools/view.js";
 
 function scene() {
   const seg = new Segmentation(200, 100);

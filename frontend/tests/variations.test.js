@@ -2,7 +2,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {variantCaption} from "../procedure-variations.js";
+import {variantCaption} from "../procedure/variations.js";
 
 test("a variant's caption says its counts and what made it, not its kind and size", () => {
   const v = (variation, counts, w = 654.4, h = 797) => ({width: w, height: h, meta: {variation, counts}});

@@ -2,7 +2,7 @@
 import assert from "node:assert/strict";
 import {test} from "node:test";
 
-import {photoFilter} from "../tools/view.js";
+import {photoFilter} from "../editor/tools/view.js";
 
 test("photo filter: none at the photo's own levels, the factors otherwise, kept inside 0.2..4", () => {
   assert.equal(photoFilter(), "none");

@@ -19,7 +19,7 @@ def node_eval(code: str) -> str:
 
 
 def test_labels_palette_and_paint_order_match_the_library():
-    out = json.loads(node_eval("import * as L from './labels.js'; console.log(JSON.stringify("
+    out = json.loads(node_eval("import * as L from './editor/labels.js'; console.log(JSON.stringify("
                                "{labels: L.LABELS, order: L.PAINT_ORDER, palette: L.PALETTE}))"))
     assert out["labels"] == list(LABELS)
     assert out["order"] == list(PAINT_ORDER)

@@ -137,7 +137,7 @@ def test_the_shortcuts_help_lists_the_key_table_opens_on_question_mark_and_close
     page.keyboard.press("?")
     assert page.is_visible("#help")
     # the rows are keys.js's table, as the page loaded it
-    table = page.evaluate("import('/static/editor/keys.js').then(k => k.shortcutRows())")
+    table = page.evaluate("import('/static/app/editor/keys.js').then(k => k.shortcutRows())")
     shown = page.eval_on_selector_all("#help-body section:first-child tr", "rows => rows.map(r => "
                                       "({keys: r.cells[0].textContent, does: r.cells[1].textContent}))")
     assert shown == table and len(shown) >= 15

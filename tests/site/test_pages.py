@@ -115,7 +115,7 @@ def test_the_procedure_pages_3d_panel_loads_three_js_from_this_site(alice):
         panel = re.search(r'<details class="panel preview3d" id="preview3d"([^>]*)>', html).group(1)
         assert f'data-glb="/api/v1/procedures/{proc.code}/download/facade.glb"' in panel
         assert ("facade-photo.glb" in panel) == photo_visible == ('id="preview3d-photo"' in html)
-        assert '<script type="module" src="/static/editor/preview3d.js">' in html
+        assert '<script type="module" src="/static/app/procedure/preview3d.js">' in html
 
 
 def test_the_api_docs_page_names_only_files_of_this_site():

@@ -1,8 +1,8 @@
-"""The procedure page's 3D panel (frontend/preview3d.js) in Debian's Chromium through Playwright, offline (every
-request to another site is refused and counted): three.js and the glTF are fetched only once the panel opens, every
-element of the procedure is a loaded node, a frame is drawn with the facade lit, pointing at an element names it and
-its node in the tree, a click keeps it, the photo toggle loads the photo's glTF; without WebGL, or without three.js
-on the server, the panel says so. WebGL runs on the CPU (SwiftShader, `--enable-unsafe-swiftshader`). With
+"""The procedure page's 3D panel (frontend/procedure/preview3d.js) in Debian's Chromium through Playwright, offline
+(every request to another site is refused and counted): three.js and the glTF are fetched only once the panel opens,
+every element of the procedure is a loaded node, a frame is drawn with the facade lit, pointing at an element names
+it and its node in the tree, a click keeps it, the photo toggle loads the photo's glTF; without WebGL, or without
+three.js on the server, the panel says so. WebGL runs on the CPU (SwiftShader, `--enable-unsafe-swiftshader`). With
 FACAID_SCREENSHOT_DIR set, the picture of docs/img/procedure-3d.png is written there. (The page's import map, in
 `test_pages.py`.)"""
 
@@ -28,7 +28,7 @@ VENDORED = pytest.mark.skipif(finders.find("vendor/three/build/three.module.js")
 pytestmark = [pytest.mark.django_db(transaction=True), VENDORED,
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
 READY = "window.facaidPreview3d && window.facaidPreview3d.ready"
-BACKGROUND = (0xEE, 0xF1, 0xF4)  # the scene's background (frontend/preview3d.js)
+BACKGROUND = (0xEE, 0xF1, 0xF4)  # the scene's background (frontend/procedure/preview3d.js)
 
 
 @pytest.fixture

@@ -3,7 +3,7 @@
 import {ReplaceAll} from "./commands.js";
 import {throughRectification} from "./geometry.js";
 import {History} from "./history.js";
-import {followJob} from "./server.js";
+import {followJob} from "../common/server.js";
 import {Segmentation} from "./state.js";
 
 export const draftKey = (photoCode) => `facaid-draft:${photoCode}`;

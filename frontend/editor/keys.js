@@ -36,7 +36,7 @@ export const SHORTCUTS = [
   {keys: ["Escape", "?"], when: "help", action: {action: "help", open: false}, does: "close this help"},
 ];
 
-// What the pointer does with modifiers (read by frontend/tools/ and editor.js, not by keyAction), for the help.
+// What the pointer does with modifiers (read by tools/ and editor.js, not by keyAction), for the help.
 export const POINTER = [
   {keys: "wheel", does: "zoom about the cursor"},
   {keys: "middle button drag", does: "pan"},

@@ -2,7 +2,7 @@
 // compared side by side (both pictures, the pixels whose label differs, both accuracies against the procedure's
 // segmentation), and, for the owner, revert: a new version equal to an old one, after which the page reloads.
 
-import {patientFetch, patientImage} from "./server.js";
+import {patientFetch, patientImage} from "../common/server.js";
 
 const KINDS = {created: "created", edit: "edited", revert: "reverted", rerun: "re-run"};
 

@@ -1,13 +1,13 @@
 // The procedure page: an editable tree of parameters with live re-rendering, saved as a new version or as a new
-// procedure, the history (procedure-history.js), variations, overlay opacity, and one selection shared by the
+// procedure, the history (history.js), variations, overlay opacity, and one selection shared by the
 // picture, the named parameters, the tree and the 3D panel (selection.js): a click on an element of the picture
 // selects its node in the tree and the parameters that stand for it; a click on a parameter's name or a node's
 // outlines what it stands for in the picture.
-import {accuracyText, mountHistory} from "./procedure-history.js";
-import {drawRanges, rangesAsked, variantCaption} from "./procedure-variations.js";
-import {treeElement} from "./procedure-tree.js";
+import {accuracyText, mountHistory} from "./history.js";
+import {drawRanges, rangesAsked, variantCaption} from "./variations.js";
+import {treeElement} from "./tree.js";
 import {leafAt, leavesUnder, parametersOf, pictureToProcedure} from "./selection.js";
-import {busy, patientFetch} from "./server.js";
+import {busy, patientFetch} from "../common/server.js";
 
 const script = document.currentScript || document.querySelector("script[data-code]");
 const code = script.dataset.code;

@@ -1,8 +1,8 @@
 // The editor page: the glue between the DOM and the editor's DOM-free parts. All changes go through commands and
-// the history; a gesture (frontend/tools/) previews outside the history and is committed as one command.
+// the history; a gesture (tools/) previews outside the history and is committed as one command.
 import {rejectedOf, repeatByPitch, repeatSelection, splitCommand} from "./assist.js";
 import {DeleteRects, duplicateRects, moveRects, setLabel} from "./commands.js";
-import {mountFiles} from "./editor-files.js";
+import {mountFiles} from "./files.js";
 import {identical} from "./geometry.js";
 import {buildHelp} from "./help.js";
 import {BOX_FIELDS, boxFields, setBoxCommand} from "./inspect.js";
@@ -12,7 +12,7 @@ import {freeView, layersNote, objectGroups, pickable, pickableSelection, toggleL
 import {buildPalette, markActive} from "./panel.js";
 import {mountProposing} from "./proposing.js";
 import {drawScene, grayPixels} from "./render.js";
-import {download, makeApi} from "./server.js";
+import {download, makeApi} from "../common/server.js";
 import {DraftKeeper, loadPhoto} from "./session.js";
 import {mountPointer} from "./tools/pointer.js";
 import {fitView, photoFilter, reveal} from "./tools/view.js";
@@ -170,7 +170,7 @@ function setTool(tool) {
   canvas.style.cursor = tool === "draw" ? "crosshair" : "default";
 }
 
-// --- the editor's parts (tools/pointer.js, proposing.js, editor-files.js) share the state and its echo -------------
+// --- the editor's parts (tools/pointer.js, proposing.js, files.js) share the state and its echo --------------------
 const ed = {api, photoCode, root, canvas, ui, view, status, run, changed, draw, toImage, toScreen,
   get info() { return info; }, get photo() { return photo; }, get seg() { return seg; },
   get history() { return history; }, photoGray,
@@ -179,7 +179,7 @@ const {similar, findCopies, completeNow, acceptProposals} = mountProposing(ed);
 const {importJSON, saveNow, submitNow, openRectify, applyRectify} = mountFiles(ed);
 mountPointer(ed, {readout, afterDrawn: () => { if ($("#auto-complete").checked) completeNow(); }});
 
-// --- keyboard: frontend/keys.js maps keys to actions ---------------------------------------------------------------
+// --- keyboard: keys.js maps keys to actions ------------------------------------------------------------------------
 const keyHandlers = {undo: () => history.undo(), redo: () => history.redo(), duplicate, delete: () => removeSelected(),
   selectAll: () => {  // what can be picked: Ctrl+A then Delete must not remove a hidden or locked class
     ui.selection = new Set([...seg.rects.values()].filter((r) => pickable(ui.layers, r)).map((r) => r.id));
@@ -237,7 +237,7 @@ function duplicate() {
   changed();
 }
 
-// --- repeat and find similar (frontend/assist.js) ------------------------------------------------------------------
+// --- repeat and find similar (assist.js) ---------------------------------------------------------------------------
 function repeatSelected() {
   const n = (sel) => Number($(sel).value);
   carryOut(repeatSelection(seg, [...ui.selection], {cols: n("#rep-cols"), rows: n("#rep-rows"), gapX: n("#rep-gapx"),

@@ -1,7 +1,7 @@
 // The rectification step: four draggable corners on the original photo and a live preview of the warp; "Propose
 // corners" places them where the server finds the facade's outermost lines, for the user to adjust.
 import {applyHomography, homography, isConvexQuad, rectifiedSize} from "./geometry.js";
-import {makeApi} from "./server.js";
+import {makeApi} from "../common/server.js";
 
 const PREVIEW_SIDE = 320;
 

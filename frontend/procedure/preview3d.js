@@ -5,7 +5,7 @@
 // its label and tree path (the node's glTF `extras`), a click keeps it. Frames are drawn on demand, never in a loop.
 // `window.facaidPreview3d` says how far it got, for the page's tests.
 import {elementOf, elementsUnder, elementText, fitView, keyLight} from "./preview3d-view.js";
-import {patientFetch} from "./server.js";
+import {patientFetch} from "../common/server.js";
 
 const panel = document.getElementById("preview3d");
 const view = panel.querySelector(".preview3d-view");
