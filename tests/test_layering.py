@@ -166,7 +166,10 @@ def test_every_package_opens_on_a_short_front_door():
 
 def test_frontend_is_a_folder_per_page():
     """Issue 69: the browser's modules sit in a folder per page (`editor/`, `procedure/`, `job/`) and `common/` for
-    what more than one page imports; at most 8 scripts at `frontend/`'s top level."""
+    what more than one page imports; at most 8 scripts at `frontend/`'s top level, none over 400 lines."""
     top = list((ROOT / "frontend").glob("*.js"))
     assert len(top) <= 8, sorted(p.name for p in top)
     assert {"editor", "procedure", "job", "common"} <= {p.name for p in (ROOT / "frontend").iterdir() if p.is_dir()}
+    scripts = [p for p in (ROOT / "frontend").rglob("*.js") if "tests" not in p.parts]
+    long = {str(p.relative_to(ROOT)): n for p in scripts if (n := len(p.read_text().splitlines())) > 400}
+    assert long == {}

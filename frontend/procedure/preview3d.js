@@ -237,7 +237,7 @@ function select(element) {
   state.selected = selected ? {...selected.userData} : null;
   info.textContent = selected ? `Selected: ${elementText(selected)}` : "";
   draw();
-  // the page selects the same node in the tree and its parameters (procedure.js)
+  // the page selects the same node in the tree and its parameters (selection-view.js)
   document.dispatchEvent(new CustomEvent("facaid:select3d", {detail: {path: selected?.userData.path || null}}));
 }
 
