@@ -42,6 +42,7 @@ import torch
 from facaid.decoding import Candidate, decode, ranked_candidates
 from facaid.defaults import DEFAULT_K, STRUCTURES, TEMPERATURE
 from facaid.editing.check import MORE, check_edits
+from facaid.editing.describes import describes
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE
@@ -288,15 +289,18 @@ def _chosen(result: Reconstruction, flat: Segmentation, opts: ReconstructOptions
 def best_reading(flat: Segmentation):
     """Of the lattice readings of a flattened segmentation (`facaid.reading.lattice.readings`), sized, the first
     whose `floors` + 1 and `bays` + 1 are clean (`facaid.editing.check`: the grid as read is tried first, the others
-    only where its edits fail), else of those with the most clean edits the most accurate (a reading of floors
-    two by two whose edits both fail is no better for being a little more accurate than the grid whose new floor
-    is clean); a `SizingResult`, its procedure's meta naming its ``group``, or None where there is no lattice."""
+    only where its edits fail), else the best by `reading_key`: the most clean edits and a floor height that is the
+    floors' pitch (`facaid.editing.describes`), then the most accurate (a reading of floors two by two whose edits
+    both fail is no better for being a little more accurate than the grid whose new floor is clean; one whose floor
+    is two of the building's is worth an edit); a `SizingResult`, its procedure's meta naming its ``group``, or None
+    where there is no lattice."""
+    rows = flat.to_array()
     best, key = None, None
     for group, proc in readings(flat):
         fitted = fit_sizes(proc, flat)
         verdicts = list(check_edits(fitted.procedure, MORE).values())
         fitted.procedure.meta["group"] = list(group)
-        mine = reading_key(verdicts, fitted.accuracy)
+        mine = reading_key(verdicts, fitted.accuracy, describes(fitted.procedure, rows)["floor_height_ok"])
         if key is None or mine > key:
             best, key = fitted, mine
         if all(v.clean for v in verdicts):
@@ -304,9 +308,11 @@ def best_reading(flat: Segmentation):
     return best
 
 
-def reading_key(verdicts: list, accuracy: float) -> tuple[int, float]:
-    """How `best_reading` ranks a reading: by how many of its edits' ``verdicts`` are clean, then by accuracy."""
-    return sum(v.clean for v in verdicts), accuracy
+def reading_key(verdicts: list, accuracy: float, floor_pitch: bool | None = None) -> tuple[int, float]:
+    """How `best_reading` ranks a reading: by how many of its edits' ``verdicts`` are clean, one more where its
+    floor height is the floors' pitch (``floor_pitch``: True; None where there is no pitch to judge), then by
+    accuracy."""
+    return sum(v.clean for v in verdicts) + bool(floor_pitch), accuracy
 
 
 def _with_editable(exact: Reconstruction, editable, structure: str) -> Reconstruction:

@@ -12,8 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from facaid.editing.check import check_edits
+from facaid.editing.describes import PITCH, describes
 from facaid.editing.parameters import named_parameters, set_parameter
-from facaid.editing.windows import lattice, pitches, segmentation_lattice, window_boxes
+from facaid.editing.windows import lattice, segmentation_lattice, window_boxes
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE
@@ -38,26 +39,6 @@ def kept_elements(rows: np.ndarray, target: np.ndarray, pred: np.ndarray) -> tup
             drawn += 1
             kept += appears(pred, label, tuple(box), area, KEPT)
     return drawn, kept
-
-
-PITCH = 0.15  # floor_height within this share of the window rows' pitch
-
-
-def describes(proc: Procedure, rows: np.ndarray) -> dict:
-    """Whether the named parameters describe the building of a flattened annotation's ``rows``: ``floor_height``
-    within `PITCH` of its floors' pitch (where it has at least three rows of windows: the median step from a window
-    to the next one up its column, `facaid.editing.windows.window_pitch`), ``tile_width`` the same of its bays' pitch,
-    and no narrower than ``window_width`` (None where there is nothing to judge)."""
-    names = {p.name: p.value for p in named_parameters(proc)}
-    floor, bay = pitches(rows)
-    out = {"floor_pitch": floor, "bay_pitch": bay, "floor_height": names.get("floor_height"),
-           "tile_width": names.get("tile_width"), "floor_height_ok": None, "tile_width_ok": None}
-    if floor is not None and "floor_height" in names:
-        out["floor_height_ok"] = abs(names["floor_height"] / floor - 1) <= PITCH
-    if bay is not None and "tile_width" in names:
-        out["tile_width_ok"] = (abs(names["tile_width"] / bay - 1) <= PITCH
-                                and names["tile_width"] >= names.get("window_width", 0.0))
-    return out
 
 
 def editability(proc: Procedure, annotation: tuple[int, int] | None = None) -> dict:

@@ -159,13 +159,20 @@ def test_bad_real_input_gets_a_procedure_or_a_clear_error():
         reconstruct(Segmentation(2000, 2000, tuple(many)), ReconstructOptions(k=2))
 
 
-def test_a_reading_is_ranked_by_its_clean_edits_then_its_accuracy():
+def test_a_reading_is_ranked_by_its_clean_edits_and_floor_pitch_then_its_accuracy():
     clean, broken = Verdict(True, "one floor like the others"), Verdict(False, "the new bay is like no bay")
     grid = reading_key([clean, broken], 0.95)  # the grid as read: its new floor is clean
     pairs = reading_key([broken, broken], 0.99)  # floors two by two: a little more accurate, no edit clean
     both = reading_key([clean, clean], 0.90)
     assert both > grid > pairs
     assert reading_key([clean, broken], 0.96) > grid
+    # issue 67: a floor height that is the floors' pitch counts like a clean edit: the grid as read, one edit clean
+    # and its floor one storey, against floors read two by two, both edits clean and their floor two storeys: the
+    # more accurate wins
+    assert reading_key([clean, broken], 0.97, True) > reading_key([clean, clean], 0.96, False)
+    assert reading_key([clean, broken], 0.95, True) < reading_key([clean, clean], 0.96, False)
+    assert reading_key([clean, broken], 0.95, True) > grid
+    assert reading_key([clean, clean], 0.9, None) == both
 
 
 def test_reconstruct_options_are_one_frozen_object_checked_when_made():
