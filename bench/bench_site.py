@@ -168,7 +168,7 @@ def main() -> None:
 import json
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
-from webapp.facades import jobs
+from webapp.facades.services import jobs
 from webapp.facades.models import Photo, Segmentation, Job
 from django.contrib.auth import get_user_model
 user = get_user_model().objects.get(username="bench")

@@ -4,7 +4,7 @@ for model work), late acks, one job at a time, soft and hard time limits.
 Job state lives in the site's database, not in a result backend: the task (`worker.tasks`) takes a job id, claims
 the row with a conditional update and writes its results there. Messages are acknowledged after the task returns
 (``acks_late``) and given back if the worker dies, and the site re-sends jobs that stay queued or whose worker
-stopped beating (`webapp.facades.jobs.recover`), so neither a killed worker nor a Redis restart loses a job.
+stopped beating (`webapp.facades.services.jobs.recover`), so neither a killed worker nor a Redis restart loses a job.
 """
 
 from __future__ import annotations

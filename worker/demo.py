@@ -9,9 +9,9 @@ import sys
 
 from django.core.management import call_command
 
-from webapp.facades import jobs
 from webapp.facades.example import DEMO_USERNAME
 from webapp.facades.models import Job
+from webapp.facades.services import jobs
 from worker.tasks import run_job
 
 

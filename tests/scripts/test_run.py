@@ -104,7 +104,7 @@ class Run:
 
 SUBMIT = """
 from django.contrib.auth import get_user_model
-from webapp.facades import jobs
+from webapp.facades.services import jobs
 from webapp.facades.models import Segmentation
 user = get_user_model().objects.create_user("tester", "t@example.com", "tester-password-1")
 seg = Segmentation.objects.get(photo__owner__username="demo")

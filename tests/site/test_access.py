@@ -269,7 +269,7 @@ def test_a_forks_rerun_stores_nothing_once_its_photo_is_made_private(objects, as
     (at its first progress beat, through the API). The worker's task, run in this process as the worker runs it,
     reads the photo again as it stores: it fails the job and stores nothing, and the job's JSON no longer names the
     segmentation."""
-    from webapp.facades import jobs
+    from webapp.facades.services import jobs
     from worker import tasks
 
     monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")  # the progress beats are enough here

@@ -258,14 +258,14 @@ def test_a_re_run_from_a_prefix_is_a_new_version_with_a_warning_when_it_fits_wor
 
 def test_a_re_run_of_someone_elses_procedure_is_a_new_procedure_told_apart(facade_photo, as_alice, as_bob, alice,
                                                                           bob):
-    from webapp.facades import services
+    from webapp.facades.services.jobs import submit_job
 
     _, seg = facade_photo
     proc = _faithful(alice, seg, visibility="public")
-    mine = services.submit_job(alice, Segmentation.objects.get(code=seg["code"]), prefix=proc, prefix_nodes=2)
+    mine = submit_job(alice, Segmentation.objects.get(code=seg["code"]), prefix=proc, prefix_nodes=2)
     assert mine.params["as_version"] is True and mine.params["prefix_version"] == 1
     newer = as_alice.post(f"/api/v1/photos/{seg['photo']}/segmentations/", seg["data"], format="json").json()
-    other = services.submit_job(alice, Segmentation.objects.get(code=newer["code"]), prefix=proc, prefix_nodes=2)
+    other = submit_job(alice, Segmentation.objects.get(code=newer["code"]), prefix=proc, prefix_nodes=2)
     assert other.params["as_version"] is False  # another segmentation: its figures would not compare
 
 

@@ -82,7 +82,7 @@ def test_a_late_queued_job_says_why(alice, bob, redis, worker):
 
     from django.utils import timezone
 
-    from webapp.facades import jobs
+    from webapp.facades.services import jobs
 
     redis.stop()
     job = submit(alice)  # not sent: Redis is down
@@ -105,7 +105,7 @@ def test_a_late_queued_job_says_why(alice, bob, redis, worker):
 
 
 def test_the_broker_epoch_tells_a_redis_that_lost_its_data(redis):
-    from webapp.facades import jobs
+    from webapp.facades.services import jobs
 
     assert jobs.broker_lost_messages()  # the first look: nothing to tell it from a lost one
     assert not jobs.broker_lost_messages()
@@ -118,7 +118,7 @@ def test_jobs_a_redis_restarted_empty_lost_are_sent_again_at_once(alice, redis, 
     """Issue 66: a job stayed 'queued' 310 s after Redis restarted empty (the resend delay, 300 s)."""
     import redis as redis_client
 
-    from webapp.facades import jobs
+    from webapp.facades.services import jobs
 
     worker.start()
     assert redis_client.Redis.from_url(redis.url).exists(jobs.EPOCH_KEY)  # its first recovery round marked it

@@ -13,9 +13,10 @@ from rest_framework.exceptions import ValidationError
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
-from webapp.facades import access, editcheck, rendering, services, sharing
+from webapp.facades import access, editcheck, rendering, sharing
 from webapp.facades.models import Change, Procedure, ProcedureVersion, tree_digest
 from webapp.facades.parsing import parse_procedure
+from webapp.facades.services.procedures import fork_procedure
 
 # figures of the job that made a tree (its timings, the decoded candidate's accuracy, how it searched): true of that
 # tree alone, so an edit, a revert or a copy drops them; `source` (where the structure came from) stays
@@ -168,7 +169,7 @@ def save_as_new(user, proc: Procedure, data: dict | None = None, title: str = ""
     # its edits checked before the transaction writes (SQLite's one writer is not held for them); the parent's
     # verdicts where the tree is the parent's
     checks = editcheck.checked(proc.metrics, tree, digest)[editcheck.KEY]
-    return services.fork_procedure(user, proc, data, note[:200], measure=lambda p: _measured(p, checks), title=title)
+    return fork_procedure(user, proc, data, note[:200], measure=lambda p: _measured(p, checks), title=title)
 
 
 def _measured(proc: Procedure, checks: dict) -> None:

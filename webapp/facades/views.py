@@ -18,7 +18,7 @@ from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
 from facaid.grammar.budget import WorkLimitError
-from webapp.facades import access, disclosure, example, jobs, jsonbody, services, sharing, throttling
+from webapp.facades import access, disclosure, example, jsonbody, sharing, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
     PhotoForm,
@@ -32,6 +32,7 @@ from webapp.facades.forms import (
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, QuotaError
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers import PhotoSerializer
+from webapp.facades.services import jobs, photos, procedures, segmentations
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
 
@@ -90,8 +91,8 @@ def photo_new(request):
 def _upload(request, form: PhotoForm) -> Photo | None:
     """The photo the form uploads, or None with what was wrong added to the form's image field."""
     try:
-        return services.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
-                                     form.cleaned_data["visibility"])
+        return photos.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
+                                   form.cleaned_data["visibility"])
     except ValidationError as exc:
         form.add_error("image", _error_text(exc).removeprefix("image: "))
     except QuotaError as exc:
@@ -166,7 +167,7 @@ def photo_segmentation(request, code):
         try:
             # XML is a CVAT file, read as it is; JSON is ours, COCO's or LabelMe's, read with bounded nesting
             data = raw if raw.lstrip()[:1] in ("<", b"<") else jsonbody.loads(raw)
-            seg, warnings = services.add_segmentation(photo, data)
+            seg, warnings = segmentations.add_segmentation(photo, data)
         except jsonbody.JSONError as exc:
             messages.error(request, f"The segmentation could not be read: {exc}")
         except ValidationError as exc:
@@ -191,9 +192,9 @@ def photo_reconstruct(request, code):
         messages.error(request, "Check the reconstruction settings.")
         return redirect(photo)
     try:
-        job = services.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"],
-                                  structure=form.cleaned_data["structure"] or "editable")
-    except services.TooManyJobs as exc:
+        job = jobs.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"],
+                              structure=form.cleaned_data["structure"] or "editable")
+    except jobs.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(photo)
     return redirect(job)
@@ -307,7 +308,7 @@ def procedure_fork(request, code):
     if not allowed:
         messages.error(request, f"Too many forks and edits in a row; try again in {math.ceil(wait or 1)} s.")
         return redirect(proc)
-    fork = services.fork_procedure(request.user, proc)
+    fork = procedures.fork_procedure(request.user, proc)
     messages.success(request, "Forked: this copy is yours to edit.")
     return redirect(fork)
 
@@ -321,12 +322,12 @@ def procedure_rerun(request, code):
         messages.error(request, "Re-running needs a node count of at least 1.")
         return redirect(proc)
     try:
-        job = services.rerun(request.user, proc, form.cleaned_data["nodes"])
+        job = procedures.rerun(request.user, proc, form.cleaned_data["nodes"])
     except ValidationError as exc:
         text = _error_text(exc).removeprefix("procedure: ")
         messages.error(request, f"{text[:1].upper()}{text[1:]}.")
         return redirect(proc)
-    except services.TooManyJobs as exc:
+    except jobs.TooManyJobs as exc:
         messages.error(request, str(exc.detail))
         return redirect(proc)
     messages.info(request, f"Re-running version {job.params['prefix_version']}: the result will be the procedure's "

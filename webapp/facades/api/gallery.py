@@ -11,13 +11,14 @@ from rest_framework.decorators import (
 from rest_framework.permissions import AllowAny
 from rest_framework.response import Response
 
-from webapp.facades import access, services
+from webapp.facades import access
 from webapp.facades.api.common import (
     page,
 )
 from webapp.facades.serializers import (
     ProcedureSummarySerializer,
 )
+from webapp.facades.services.gallery import gallery_page
 
 
 @extend_schema(responses=ProcedureSummarySerializer(many=True), auth=[],
@@ -26,7 +27,7 @@ from webapp.facades.serializers import (
 @authentication_classes([])  # the listing is the public's: no session or token is read
 @permission_classes([AllowAny])
 def gallery(request):
-    """Served from each process's memory while no procedure has changed (`services.gallery_page`)."""
+    """Served from each process's memory while no procedure has changed (`webapp.facades.services.gallery`)."""
     where = (request.scheme, request.get_host(), request.get_full_path())  # the page's links are made from it
-    return Response(services.gallery_page(
+    return Response(gallery_page(
         where, lambda: page(request, access.public_procedures(), ProcedureSummarySerializer).data))

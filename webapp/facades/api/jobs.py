@@ -13,7 +13,7 @@ from rest_framework.exceptions import PermissionDenied, ValidationError
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
-from webapp.facades import access, services
+from webapp.facades import access
 from webapp.facades.api.common import (
     page,
 )
@@ -25,6 +25,7 @@ from webapp.facades.serializers import (
     JobCreateSerializer,
     JobSerializer,
 )
+from webapp.facades.services.jobs import submit_job
 
 
 @extend_schema(methods=["GET"], responses=JobSerializer(many=True), summary="Your jobs, newest first")
@@ -48,7 +49,7 @@ def job_list(request):
     if access.is_demo(seg.photo):
         raise PermissionDenied(access.DEMO_READ_ONLY)
     prefix = access.get_procedure_for_user(request.user, v["prefix_procedure"]) if v["prefix_procedure"] else None
-    job = services.submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"], v["structure"])
+    job = submit_job(request.user, seg, v["k"], v["seed"], prefix, v["prefix_nodes"], v["structure"])
     return Response(JobSerializer(job, context={"request": request}).data, status=status.HTTP_202_ACCEPTED)
 
 

@@ -18,7 +18,7 @@ from rest_framework.parsers import FormParser, MultiPartParser
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
-from webapp.facades import access, services
+from webapp.facades import access
 from webapp.facades.api.common import (
     page,
 )
@@ -32,6 +32,8 @@ from webapp.facades.serializers import (
     PhotoUploadSerializer,
     RectifySerializer,
 )
+from webapp.facades.services.photos import create_photo, delete_photo, propose_corners, rectify_photo
+from webapp.facades.services.segmentations import complete_segmentation
 from webapp.facades.throttling import HEAVY
 
 
@@ -50,8 +52,8 @@ def photos(request):
         return page(request, photos, PhotoSerializer)
     form = PhotoUploadSerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    photo = services.create_photo(request.user, form.validated_data["image"], form.validated_data.get("title", ""),
-                                  form.validated_data["visibility"])
+    photo = create_photo(request.user, form.validated_data["image"], form.validated_data.get("title", ""),
+                         form.validated_data["visibility"])
     return Response(PhotoSerializer(photo).data, status=status.HTTP_201_CREATED)
 
 
@@ -66,7 +68,7 @@ def photo_detail(request, code):
         return Response(PhotoSerializer(access.get_photo_for_user(request.user, code)).data)
     photo = access.get_rw_photo_for_user(request.user, code)
     if request.method == "DELETE":
-        services.delete_photo(photo)
+        delete_photo(photo)
         return Response(status=status.HTTP_204_NO_CONTENT)
     form = PhotoSerializer(photo, data=request.data, partial=True)
     form.is_valid(raise_exception=True)
@@ -94,7 +96,7 @@ def photo_rectify(request, code):
     photo = access.get_rw_photo_for_user(request.user, code)
     form = RectifySerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    services.rectify_photo(photo, form.validated_data["corners"])
+    rectify_photo(photo, form.validated_data["corners"])
     return Response(PhotoSerializer(photo).data)
 
 
@@ -108,7 +110,7 @@ def photo_rectify(request, code):
 @throttle_classes(HEAVY)
 @permission_classes([IsAuthenticated])
 def photo_propose_corners(request, code):
-    return Response(services.propose_corners(access.get_rw_photo_for_user(request.user, code)))
+    return Response(propose_corners(access.get_rw_photo_for_user(request.user, code)))
 
 
 @extend_schema(request={"application/json": dict}, responses={200: dict},
@@ -125,5 +127,5 @@ def photo_complete(request, code):
     photo = access.get_photo_for_user(request.user, code)
     if not isinstance(request.data, dict):
         raise ValidationError({"segmentation": "must be a JSON object"})
-    return Response(services.complete_segmentation(photo, request.data))
+    return Response(complete_segmentation(photo, request.data))
 

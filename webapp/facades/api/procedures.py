@@ -24,7 +24,7 @@ from facaid.grammar.budget import reserve
 from facaid.grammar.layout import count_expansion
 from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
-from webapp.facades import access, disclosure, downloads, editcheck, rendering, services, versions
+from webapp.facades import access, disclosure, downloads, editcheck, rendering, versions
 from webapp.facades.api.common import (
     page,
     stored_picture,
@@ -47,6 +47,7 @@ from webapp.facades.serializers import (
     SaveAsNewSerializer,
     VariationsSerializer,
 )
+from webapp.facades.services.procedures import create_procedure, fork_procedure, rerun
 from webapp.facades.throttling import HEAVY
 
 
@@ -62,7 +63,7 @@ def procedure_list(request):
         return page(request, access.listed(Procedure.objects.filter(owner=request.user)), ProcedureSummarySerializer)
     form = ProcedureWriteSerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    proc = services.create_procedure(request.user, form.validated_data)
+    proc = create_procedure(request.user, form.validated_data)
     return Response(ProcedureSerializer(proc, context={"request": request}).data, status=status.HTTP_201_CREATED)
 
 
@@ -95,7 +96,7 @@ def procedure_detail(request, code):
 @throttle_classes(HEAVY)
 @permission_classes([IsAuthenticated])
 def procedure_fork(request, code):
-    fork = services.fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
+    fork = fork_procedure(request.user, access.get_procedure_for_user(request.user, code))
     return Response(ProcedureSerializer(fork, context={"request": request}).data, status=status.HTTP_201_CREATED)
 
 
@@ -299,6 +300,6 @@ def procedure_rerun(request, code):
     proc = access.get_rw_procedure_for_user(request.user, code)
     form = RerunSerializer(data=request.data)
     form.is_valid(raise_exception=True)
-    job = services.rerun(request.user, proc, form.validated_data["nodes"], form.validated_data["k"])
+    job = rerun(request.user, proc, form.validated_data["nodes"], form.validated_data["k"])
     return Response(JobSerializer(job, context={"request": request}).data, status=status.HTTP_202_ACCEPTED)
 

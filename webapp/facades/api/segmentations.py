@@ -17,7 +17,7 @@ from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
 from facaid.formats import interchange
-from webapp.facades import access, services
+from webapp.facades import access
 from webapp.facades.api.common import (
     ANNOTATIONS,
     IMPORT_PARAMETERS,
@@ -31,6 +31,14 @@ from webapp.facades.serializers import (
     ConvertSerializer,
     SegmentationSerializer,
     SegmentationSummarySerializer,
+)
+from webapp.facades.services.segmentations import (
+    add_segmentation,
+    draft_of,
+    drop_draft,
+    read_annotations,
+    save_draft,
+    segmentation_file,
 )
 from webapp.facades.throttling import HEAVY
 
@@ -54,8 +62,8 @@ def photo_segmentations(request, code):
     if not request.user.is_authenticated:
         raise NotAuthenticated()
     photo = access.get_rw_photo_for_user(request.user, code)
-    seg, warnings = services.add_segmentation(photo, request.data, request.query_params.get("format"),
-                                              request.query_params.get("image"))
+    seg, warnings = add_segmentation(photo, request.data, request.query_params.get("format"),
+                                      request.query_params.get("image"))
     return Response({**SegmentationSerializer(seg).data, "warnings": list(warnings)}, status=status.HTTP_201_CREATED)
 
 
@@ -77,11 +85,11 @@ def _draft(draft) -> dict:
 def photo_draft(request, code):
     photo = access.get_rw_photo_for_user(request.user, code)  # the owner's: a draft is no one else's business
     if request.method == "PUT":
-        return Response(_draft(services.save_draft(photo, request.data)))
+        return Response(_draft(save_draft(photo, request.data)))
     if request.method == "DELETE":
-        services.drop_draft(photo)
+        drop_draft(photo)
         return Response(status=status.HTTP_204_NO_CONTENT)
-    return Response(_draft(services.draft_of(photo)))
+    return Response(_draft(draft_of(photo)))
 
 
 @extend_schema(parameters=[OpenApiParameter("format", str, enum=interchange.FORMATS,
@@ -96,8 +104,8 @@ def photo_draft(request, code):
 @file_format_param
 def photo_segmentation_file(request, code):
     photo = access.get_photo_for_user(request.user, code)
-    name, content_type, body = services.segmentation_file(photo, request.query_params.get("format", "segmentation"),
-                                                          request.query_params.get("version"))
+    name, content_type, body = segmentation_file(photo, request.query_params.get("format", "segmentation"),
+                                                  request.query_params.get("version"))
     resp = HttpResponse(body, content_type=content_type)
     resp["Content-Disposition"] = f'attachment; filename="{name}"'
     return resp
@@ -123,7 +131,7 @@ def convert(request):
     v = form.validated_data
     size = (v["width"], v["height"]) if "width" in v and "height" in v else None
     try:
-        loaded = services.read_annotations(v["text"], v.get("format"), v.get("image"), size)
+        loaded = read_annotations(v["text"], v.get("format"), v.get("image"), size)
     except ValidationError as exc:  # the file is the request's 'text'
         detail = exc.detail
         raise ValidationError({"text" if k == "segmentation" else k: m for k, m in detail.items()}) from None

@@ -15,9 +15,9 @@ from django.core.management.base import BaseCommand
 from facaid.defaults import DEFAULT_K
 from facaid.generator import generate
 from facaid.photo.photolike import render_photo
-from webapp.facades import jobs
 from webapp.facades.example import DEMO_PASSWORD, DEMO_USERNAME
 from webapp.facades.models import Job, Photo, Segmentation, Visibility
+from webapp.facades.services import jobs
 
 
 class Command(BaseCommand):

@@ -1,19 +1,23 @@
-"""The life of a job: submit (the task is sent once the row is committed), claim (a conditional update, so a
-message delivered twice runs once), heartbeat, finish, and recovery of jobs whose message or worker was lost.
-"""
+"""The life of a job: submitted under its owner's cap (`submit_job`; the task is sent once the row is committed),
+claimed (a conditional update, so a message delivered twice runs once), heartbeat, finish, and recovery of jobs
+whose message or worker was lost."""
 
 from __future__ import annotations
 
 import logging
 from datetime import datetime, timedelta
 
+from django.conf import settings
+from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.db.models import F, Q
 from django.utils import timezone
+from rest_framework.exceptions import APIException
 
+from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
 from webapp.facades import queue
-from webapp.facades.models import Job
+from webapp.facades.models import Job, Procedure, Segmentation, check_quota
 
 log = logging.getLogger(__name__)
 
@@ -84,6 +88,37 @@ def submit(**fields) -> Job:
     job = Job.objects.create(**fields)
     transaction.on_commit(lambda: _send_quietly(job.id))
     return job
+
+
+QUOTA_ROOM = 64 * 1024  # bytes of versions a job's result needs at most, about (two versions of a large tree)
+
+
+class TooManyJobs(APIException):
+    status_code = 429
+    default_code = "too_many_jobs"
+
+
+def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
+               prefix_nodes: int = 0, structure: str = "editable") -> Job:
+    """Queue a reconstruction; `TooManyJobs` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
+    running, so that one account cannot fill the workers' queue. A re-run from a prefix continues the prefix
+    procedure's current version; of the user's own procedure against its own segmentation, its result is that
+    procedure's next version, else a new procedure whose parent it is. ``structure``: which of a real facade's two
+    procedures is current (`facaid.pipeline.reconstruct`); the other is its first version."""
+    params = {"k": k, "seed": seed, "structure": structure}
+    if prefix is not None and prefix_nodes > 0:
+        current = prefix.current_version()
+        params.update(prefix_procedure=str(prefix.code), prefix_nodes=prefix_nodes, parent_id=prefix.id,
+                      prefix_version=current.version if current else None,
+                      as_version=prefix.owner_id == user.id and prefix.segmentation_id == segmentation.id)
+    with transaction.atomic():  # the count and the new row together: two submissions at once cannot both pass
+        get_user_model().objects.select_for_update().filter(pk=user.pk).first()
+        active = Job.objects.filter(owner=user, status__in=(Job.Status.QUEUED, Job.Status.RUNNING)).count()
+        if active >= settings.FACAID_MAX_ACTIVE_JOBS:
+            raise TooManyJobs(f"You have {active} reconstructions waiting or running (at most "
+                              f"{settings.FACAID_MAX_ACTIVE_JOBS}); submit more when one has finished.")
+        check_quota(user.pk, QUOTA_ROOM)  # a full quota refuses the job now, not its result after the work
+        return submit(owner=user, segmentation=segmentation, params=params)
 
 
 def _send_quietly(job_id: int) -> None:

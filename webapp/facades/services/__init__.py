@@ -1,0 +1,12 @@
+"""What the site does, for the API's views and the pages alike, a module per resource (callers import the one they
+use):
+
+- `photos`: stored from an upload within the owner's quota, deleted with their files, rectified, corners proposed;
+- `segmentations`: versions read from our JSON or another tool's file, the editor's draft, a version as a file,
+  proposals for what is not drawn yet;
+- `jobs`: a reconstruction's life, submitted under its owner's cap, claimed, beating, finished, recovered (sent to
+  the worker by name: `webapp.facades.queue`);
+- `procedures`: stored, forked, re-run;
+- `gallery`: the public gallery's pages, cached while no procedure changes;
+- `files`: what they share of the stored files.
+"""
