@@ -15,9 +15,9 @@ from django.utils import timezone
 
 from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
-from webapp.facades import access, editcheck, versions
+from webapp.facades import access, editcheck
 from webapp.facades.models import Change, Job, Photo, Procedure, ProcedureVersion, Visibility, tree_digest
-from webapp.facades.services import jobs
+from webapp.facades.services import jobs, versions
 from worker import compute
 from worker.app import RUN_JOB, app
 

@@ -18,8 +18,8 @@ from site_helpers import collect_errors, login
 from facaid.editing.variation import vary
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
-from webapp.facades import versions
 from webapp.facades.models import Procedure, Segmentation
+from webapp.facades.services import versions
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]

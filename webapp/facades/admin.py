@@ -1,7 +1,7 @@
 from django.contrib import admin
 
-from webapp.facades import versions
 from webapp.facades.models import Job, Photo, Procedure, ProcedureVersion, Segmentation
+from webapp.facades.services import versions
 
 
 @admin.register(Photo)

@@ -17,10 +17,10 @@ from facaid.formats.cga import MAX_SCALE
 from facaid.grammar.procedure import MAX_NODES
 from facaid.numbers import finite
 from facaid.segmentation import MAX_SIDE
-from webapp.facades import access, disclosure, sharing
+from webapp.facades import access, disclosure
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, ProcedureVersion, Segmentation, Visibility
 from webapp.facades.parsing import parse_procedure
-from webapp.facades.services import jobs
+from webapp.facades.services import jobs, sharing
 
 
 class TextField(serializers.CharField):

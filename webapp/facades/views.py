@@ -18,7 +18,7 @@ from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
 from facaid.grammar.budget import WorkLimitError
-from webapp.facades import access, disclosure, example, jsonbody, sharing, throttling
+from webapp.facades import access, disclosure, example, jsonbody, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.forms import (
     PhotoForm,
@@ -32,7 +32,7 @@ from webapp.facades.forms import (
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, QuotaError
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers import PhotoSerializer
-from webapp.facades.services import jobs, photos, procedures, segmentations
+from webapp.facades.services import jobs, photos, procedures, segmentations, sharing
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
 

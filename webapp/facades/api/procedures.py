@@ -24,7 +24,7 @@ from facaid.grammar.budget import reserve
 from facaid.grammar.layout import count_expansion
 from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
-from webapp.facades import access, disclosure, downloads, editcheck, rendering, versions
+from webapp.facades import access, disclosure, downloads, editcheck, rendering
 from webapp.facades.api.common import (
     page,
     stored_picture,
@@ -47,6 +47,7 @@ from webapp.facades.serializers import (
     SaveAsNewSerializer,
     VariationsSerializer,
 )
+from webapp.facades.services import versions
 from webapp.facades.services.procedures import create_procedure, fork_procedure, rerun
 from webapp.facades.throttling import HEAVY
 

@@ -14,7 +14,7 @@ from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
 from facaid.grammar import to_segmentation
-from webapp.facades import access, rendering, versions
+from webapp.facades import access, rendering
 from webapp.facades.api.common import (
     cacheable,
 )
@@ -25,6 +25,7 @@ from webapp.facades.serializers import (
     ProcedureVersionSerializer,
     ProcedureVersionSummarySerializer,
 )
+from webapp.facades.services import versions
 from webapp.facades.throttling import HEAVY
 
 

@@ -7,6 +7,8 @@ use):
 - `jobs`: a reconstruction's life, submitted under its owner's cap, claimed, beating, finished, recovered (sent to
   the worker by name: `webapp.facades.queue`);
 - `procedures`: stored, forked, re-run;
+- `versions`: a procedure's trees saved and re-measured, edited, reverted, compared, saved as a new procedure;
+- `sharing`: a procedure and its photo shared, and what viewers see of them;
 - `gallery`: the public gallery's pages, cached while no procedure changes;
 - `files`: what they share of the stored files.
 """

@@ -13,9 +13,10 @@ from rest_framework.exceptions import ValidationError
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
-from webapp.facades import access, editcheck, rendering, sharing
+from webapp.facades import access, editcheck, rendering
 from webapp.facades.models import Change, Procedure, ProcedureVersion, tree_digest
 from webapp.facades.parsing import parse_procedure
+from webapp.facades.services import sharing
 from webapp.facades.services.procedures import fork_procedure
 
 # figures of the job that made a tree (its timings, the decoded candidate's accuracy, how it searched): true of that
