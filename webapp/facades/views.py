@@ -31,7 +31,7 @@ from webapp.facades.forms import (
 )
 from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, QuotaError
 from webapp.facades.parsing import parse_procedure
-from webapp.facades.serializers import PhotoSerializer
+from webapp.facades.serializers.photos import PhotoSerializer
 from webapp.facades.services import jobs, photos, procedures, segmentations, sharing
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))

@@ -15,7 +15,7 @@ from webapp.facades import access
 from webapp.facades.api.common import (
     page,
 )
-from webapp.facades.serializers import (
+from webapp.facades.serializers.procedures import (
     ProcedureSummarySerializer,
 )
 from webapp.facades.services.gallery import gallery_page

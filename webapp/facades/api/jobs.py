@@ -21,7 +21,7 @@ from webapp.facades.jsonbody import JSONParser
 from webapp.facades.models import (
     Job,
 )
-from webapp.facades.serializers import (
+from webapp.facades.serializers.jobs import (
     JobCreateSerializer,
     JobSerializer,
 )

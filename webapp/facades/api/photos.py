@@ -27,7 +27,7 @@ from webapp.facades.models import (
     Photo,
     Segmentation,
 )
-from webapp.facades.serializers import (
+from webapp.facades.serializers.photos import (
     PhotoSerializer,
     PhotoUploadSerializer,
     RectifySerializer,

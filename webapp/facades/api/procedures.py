@@ -36,14 +36,13 @@ from webapp.facades.models import (
     tree_digest,
 )
 from webapp.facades.parsing import parse_procedure
-from webapp.facades.serializers import (
-    JobSerializer,
+from webapp.facades.serializers.jobs import JobSerializer, RerunSerializer
+from webapp.facades.serializers.procedures import (
     ParametersSerializer,
     ProcedureEditSerializer,
     ProcedureSerializer,
     ProcedureSummarySerializer,
     ProcedureWriteSerializer,
-    RerunSerializer,
     SaveAsNewSerializer,
     VariationsSerializer,
 )

@@ -27,7 +27,7 @@ from webapp.facades.api.common import (
     page,
 )
 from webapp.facades.jsonbody import JSONParser
-from webapp.facades.serializers import (
+from webapp.facades.serializers.segmentations import (
     ConvertSerializer,
     SegmentationSerializer,
     SegmentationSummarySerializer,

@@ -20,11 +20,8 @@ from webapp.facades.api.common import (
 )
 from webapp.facades.paging import Pagination
 from webapp.facades.parsing import parse_procedure
-from webapp.facades.serializers import (
-    ProcedureSerializer,
-    ProcedureVersionSerializer,
-    ProcedureVersionSummarySerializer,
-)
+from webapp.facades.serializers.procedures import ProcedureSerializer
+from webapp.facades.serializers.versions import ProcedureVersionSerializer, ProcedureVersionSummarySerializer
 from webapp.facades.services import versions
 from webapp.facades.throttling import HEAVY
 
