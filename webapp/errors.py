@@ -23,6 +23,8 @@ TEXTS = {
     404: "There is nothing here, or it is not shared with you.",
     500: "Something went wrong on our side. It has been logged; try again in a moment.",
 }
+# the services' errors (`webapp.facades.services.errors`) by kind, as the API answers them and the pages show them
+SERVICE_STATUS = {"invalid": 400, "over_quota": 400, "not_found": 404, "not_allowed": 403, "too_many_jobs": 429}
 # the page's last resort: what is answered if even the template fails
 BARE_PAGE = ("<!doctype html><html lang=\"en\"><meta charset=\"utf-8\"><title>{title} · FaçAID</title>"
              "<p><a href=\"/\">FaçAID</a></p><h1>{title}</h1><p>{message}</p></html>")
@@ -61,6 +63,11 @@ def _message(exception) -> str:
     """The exception's own message where it is one (a resolver's 404 carries a dict of the patterns tried)."""
     message = exception.args[0] if exception is not None and exception.args else ""
     return message if isinstance(message, str) else ""
+
+
+def service_status(exc) -> int:
+    """The HTTP status of a service's error, from its kind (`SERVICE_STATUS`; an unknown kind is a bad request)."""
+    return SERVICE_STATUS.get(getattr(exc, "kind", ""), 400)
 
 
 def bad_request(request, exception=None):

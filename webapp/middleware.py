@@ -5,7 +5,8 @@ elsewhere (`webapp.errors`), drawn without the session or the database. Whatever
 what the view left unread of the body is read first, so that the connection can carry the next request. And every
 request has a work budget: the trees it reads and makes may lay out at most ``FACAID_REQUEST_WORK`` node instances
 in all and take ``FACAID_REQUEST_SECONDS`` of CPU (`facaid.grammar.budget`), past which it is a 400 that names the
-limit."""
+limit. A service's error that a page does not catch (a photo or procedure not found, or not the viewer's to change, a
+write past the storage quota) is the site's error page with its status and message."""
 
 from __future__ import annotations
 
@@ -16,9 +17,9 @@ from django.conf import settings
 from django.db import OperationalError
 
 from facaid.grammar.budget import WorkLimitError, work_budget
-from webapp.errors import error_response
+from webapp.errors import error_response, service_status
 from webapp.facades import throttling
-from webapp.facades.models import QuotaError
+from webapp.facades.services.errors import ServiceError
 from webapp.facades.throttling import is_heavy
 
 log = logging.getLogger(__name__)
@@ -129,9 +130,27 @@ class WorkBudgetMiddleware:
             return self.get_response(request)
 
     def process_exception(self, request, exception):
-        if not isinstance(exception, WorkLimitError | QuotaError):  # (the storage quota: a write past it, models.py)
+        if not isinstance(exception, WorkLimitError):
             return None
         return error_response(request, 400, str(exception))
+
+
+class ServiceErrorMiddleware:
+    """A service's error (`webapp.facades.services.errors`) that a page did not catch: the error page with the
+    status of its kind (`webapp.errors.service_status`) and its message (a 404 for an object the viewer may not see,
+    a 403 for one they may not change, a 400 for a write past the storage quota). The API answers them itself
+    (`webapp.facades.api.errors`), in its JSON."""
+
+    def __init__(self, get_response):
+        self.get_response = get_response
+
+    def __call__(self, request):
+        return self.get_response(request)
+
+    def process_exception(self, request, exception):
+        if not isinstance(exception, ServiceError):
+            return None
+        return error_response(request, service_status(exception), exception.text())
 
 
 class HeavySlotsMiddleware:

@@ -94,6 +94,7 @@ MIDDLEWARE = [
     "axes.middleware.AxesMiddleware",  # turns a login lockout into the 429 page
     "webapp.middleware.BusyDatabaseMiddleware",
     "webapp.middleware.WorkBudgetMiddleware",  # the trees one request may read and make (docs/site.md#security)
+    "webapp.middleware.ServiceErrorMiddleware",  # a service's error a page did not catch: the error page
     "webapp.middleware.HeavySlotsMiddleware",  # heavy API requests at once per process, the rest a 503
 ]
 
@@ -206,6 +207,8 @@ REST_FRAMEWORK = {
                                  "rest_framework.renderers.BrowsableAPIRenderer"],
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
     "DEFAULT_PAGINATION_CLASS": "webapp.facades.paging.Pagination",
+    # the services' errors (not found, not allowed, invalid input, ...) as their statuses, in the API's JSON
+    "EXCEPTION_HANDLER": "webapp.facades.api.errors.exception_handler",
     "PAGE_SIZE": 24,  # (webapp.facades.paging.Pagination: at most 100)
 }
 SPECTACULAR_SETTINGS = {

@@ -1,13 +1,13 @@
-"""Who may see and change what. Objects someone may not see are 404 (their existence is not revealed);
-objects they may see but not change are 403."""
+"""Who may see and change what. Objects someone may not see are `NotFound` (a 404: their existence is not
+revealed); objects they may see but not change are `NotAllowed` (a 403)."""
 
 from __future__ import annotations
 
-from django.core.exceptions import PermissionDenied, ValidationError
+from django.core.exceptions import ValidationError
 from django.db.models import Q, QuerySet
-from django.http import Http404
 
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
+from webapp.facades.services.errors import NotAllowed, NotFound
 
 READABLE = (Visibility.PUBLIC, Visibility.UNLISTED)  # by link; only public ones are listed
 # large JSON columns that lists and job statuses never show: not read at all (they were most of a gallery page's time)
@@ -30,14 +30,14 @@ def _get(qs: QuerySet, code):
     try:
         return qs.get(code=code)
     except (qs.model.DoesNotExist, ValidationError, ValueError, TypeError):  # a malformed UUID: not found
-        raise Http404(f"no such {qs.model._meta.verbose_name}") from None
+        raise NotFound(f"no such {qs.model._meta.verbose_name}") from None
 
 
 def _owned(obj, user, owner):
     if not (user.is_authenticated and owner == user):
-        raise PermissionDenied("only the owner may change this")
+        raise NotAllowed("only the owner may change this")
     if is_demo(obj):
-        raise PermissionDenied(DEMO_READ_ONLY)
+        raise NotAllowed(DEMO_READ_ONLY)
     return obj
 
 
@@ -50,9 +50,9 @@ def is_demo(obj: Photo | Procedure) -> bool:
 
 
 def refuse_demo_account(user, what: str) -> None:
-    """A 403 for the demo account (anyone may log in as it), which may not make ``what``."""
+    """`NotAllowed` (a 403) for the demo account (anyone may log in as it), which may not make ``what``."""
     if user.is_authenticated and user.get_username() == DEMO_USERNAME:
-        raise PermissionDenied(f"the demo account cannot {what} (its password is public): sign up to do it as "
+        raise NotAllowed(f"the demo account cannot {what} (its password is public): sign up to do it as "
                                "yourself, or fork the demo procedure to edit a copy")
 
 
@@ -124,7 +124,7 @@ def get_rw_procedure_for_user(user, code) -> Procedure:
 
 def get_job_for_user(user, code) -> Job:
     if not user.is_authenticated:
-        raise Http404("no such job")
+        raise NotFound("no such job")
     return _get(Job.objects.filter(owner=user).select_related("result", "segmentation__photo").defer(
         *JOB_WITHOUT), code)
 

@@ -9,8 +9,6 @@ import zipfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from rest_framework.exceptions import ValidationError
-
 from facaid.formats import interchange
 from facaid.formats.annotation import written_as
 from facaid.formats.cga import MAX_SCALE, STOREY_M, checked_scale, default_scale, procedure_cga
@@ -27,6 +25,7 @@ from facaid.photo.files import read_photo
 from webapp.facades import access, disclosure, rendering
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
+from webapp.facades.services.errors import Invalid
 
 Params = Mapping[str, str]
 # (the procedure, its tree, the request's parameters, the viewer) -> the file: what is in it may depend on who asks
@@ -83,8 +82,7 @@ def _scale(proc: Procedure, tree: Tree, params: Params, viewer) -> tuple[float |
     try:
         return checked_scale(tree, float(raw)), ""  # the writers say "given"
     except ValueError:
-        raise ValidationError({"metres_per_pixel": "metres_per_pixel must be a number > 0 and at most "
-                                                   f"{MAX_SCALE:g}"}) from None
+        raise Invalid(f"metres_per_pixel must be a number > 0 and at most {MAX_SCALE:g}", "metres_per_pixel") from None
 
 
 def stem(proc: Procedure) -> str:
@@ -109,7 +107,7 @@ def _metric(write: Callable[[Procedure, Tree, float | None, str, str], bytes | s
         try:
             return write(proc, tree, scale, source, _name(proc, viewer))
         except MeshTooLarge as exc:
-            raise ValidationError({"name": str(exc)}) from None
+            raise Invalid(str(exc), "name") from None
     return build
 
 
@@ -160,7 +158,7 @@ def _overlay(proc: Procedure, tree: Tree, params: Params, viewer) -> bytes:
     except ValueError:
         alpha = -1.0
     if not 0.0 <= alpha <= 1.0:
-        raise ValidationError({"alpha": "alpha must be a number between 0 and 1"})
+        raise Invalid("alpha must be a number between 0 and 1", "alpha")
     with proc.photo.working_image().open("rb") as f:
         return rendering.overlay_png(to_segmentation(tree), f, alpha)
 
@@ -227,7 +225,7 @@ DOWNLOADS: dict[str, Download] = {
 
 def build(name: str, proc: Procedure, params: Params, viewer) -> bytes | str:
     """The download ``name`` of a procedure (one with a builder) as ``viewer`` may have it (no title of a photo they
-    may not see); a `ValidationError` names a bad parameter."""
+    may not see); `Invalid` names a bad parameter."""
     download, tree = DOWNLOADS[name], parse_procedure(proc.data)  # the tree's own units charged as it is read
     if download.per_leaf:  # and what writing its rectangles costs, before any of it is written (the 3D formats
         # refuse more than MAX_MESH_RECTS once they are laid out, so no more are charged: those say how many)

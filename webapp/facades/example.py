@@ -7,7 +7,6 @@ import base64
 import logging
 
 from django.core.cache import caches
-from rest_framework.exceptions import ValidationError
 
 from facaid.editing.parameters import named_parameters
 from facaid.editing.variation import vary
@@ -18,6 +17,7 @@ from webapp.facades.access import DEMO_USERNAME
 from webapp.facades.models import Procedure, Visibility
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.rendering import label_map_png
+from webapp.facades.services.errors import Invalid
 
 DEMO_PASSWORD = "demo-facade"
 VARIANTS = 3
@@ -87,7 +87,7 @@ def _pictures(proc: Procedure) -> dict:
             with work_budget(EXAMPLE_WORK, EXAMPLE_SECONDS):
                 found = _draw(proc)
             cache.set(key, found, None)
-        except (ProcedureError, ValueError, ValidationError, WorkLimitError) as exc:
+        except (ProcedureError, ValueError, Invalid, WorkLimitError) as exc:
             log.warning("the front page's example %s is shown without its pictures: %s", proc.code, exc)
             found = {"caption": "", "variations": []}
             cache.set(key, found, RETRY_SECONDS)

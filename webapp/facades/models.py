@@ -18,6 +18,7 @@ from django.utils import timezone
 
 from webapp.facades import editcheck
 from webapp.facades.fields import CompressedJSONField, pack
+from webapp.facades.services.errors import QuotaError
 
 
 class Visibility(models.TextChoices):
@@ -147,10 +148,6 @@ class Draft(models.Model):
 
     def __str__(self) -> str:
         return f"{self.photo} draft"
-
-
-class QuotaError(Exception):
-    """A write past its owner's storage quota; the message says how much is used, by what, and what to do."""
 
 
 def json_size(data) -> int:

@@ -22,6 +22,7 @@ from PIL import Image, ImageMode, UnidentifiedImageError
 
 from facaid.photo import metadata, webp
 from facaid.photo.files import TRANSPOSE, orientation, read_photo
+from webapp.facades.services.errors import Invalid
 
 FORMATS = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
 MIN_SIDE = 16  # pixels: smaller is no photo of a facade (a newcomer's 4 x 4 test image was taken)
@@ -30,8 +31,12 @@ KEPT = {"JPEG": ("RGB", "L"), "PNG": ("RGB", "RGBA", "L")}  # stored as sent whe
 JPEG_QUALITY = 92
 
 
-class UploadError(ValueError):
-    """An upload we refuse; the message is shown to the user."""
+class UploadError(Invalid, ValueError):
+    """An upload we refuse; the message is shown to the user. Input at fault: the ``image``, as the API and the
+    upload form name it."""
+
+    def __init__(self, message: str, field: str = "image"):
+        super().__init__(message, field)
 
 
 def normalize_photo(upload) -> tuple[ImageFile, int, int]:

@@ -1,5 +1,6 @@
 """The pages. They call the same operations as the JSON API (`webapp.facades.services`) under the same access
-rules."""
+rules; a service's error about what a form sent is said on the page, the rest is the error page
+(`webapp.middleware.ServiceErrorMiddleware`)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,6 @@ from django.contrib.auth.decorators import login_required
 from django.core.paginator import Paginator
 from django.shortcuts import redirect, render
 from django.views.decorators.http import require_POST
-from rest_framework.exceptions import ValidationError
 
 from facaid.defaults import DEFAULT_K, MAX_K
 from facaid.formats import interchange
@@ -29,16 +29,17 @@ from webapp.facades.forms import (
     SegmentationForm,
     VisibilityForm,
 )
-from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure, QuotaError
+from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers.photos import PhotoSerializer
 from webapp.facades.services import jobs, photos, procedures, segmentations, sharing
+from webapp.facades.services.errors import Invalid, QuotaError, TooManyJobs
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
 
 
-def _error_text(exc: ValidationError) -> str:
-    detail = exc.detail
+def _errors_text(detail) -> str:
+    """A serializer's errors (field -> messages) in a sentence: "real_width_m: Ensure this value ..."."""
     if isinstance(detail, dict):
         return "; ".join(f"{k}: {' '.join(map(str, v)) if isinstance(v, list) else v}" for k, v in detail.items())
     return " ".join(map(str, detail)) if isinstance(detail, list) else str(detail)
@@ -93,8 +94,8 @@ def _upload(request, form: PhotoForm) -> Photo | None:
     try:
         return photos.create_photo(request.user, form.cleaned_data["image"], form.cleaned_data["title"],
                                    form.cleaned_data["visibility"])
-    except ValidationError as exc:
-        form.add_error("image", _error_text(exc).removeprefix("image: "))
+    except Invalid as exc:
+        form.add_error("image", exc.text().removeprefix("image: "))
     except QuotaError as exc:
         form.add_error("image", str(exc))
     return None
@@ -140,7 +141,7 @@ def photo_real_size(request, code):
         data[f"real_{side}_m"] = metres
     change = PhotoSerializer(photo, data=data, partial=True)
     if not change.is_valid():
-        messages.error(request, _error_text(ValidationError(change.errors)))
+        messages.error(request, _errors_text(change.errors))
         return redirect(photo)
     change.save()
     messages.success(request, f"The facade is {metres:g} m {'wide' if side == 'width' else 'tall'}: its "
@@ -170,8 +171,8 @@ def photo_segmentation(request, code):
             seg, warnings = segmentations.add_segmentation(photo, data)
         except jsonbody.JSONError as exc:
             messages.error(request, f"The segmentation could not be read: {exc}")
-        except ValidationError as exc:
-            messages.error(request, _error_text(exc))
+        except Invalid as exc:
+            messages.error(request, exc.text())
         else:
             messages.success(request, f"Segmentation version {seg.version} saved ({seg.rect_count} rectangles).")
             for line in warnings:
@@ -194,8 +195,8 @@ def photo_reconstruct(request, code):
     try:
         job = jobs.submit_job(request.user, seg, form.cleaned_data["k"], form.cleaned_data["seed"],
                               structure=form.cleaned_data["structure"] or "editable")
-    except jobs.TooManyJobs as exc:
-        messages.error(request, str(exc.detail))
+    except TooManyJobs as exc:
+        messages.error(request, str(exc))
         return redirect(photo)
     return redirect(job)
 
@@ -254,8 +255,8 @@ def _drawing(proc, viewer) -> tuple[tuple[float, str] | None, bool, str]:
     breaks, or one past the budget, is shown without its picture."""
     try:
         return download_scale(proc, parse_procedure(proc.data), viewer), True, ""
-    except (ValidationError, ProcedureError) as exc:
-        why = _error_text(exc) if isinstance(exc, ValidationError) else str(exc)
+    except (Invalid, ProcedureError) as exc:
+        why = exc.text() if isinstance(exc, Invalid) else str(exc)
         return None, False, f"This procedure cannot be drawn ({why}). Its tree is below, and procedure.json has it."
     except WorkLimitError as exc:
         return None, False, f"This procedure is not drawn here: {exc}. Its tree is below, and procedure.json has it."
@@ -291,8 +292,8 @@ def procedure_visibility(request, code):
         try:
             said = sharing.set_visibility(request.user, proc, form.cleaned_data["visibility"],
                                           form.cleaned_data["share_photo"])
-        except ValidationError as exc:
-            messages.error(request, _error_text(exc))
+        except Invalid as exc:
+            messages.error(request, exc.text())
         else:
             messages.success(request, f"The procedure is now {proc.get_visibility_display().lower()}. {said}")
     else:
@@ -323,12 +324,12 @@ def procedure_rerun(request, code):
         return redirect(proc)
     try:
         job = procedures.rerun(request.user, proc, form.cleaned_data["nodes"])
-    except ValidationError as exc:
-        text = _error_text(exc).removeprefix("procedure: ")
+    except Invalid as exc:
+        text = exc.text().removeprefix("procedure: ")
         messages.error(request, f"{text[:1].upper()}{text[1:]}.")
         return redirect(proc)
-    except jobs.TooManyJobs as exc:
-        messages.error(request, str(exc.detail))
+    except TooManyJobs as exc:
+        messages.error(request, str(exc))
         return redirect(proc)
     messages.info(request, f"Re-running version {job.params['prefix_version']}: the result will be the procedure's "
                            "next version, shown beside it.")

@@ -12,7 +12,7 @@ from rest_framework.decorators import (
     permission_classes,
     throttle_classes,
 )
-from rest_framework.exceptions import NotAuthenticated, ValidationError
+from rest_framework.exceptions import NotAuthenticated
 from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
@@ -32,6 +32,7 @@ from webapp.facades.serializers.segmentations import (
     SegmentationSerializer,
     SegmentationSummarySerializer,
 )
+from webapp.facades.services.errors import Invalid
 from webapp.facades.services.segmentations import (
     add_segmentation,
     draft_of,
@@ -132,9 +133,8 @@ def convert(request):
     size = (v["width"], v["height"]) if "width" in v and "height" in v else None
     try:
         loaded = read_annotations(v["text"], v.get("format"), v.get("image"), size)
-    except ValidationError as exc:  # the file is the request's 'text'
-        detail = exc.detail
-        raise ValidationError({"text" if k == "segmentation" else k: m for k, m in detail.items()}) from None
+    except Invalid as exc:  # the file is the request's 'text'
+        raise Invalid(exc.message, "text" if exc.field == "segmentation" else exc.field) from None
     return Response({"segmentation": loaded.segmentation.to_dict(), "format": loaded.format, "image": loaded.image,
                      "warnings": list(loaded.warnings)})
 

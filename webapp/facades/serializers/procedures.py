@@ -12,6 +12,16 @@ from webapp.facades.models import Procedure, Visibility
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers.base import NumberField, StrictBooleanField, WholeNumberField, title_field, viewer
 from webapp.facades.services import sharing
+from webapp.facades.services.errors import Invalid
+
+
+def procedure_data(value) -> dict:
+    """A procedure JSON validated (`parsing.parse_procedure`), as a field's value: a bad one is the field's error,
+    ``{"data": <the library's message>}``."""
+    try:
+        return parse_procedure(value).to_dict()
+    except Invalid as exc:
+        raise serializers.ValidationError({exc.field: exc.message}) from None
 
 
 class ProcedureSerializer(serializers.ModelSerializer):
@@ -87,7 +97,7 @@ class SaveAsNewSerializer(serializers.Serializer):
     data = serializers.JSONField(required=False, help_text="a procedure JSON (validated)")
 
     def validate_data(self, value):
-        return parse_procedure(value).to_dict()
+        return procedure_data(value)
 
 
 class ProcedureWriteSerializer(SaveAsNewSerializer):
@@ -135,4 +145,4 @@ class ParametersSerializer(serializers.Serializer):
                                                            "the procedure's saved one): the page's unsaved edits")
 
     def validate_data(self, value):
-        return parse_procedure(value).to_dict()
+        return procedure_data(value)

@@ -1,22 +1,23 @@
-"""The stored files the services read: a field's file open for reading, a file that no longer decodes a 400 naming
-``image``, and the bytes a stored file takes."""
+"""The stored files the services read: a field's file open for reading (one that no longer decodes is `Invalid`,
+naming ``image``), and the bytes a stored file takes."""
 
 from __future__ import annotations
 
 from contextlib import contextmanager
 
 from PIL import Image
-from rest_framework.exceptions import ValidationError
+
+from webapp.facades.services.errors import Invalid
 
 
 @contextmanager
 def readable(field):
-    """The stored image file, open; a file that no longer decodes while it is read is a 400 naming ``image``."""
+    """The stored image file, open; a file that no longer decodes while it is read is `Invalid`, naming ``image``."""
     try:
         with field.open("rb") as f:
             yield f
     except (OSError, ValueError, Image.DecompressionBombError) as exc:
-        raise ValidationError({"image": f"the photo cannot be read: {exc}"}) from None
+        raise Invalid(f"the photo cannot be read: {exc}", "image") from None
 
 
 def file_size(field) -> int:

@@ -12,12 +12,12 @@ from django.contrib.auth import get_user_model
 from django.db import transaction
 from django.db.models import F, Q
 from django.utils import timezone
-from rest_framework.exceptions import APIException
 
 from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
 from webapp.facades import queue
 from webapp.facades.models import Job, Procedure, Segmentation, check_quota
+from webapp.facades.services.errors import TooManyJobs
 
 log = logging.getLogger(__name__)
 
@@ -93,14 +93,9 @@ def submit(**fields) -> Job:
 QUOTA_ROOM = 64 * 1024  # bytes of versions a job's result needs at most, about (two versions of a large tree)
 
 
-class TooManyJobs(APIException):
-    status_code = 429
-    default_code = "too_many_jobs"
-
-
 def submit_job(user, segmentation: Segmentation, k=DEFAULT_K, seed=0, prefix: Procedure | None = None,
                prefix_nodes: int = 0, structure: str = "editable") -> Job:
-    """Queue a reconstruction; `TooManyJobs` (429) when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
+    """Queue a reconstruction; `TooManyJobs` when the user already has FACAID_MAX_ACTIVE_JOBS waiting or
     running, so that one account cannot fill the workers' queue. A re-run from a prefix continues the prefix
     procedure's current version; of the user's own procedure against its own segmentation, its result is that
     procedure's next version, else a new procedure whose parent it is. ``structure``: which of a real facade's two

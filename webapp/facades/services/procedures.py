@@ -1,23 +1,22 @@
 """Procedures: one stored from a procedure JSON, forked (a private copy with its parent named), and re-run against
 the segmentation it was made from (a job). Their versions, edits and comparisons: `versions`. Bad input raises
-DRF's `ValidationError` naming the field."""
+`Invalid` naming the field."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from rest_framework.exceptions import ValidationError
-
 from facaid.defaults import DEFAULT_K
 from webapp.facades import access
 from webapp.facades.models import Change, Job, Procedure, ProcedureVersion
+from webapp.facades.services.errors import Invalid
 from webapp.facades.services.jobs import submit_job
 
 
 def create_procedure(user, fields: dict) -> Procedure:
     """A procedure of ``user``'s from a validated procedure JSON (``data``) with its title and visibility."""
     if "data" not in fields:
-        raise ValidationError({"data": "a procedure JSON is required"})
+        raise Invalid("a procedure JSON is required", "data")
     return Procedure.objects.create(owner=user, **fields)
 
 
@@ -45,11 +44,11 @@ def fork_procedure(user, proc: Procedure, data: dict | None = None, note: str = 
 
 def rerun(user, proc: Procedure, nodes: int, k: int = DEFAULT_K) -> Job:
     """Re-run inference against the segmentation ``proc`` was made from, keeping its first ``nodes`` nodes (breadth
-    first), for its owner ``user``; a `ValidationError` naming ``procedure`` without a segmentation ``user`` may see
+    first), for its owner ``user``; `Invalid` naming ``procedure`` without a segmentation ``user`` may see
     (none, or a fork's photo made private since the fork)."""
     if proc.segmentation_id is None:
-        raise ValidationError({"procedure": "this procedure has no segmentation to re-run against"})
+        raise Invalid("this procedure has no segmentation to re-run against", "procedure")
     if not access.segmentation_visible_to(user, proc):
-        raise ValidationError({"procedure": "the photo this procedure was made from is not shared with you, "
-                                            "so it cannot be re-run"})
+        raise Invalid("the photo this procedure was made from is not shared with you, so it cannot be re-run",
+                      "procedure")
     return submit_job(user, proc.segmentation, k=k, seed=0, prefix=proc, prefix_nodes=nodes)

@@ -1,14 +1,12 @@
 """Segmentations of a photo: versions read from the contract's JSON or another tool's file (COCO, LabelMe, CVAT),
 the editor's draft, a version written as a file of any of those formats, and proposals for what is not drawn yet.
-Bad input raises DRF's `ValidationError` naming the field; a version there is not is `Http404`."""
+Bad input raises `Invalid` naming the field; a version there is not is `NotFound`."""
 
 from __future__ import annotations
 
 from django.db import transaction
 from django.db.models import Max
-from django.http import Http404
 from django.utils import timezone
-from rest_framework.exceptions import ValidationError
 
 from facaid.completion import RejectedError, explained
 from facaid.completion.copies import UnitError, find_copies
@@ -18,6 +16,7 @@ from facaid.photo import appearance
 from facaid.segmentation import Segmentation as SegmentationData
 from webapp.facades.models import Draft, Photo, Segmentation, check_quota, json_size
 from webapp.facades.parsing import parse_segmentation
+from webapp.facades.services.errors import Invalid, NotFound
 from webapp.facades.services.files import readable
 
 
@@ -35,17 +34,17 @@ def read_annotations(data, format: str | None = None, image: str | None = None,
                      size: tuple[int, int] | None = None) -> interchange.Loaded:
     """A segmentation from the contract's JSON or from a COCO, LabelMe or CVAT file (its text or bytes, or its
     JSON decoded), found from the content or named by ``format``; of a file of several images, the one named
-    ``image``, else the only one of ``size``. A `ValidationError` names the field."""
+    ``image``, else the only one of ``size``. `Invalid` names the field."""
     if format not in (None, *interchange.FORMATS):
-        raise ValidationError({"format": f"give one of {', '.join(interchange.FORMATS)}, got {format!r}"})
+        raise Invalid(f"give one of {', '.join(interchange.FORMATS)}, got {format!r}", "format")
     if format in (None, "segmentation") and not _foreign(data):
         return interchange.Loaded(parse_segmentation(data), "segmentation", None, ())
     try:
         return interchange.load(data, format, image=image, size=size)
     except interchange.SeveralImages as exc:
-        raise ValidationError({"image": f"{exc} by its name or id"}) from None
+        raise Invalid(f"{exc} by its name or id", "image") from None
     except interchange.InterchangeError as exc:
-        raise ValidationError({"segmentation": str(exc)}) from None
+        raise Invalid(str(exc), "segmentation") from None
 
 
 def _segmentation_of(photo: Photo, data, format: str | None = None, image: str | None = None) -> interchange.Loaded:
@@ -55,8 +54,8 @@ def _segmentation_of(photo: Photo, data, format: str | None = None, image: str |
     loaded = read_annotations(data, format, image, size=(w, h))
     seg = loaded.segmentation
     if (seg.width, seg.height) != (w, h):
-        raise ValidationError({"segmentation": f"the segmentation is {seg.width}x{seg.height} but the "
-                                               f"{'rectified ' if photo.rectified else ''}photo is {w}x{h}"})
+        raise Invalid(f"the segmentation is {seg.width}x{seg.height} but the "
+                      f"{'rectified ' if photo.rectified else ''}photo is {w}x{h}", "segmentation")
     return loaded
 
 
@@ -101,17 +100,17 @@ def save_draft(photo: Photo, data) -> Draft:
 
 def segmentation_file(photo: Photo, format: str, version: str | None = None) -> tuple[str, str, bytes]:
     """A version of the photo's segmentation (the latest by default) as a file of ``format``: its name, content
-    type and bytes; `Http404` when there is none."""
+    type and bytes; `NotFound` when there is none."""
     if format not in interchange.FORMATS:
-        raise ValidationError({"format": f"give one of {', '.join(interchange.FORMATS)}, got {format!r}"})
+        raise Invalid(f"give one of {', '.join(interchange.FORMATS)}, got {format!r}", "format")
     versions = photo.segmentations.order_by("-version")
     if version is not None:
         if not (version.isascii() and version.isdigit()) or len(version) > 9:
-            raise ValidationError({"version": f"give a version number, got {version[:20]!r}"})
+            raise Invalid(f"give a version number, got {version[:20]!r}", "version")
         versions = versions.filter(version=int(version))
     row = versions.first()
     if row is None:
-        raise Http404("no such segmentation version" if version else "this photo has no segmentation yet")
+        raise NotFound("no such segmentation version" if version else "this photo has no segmentation yet")
     seg = SegmentationData.from_dict(row.data)
     # the picture it was drawn on: one drawn before rectification has the original's size
     rectified = bool(photo.rectified) and (seg.width, seg.height) != (photo.width, photo.height)
@@ -133,13 +132,13 @@ def complete_segmentation(photo: Photo, data) -> dict:
     min_score = data.get("min_score", DEFAULT_MIN_SCORE if unit is None else DEFAULT_MIN_COPY)
     use_photo = data.get("use_photo", True)
     if not isinstance(rejected, list):
-        raise ValidationError({"rejected": "give a list of rectangles"})
+        raise Invalid("give a list of rectangles", "rejected")
     if isinstance(min_score, bool) or not isinstance(min_score, int | float) or not 0 <= min_score <= 1:
-        raise ValidationError({"min_score": f"give a number in [0, 1], got {min_score!r}"})
+        raise Invalid(f"give a number in [0, 1], got {min_score!r}", "min_score")
     if not isinstance(use_photo, bool):
-        raise ValidationError({"use_photo": f"give true or false, got {use_photo!r}"})
+        raise Invalid(f"give true or false, got {use_photo!r}", "use_photo")
     if unit is not None and not use_photo:
-        raise ValidationError({"unit": "the copies of a unit are found in the photo: leave use_photo true"})
+        raise Invalid("the copies of a unit are found in the photo: leave use_photo true", "unit")
     levels = None
     if use_photo:
         with readable(photo.working_image()) as f:  # grey levels at a bounded scale, the file let go
@@ -150,8 +149,8 @@ def complete_segmentation(photo: Photo, data) -> dict:
         found = explained(seg, levels, rejected=rejected, min_score=float(min_score))
         return {"proposals": found.proposals, "dimmed": found.dimmed, "tried": found.tried}
     except RejectedError as exc:
-        raise ValidationError({"rejected": str(exc)}) from None
+        raise Invalid(str(exc), "rejected") from None
     except UnitError as exc:
-        raise ValidationError({"unit": str(exc)}) from None
+        raise Invalid(str(exc), "unit") from None
     except ValueError as exc:  # too many rectangles
-        raise ValidationError({"segmentation": str(exc)}) from None
+        raise Invalid(str(exc), "segmentation") from None

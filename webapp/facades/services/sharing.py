@@ -9,10 +9,10 @@ from __future__ import annotations
 import copy
 
 from django.db import transaction
-from rest_framework.exceptions import ValidationError
 
 from webapp.facades import access
 from webapp.facades.models import Procedure, Visibility
+from webapp.facades.services.errors import Invalid
 
 REACH = {Visibility.PRIVATE: 0, Visibility.UNLISTED: 1, Visibility.PUBLIC: 2}
 # what a procedure shared without its photo still tells of it (`disclosure`): the sharing question says so plainly
@@ -75,13 +75,12 @@ def previews(user, proc: Procedure) -> dict[str, str]:
 
 def set_visibility(user, proc: Procedure, visibility: str, share_photo: bool = False) -> str:
     """Give the procedure ``visibility`` and, with ``share_photo``, its photo at least as much; the sentence of
-    `viewers_see`. A `ValidationError` naming ``share_photo`` where that photo cannot be shared by ``user``."""
+    `viewers_see`. `Invalid`, naming ``share_photo``, where that photo cannot be shared by ``user``."""
     if share_photo:
         if proc.photo is None:
-            raise ValidationError({"share_photo": "this procedure has no photo to share"})
+            raise Invalid("this procedure has no photo to share", "share_photo")
         if proc.photo.owner_id != user.id:
-            raise ValidationError({"share_photo": f"the photo is {proc.photo.owner.username}'s: only they can share "
-                                                  "it"})
+            raise Invalid(f"the photo is {proc.photo.owner.username}'s: only they can share it", "share_photo")
     with transaction.atomic():
         proc.visibility = visibility
         proc.save(update_fields=["visibility", "updated"])

@@ -2,13 +2,11 @@
 procedure's segmentation, so that no figure outlives the tree it was measured on), an old version restored (a new
 version equal to it: nothing is deleted), a re-run's result kept as a version beside the one it continued (with a
 warning when it fits worse), a procedure saved as a new one with lineage, and two versions compared. Bad input
-raises DRF's `ValidationError` naming the field; an unknown version is `Http404`."""
+raises `Invalid` naming the field; an unknown version is `NotFound`."""
 
 from __future__ import annotations
 
 from django.db import transaction
-from django.http import Http404
-from rest_framework.exceptions import ValidationError
 
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
@@ -17,6 +15,7 @@ from webapp.facades import access, editcheck, rendering
 from webapp.facades.models import Change, Procedure, ProcedureVersion, tree_digest
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.services import sharing
+from webapp.facades.services.errors import Invalid, NotFound
 from webapp.facades.services.procedures import fork_procedure
 
 # figures of the job that made a tree (its timings, the decoded candidate's accuracy, how it searched): true of that
@@ -83,18 +82,19 @@ def edit_procedure(user, proc: Procedure, changes: dict) -> Procedure:
 
 
 def version_number(text, field: str | None = None) -> int:
-    """A version number from a path (malformed: `Http404`) or from the query parameter ``field`` (a 400 naming
-    it)."""
+    """A version number from a path (malformed: `NotFound`) or from the query parameter ``field`` (`Invalid`,
+    naming it)."""
     text = "" if text is None else str(text)
     if text.isascii() and text.isdigit() and len(text) <= MAX_VERSION_DIGITS:
         return int(text)
     if field is None:
-        raise Http404(f"no version {text[:20]!r}: versions are numbered from 1")
-    raise ValidationError({field: f"give a version number, got {text[:20]!r}"})
+        raise NotFound(f"no version {text[:20]!r}: versions are numbered from 1")
+    raise Invalid(f"give a version number, got {text[:20]!r}", field)
 
 
 def get_version(proc: Procedure, number, field: str | None = None, with_data: bool = True) -> ProcedureVersion:
-    """Version ``number`` of the procedure: `Http404` (from a path) or a 400 naming ``field`` when there is none."""
+    """Version ``number`` of the procedure: `NotFound` (from a path) or `Invalid` naming ``field`` when there is
+    none."""
     n = version_number(number, field)
     rows = proc.versions.all() if with_data else proc.versions.defer("data")
     version = rows.filter(version=n).first()
@@ -102,8 +102,8 @@ def get_version(proc: Procedure, number, field: str | None = None, with_data: bo
         latest = proc.versions.order_by("-version").values_list("version", flat=True).first() or 0
         message = f"no version {n} of this procedure: it has versions 1 to {latest}"
         if field is None:
-            raise Http404(message)
-        raise ValidationError({field: message})
+            raise NotFound(message)
+        raise Invalid(message, field)
     version.procedure = proc
     return version
 
@@ -112,8 +112,8 @@ def revert(proc: Procedure, number) -> ProcedureVersion:
     """A new version whose tree is version ``number``'s, measured again; the versions between stay."""
     old = get_version(proc, number)
     if old.digest == proc.digest:
-        raise ValidationError({"version": f"version {old.version} is the tree this procedure holds now: "
-                                          "there is nothing to revert"})
+        raise Invalid(f"version {old.version} is the tree this procedure holds now: there is nothing to revert",
+                      "version")
     proc.metrics = dict(old.metrics)  # where its structure came from, as that version knew it
     save_tree(proc, old.data, Change(ProcedureVersion.Kind.REVERT, f"reverted to version {old.version}",
                                      based_on=old.version))

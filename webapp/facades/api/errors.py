@@ -1,0 +1,25 @@
+"""The API's answers to the services' errors (`webapp.facades.services.errors`), REST_FRAMEWORK's
+``EXCEPTION_HANDLER``: each kind its status (`webapp.errors.service_status`), in the JSON the API gives every error,
+``{"<field>": "<message>"}`` where input is at fault (as DRF's `ValidationError` of a field) and
+``{"detail": "<message>"}`` otherwise; what the request wrote is rolled back. Any other exception is DRF's."""
+
+from __future__ import annotations
+
+from rest_framework.response import Response
+from rest_framework.views import exception_handler as drf_exception_handler
+from rest_framework.views import set_rollback
+
+from webapp.errors import service_status
+from webapp.facades.services.errors import ServiceError
+
+
+def body(exc: ServiceError) -> dict:
+    """The JSON of a service's error: its message under the field it names, else under ``detail``."""
+    return {exc.field or "detail": exc.message}
+
+
+def exception_handler(exc, context):
+    if isinstance(exc, ServiceError):
+        set_rollback()
+        return Response(body(exc), status=service_status(exc))
+    return drf_exception_handler(exc, context)
