@@ -16,8 +16,8 @@ from site_helpers import image_bytes, upload
 from facaid.generator import generate
 from facaid.grammar.procedure import GRAMMAR_VERSION
 from facaid.segmentation import rasterize
+from webapp.facades.drawing import label_map
 from webapp.facades.models import Job, Photo, Procedure, Segmentation
-from webapp.facades.rendering import label_map
 
 pytestmark = pytest.mark.django_db
 

@@ -11,7 +11,7 @@ from django.core.files.storage import default_storage
 from PIL import Image
 
 from facaid.generator import generate
-from webapp.facades import pictures
+from webapp.facades import picture_store
 from webapp.facades.models import Procedure, tree_digest
 
 pytestmark = pytest.mark.django_db
@@ -60,12 +60,12 @@ def test_refresh_keeps_the_pictures_of_the_committed_tree(alice):
     """Two saves' refreshes running late, in either order: the pictures left are those of the tree stored."""
     proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
     first = tree_digest(proc.data)
-    pictures.refresh(proc.id)
+    picture_store.refresh(proc.id)
     proc.data = generate(4).procedure.to_dict()
     proc.save()
     second = tree_digest(proc.data)
-    pictures.refresh(proc.id)
-    pictures.refresh(proc.id)  # the first save's refresh, late: it reads the stored tree, not its own
+    picture_store.refresh(proc.id)
+    picture_store.refresh(proc.id)  # the first save's refresh, late: it reads the stored tree, not its own
     assert kept(proc) == [f"{second}-labels.png", f"{second}-thumbnail.png"] and first != second
 
 
@@ -127,10 +127,10 @@ def test_a_picture_drawn_after_an_edit_is_filed_under_the_tree_it_shows(alice, a
     seen = access.get_procedure_picture_for_user(alice, proc.code)  # digest read, tree not
     proc.data = generate(4).procedure.to_dict()
     proc.save()  # an edit commits before the picture is drawn
-    name, tag, png = pictures.stored(seen, "thumbnail.png")
+    name, tag, png = picture_store.stored(seen, "thumbnail.png")
     assert tag == tree_digest(proc.data) and name.endswith(f"{tag}-thumbnail.png") and png
     r = as_alice.get(f"/api/v1/procedures/{proc.code}/thumbnail.png")
     assert r["ETag"] == f'"{tree_digest(proc.data)}"'
     Procedure.objects.filter(id=proc.id).delete()
     with pytest.raises(LookupError):
-        pictures.stored(seen, "labels.png")
+        picture_store.stored(seen, "labels.png")

@@ -19,8 +19,8 @@ from facaid.labels import LABELS
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
+from webapp.facades.drawing import DIFFERENT
 from webapp.facades.models import Job, Procedure, ProcedureVersion, Segmentation, stored_bytes
-from webapp.facades.rendering import DIFFERENT
 
 pytestmark = pytest.mark.django_db
 

@@ -7,6 +7,6 @@ class FacadesConfig(AppConfig):
     default_auto_field = "django.db.models.BigAutoField"
 
     def ready(self) -> None:
-        from webapp.facades import pictures
+        from webapp.facades import picture_store
 
-        pictures.connect()
+        picture_store.connect()

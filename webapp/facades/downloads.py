@@ -22,7 +22,7 @@ from facaid.grammar import to_segmentation
 from facaid.grammar.budget import charge
 from facaid.grammar.layout import count_leaves
 from facaid.photo.files import read_photo
-from webapp.facades import access, disclosure, rendering
+from webapp.facades import access, disclosure, drawing
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.services.errors import Invalid
@@ -160,7 +160,7 @@ def _overlay(proc: Procedure, tree: Tree, params: Params, viewer) -> bytes:
     if not 0.0 <= alpha <= 1.0:
         raise Invalid("alpha must be a number between 0 and 1", "alpha")
     with proc.photo.working_image().open("rb") as f:
-        return rendering.overlay_png(to_segmentation(tree), f, alpha)
+        return drawing.overlay_png(to_segmentation(tree), f, alpha)
 
 
 def picture_name(proc: Procedure, tree: Tree, viewer) -> str:

@@ -14,7 +14,7 @@ from rest_framework.parsers import BaseParser
 
 from facaid.formats import interchange
 from facaid.grammar.procedure import ProcedureError
-from webapp.facades import pictures, throttling
+from webapp.facades import picture_store, throttling
 from webapp.facades.models import (
     Procedure,
     Visibility,
@@ -71,7 +71,7 @@ def stored_picture(request, proc: Procedure, kind: str) -> HttpResponse:
         resp = HttpResponse(status=304)
     else:
         try:
-            kept, resp = pictures.stored(proc, kind, draw=False), None
+            kept, resp = picture_store.stored(proc, kind, draw=False), None
             if kept is not None:
                 name, tag, _ = kept
                 try:
@@ -82,7 +82,7 @@ def stored_picture(request, proc: Procedure, kind: str) -> HttpResponse:
                 with throttling.heavy_slot(request) as held:
                     if not held:
                         return throttling.busy(request, "drawing pictures")
-                    name, tag, png = pictures.stored(proc, kind, redraw=True)
+                    name, tag, png = picture_store.stored(proc, kind, redraw=True)
                 resp = HttpResponse(png, content_type="image/png")
         except ProcedureError as exc:  # stored before a limit it now breaks
             raise ValidationError({"data": f"this procedure cannot be drawn: {exc}"}) from None

@@ -24,7 +24,7 @@ from facaid.grammar.budget import reserve
 from facaid.grammar.layout import count_expansion
 from facaid.grammar.procedure import ProcedureError
 from facaid.labels import LABELS
-from webapp.facades import access, disclosure, downloads, editcheck, rendering
+from webapp.facades import access, disclosure, downloads, drawing, editcheck
 from webapp.facades.api.common import (
     page,
     stored_picture,
@@ -246,7 +246,7 @@ def procedure_parameters(request, code):
 @parser_classes([JSONParser])
 def render_preview(request):
     seg = to_segmentation(parse_procedure(request.data))
-    return HttpResponse(rendering.label_map_png(seg, 1024), content_type="image/png")
+    return HttpResponse(drawing.label_map_png(seg, 1024), content_type="image/png")
 
 
 @extend_schema(parameters=[OpenApiParameter("alpha", float, description="overlay opacity, 0..1"),

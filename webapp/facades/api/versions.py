@@ -14,7 +14,7 @@ from rest_framework.permissions import AllowAny, IsAuthenticated
 from rest_framework.response import Response
 
 from facaid.grammar import to_segmentation
-from webapp.facades import access, rendering
+from webapp.facades import access, drawing
 from webapp.facades.api.common import (
     cacheable,
 )
@@ -63,7 +63,7 @@ def procedure_version_picture(request, code, number):
     if etag in request.headers.get("If-None-Match", ""):
         return cacheable(HttpResponse(status=304), etag, proc)
     seg = to_segmentation(parse_procedure(version.data))
-    return cacheable(HttpResponse(rendering.label_map_png(seg, rendering.COMPARE_SIDE), content_type="image/png"),
+    return cacheable(HttpResponse(drawing.label_map_png(seg, drawing.COMPARE_SIDE), content_type="image/png"),
                       etag, proc)
 
 

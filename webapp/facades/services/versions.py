@@ -11,7 +11,7 @@ from django.db import transaction
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
-from webapp.facades import access, editcheck, rendering
+from webapp.facades import access, drawing, editcheck
 from webapp.facades.models import Change, Procedure, ProcedureVersion, tree_digest
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.services import sharing
@@ -179,13 +179,13 @@ def _measured(proc: Procedure, checks: dict) -> None:
     proc.metrics = {**(proc.metrics or {}), editcheck.KEY: checks}
 
 
-def compare(proc: Procedure, a, b, max_side: int = rendering.COMPARE_SIDE) -> tuple[ProcedureVersion,
-                                                                                     ProcedureVersion, dict]:
+def compare(proc: Procedure, a, b, max_side: int = drawing.COMPARE_SIDE) -> tuple[ProcedureVersion,
+                                                                                   ProcedureVersion, dict]:
     """Versions ``a`` and ``b`` (from the query: a 400 names the bad one) and their difference picture:
     {"png", "differing", "pixels", "sizes"} (pixels whose label differs, of the picture's, at most ``max_side`` a
     side; each tree's width and height). Each tree is read once, before any is drawn."""
     first, second = get_version(proc, a, "a"), get_version(proc, b, "b")
     trees = parse_procedure(first.data), parse_procedure(second.data)  # both charged to the budget, then drawn
-    png, differing, pixels = rendering.difference_png(*trees, max_side)
+    png, differing, pixels = drawing.difference_png(*trees, max_side)
     return first, second, {"png": png, "differing": differing, "pixels": pixels,
                            "sizes": [(tree.width, tree.height) for tree in trees]}

@@ -1,4 +1,6 @@
-"""Pictures of procedures and segmentations for the site (PNG bytes), drawn at the size they are sent at.
+"""Pictures of procedures and segmentations for the site (PNG bytes), drawn at the size they are sent at: label
+maps, overlays on the photo, two versions' difference. A procedure's own pictures are kept in storage once drawn
+(`picture_store`).
 
 A request's cost is bounded by what is drawn, not by what a procedure declares: the rectangles are scaled to the
 picture (at most `MAX_RENDER_SIDE` a side) and painted there, so a 16,384 px facade costs what a 2,048 px one

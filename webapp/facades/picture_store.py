@@ -1,6 +1,6 @@
 """A procedure's pictures kept in storage: its label map (``labels.png``, at most 2,048 px a side) and the
-gallery card's thumbnail (``thumbnail.png``, at most 320 px), rendered when a save of the procedure commits and
-served as files. A picture is named by a digest of the tree it shows, so it never outlives an edit; one missing
+gallery card's thumbnail (``thumbnail.png``, at most 320 px), drawn (`drawing`) when a save of the procedure commits
+and served as files. A picture is named by a digest of the tree it shows, so it never outlives an edit; one missing
 (a procedure saved before pictures were kept, or a failed render) is rendered on its first request and kept.
 
 Files are written whole or not at all (a temporary name, then a rename), and the pictures a save leaves behind
@@ -18,12 +18,12 @@ from django.core.files.storage import default_storage
 from django.db import transaction
 
 from facaid.grammar.budget import work_budget
-from webapp.facades import rendering
+from webapp.facades import drawing
 from webapp.facades.models import Procedure
 
 log = logging.getLogger(__name__)
 
-SIDES = {"labels.png": rendering.MAX_RENDER_SIDE, "thumbnail.png": 320}
+SIDES = {"labels.png": drawing.MAX_RENDER_SIDE, "thumbnail.png": 320}
 
 
 def _folder(code) -> str:
@@ -65,7 +65,7 @@ def render(data: dict, kind: str) -> bytes:
     from facaid.grammar import Procedure as Tree
     from facaid.grammar import to_segmentation
 
-    return rendering.label_map_png(to_segmentation(Tree.from_dict(data)), SIDES[kind])
+    return drawing.label_map_png(to_segmentation(Tree.from_dict(data)), SIDES[kind])
 
 
 def stored(proc, kind: str, redraw: bool = False, draw: bool = True) -> tuple[str, str, bytes | None] | None:
