@@ -24,7 +24,7 @@ import torch
 
 from facaid.model import FacaidModel
 from facaid.model.decoder import DecoderState
-from facaid.native import load
+from facaid.native.build import load
 
 _pool: ThreadPoolExecutor | None = None
 _pool_size = 0

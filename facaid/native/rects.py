@@ -1,4 +1,5 @@
-"""Executing procedures and flattening rectangles in C (`facaid/native/rects.c`), for the generator's hot path.
+"""Executing procedures and flattening rectangles in C (`facaid/native/rects.c`), for the generator's hot path, and
+writing them as JSON (`facaid/native/rects_json.c`).
 
 - `flatten_rows`: `facaid.segmentation.flatten_array` without numpy's fixed cost per call, which dominates on
   the few hundred rectangles of a facade.
@@ -17,7 +18,7 @@ import ctypes
 import numpy as np
 
 from facaid.labels import LABEL_ID, LABELS, PRIORITY
-from facaid.native import load
+from facaid.native.build import load
 
 _PRIORITY = np.asarray(PRIORITY, dtype=np.int64)
 _NAMES = b"".join(name.encode() + b"\0" for name in LABELS)
@@ -38,8 +39,6 @@ def _declare(lib: ctypes.CDLL) -> None:
     lib.facaid_flatten.restype = ctypes.c_int64
     lib.facaid_flatten.argtypes = [ctypes.c_int64, ctypes.c_int64, ctypes.c_void_p, ctypes.c_int64, ctypes.c_void_p,
                                    ctypes.c_int, ctypes.c_void_p, ctypes.c_int64]
-    lib.facaid_rects_json.restype = ctypes.c_int64
-    lib.facaid_rects_json.argtypes = [ctypes.c_void_p, ctypes.c_int64, ctypes.c_char_p, ctypes.c_void_p, ctypes.c_int64]
     lib.facaid_execute.restype = ctypes.c_int64
     lib.facaid_execute.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p,
                                    ctypes.c_void_p, ctypes.c_void_p, ctypes.c_double,
@@ -47,8 +46,19 @@ def _declare(lib: ctypes.CDLL) -> None:
                                    ctypes.c_void_p, ctypes.c_int, ctypes.c_void_p, ctypes.c_int64]
 
 
+def _declare_json(lib: ctypes.CDLL) -> None:
+    lib.facaid_rects_json.restype = ctypes.c_int64
+    lib.facaid_rects_json.argtypes = [ctypes.c_void_p, ctypes.c_int64, ctypes.c_char_p, ctypes.c_void_p, ctypes.c_int64]
+
+
 def library() -> ctypes.CDLL | None:
+    """``rects.c``: flattening and executing."""
     return load("rects", _declare)
+
+
+def json_library() -> ctypes.CDLL | None:
+    """``rects_json.c``: rectangles written as JSON."""
+    return load("rects_json", _declare_json)
 
 
 def flatten_rows(width: int, height: int, arr: np.ndarray, wall: str = "pieces") -> np.ndarray | None:
@@ -134,7 +144,7 @@ def executed_rows(root, extent: tuple[float, float], max_count: int, max_leaves:
 def rects_json(rows: np.ndarray) -> bytes | None:
     """int rows (label, x0, y0, x1, y1) as the JSON of `facaid.segmentation.rect_dicts`, byte for byte what orjson
     writes for it; None when the library is unavailable or a label is not one of the 12."""
-    lib = library()
+    lib = json_library()
     if lib is None:
         return None
     rows = np.ascontiguousarray(rows, dtype=np.int64)
