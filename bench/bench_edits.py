@@ -4,7 +4,7 @@ both clean on at least 95 % of the facades).
     .venv/bin/python bench/bench_edits.py [--start 5000] [--count 100]
 
 Held-out generated facades (seeds ``--start`` on; the training data is drawn from other seeds), those with a lattice
-of windows (two rows and two columns at least, as on CMP: `facaid.editing.windows.lattice`). Each is edited by its
+of windows (two rows and two columns at least, as on CMP: `facaid.reading.windows.lattice`). Each is edited by its
 named parameters and judged by `facaid.editing.check` (no annotation: before against after). Prints the share with
 both edits clean, the reasons of the others, and their seeds.
 """

@@ -13,7 +13,7 @@ floor is a blend of three floors or sits under the shops; looking at the picture
 3. it holds windows, and the rows (columns) of windows grow by one, or by as many as it holds (two where a bay is
    a pair of windows, or a floor has a mezzanine; counted as most of its shifts count them, `band_holds`), while
    the columns (rows) stay as they were; a shop window several bays wide is in no column
-   (`facaid.editing.windows.WIDE`). Counted apart from the facade, a band may hold a strip of a window or a dormer
+   (`facaid.reading.windows.WIDE`). Counted apart from the facade, a band may hold a strip of a window or a dormer
    as a row (column) of its own that the facade's count joins to its neighbour: one more is what the issue asks;
 4. the doors stay as many as they were: a new bay beside the entrance is another shop, not a second door; but
    where every bay has a door of its own (a row of entrances), a new bay brings one more.
@@ -29,10 +29,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from facaid.editing.parameters import named_parameters, set_parameter
-from facaid.editing.windows import WIDE, centre_bands, lattice, window_boxes
 from facaid.grammar.execute import first_boxes, flat_rows, label_map
 from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID
+from facaid.reading.windows import WIDE, centre_bands, lattice, window_boxes
 from facaid.segmentation import region_boxes
 
 KEEP = 0.98  # share of the old pixels a new floor leaves where they were
@@ -292,4 +292,4 @@ def check_edits(proc: Procedure, edits: tuple[tuple[str, int], ...] = EDITS) -> 
 
 
 __all__ = ["COPY", "EDITS", "KEEP", "KEEP_BAY", "MORE", "Verdict", "band_holds", "best_copy", "check_edits",
-           "insertion", "judge", "judge_insert", "kept", "label_map"]
+           "insertion", "judge", "judge_insert", "kept"]

@@ -1,5 +1,5 @@
 """Whether a procedure's named parameters describe the building it reads: its floor height the floors' pitch, its
-tile width the bays', as a person measures them on the drawing (`facaid.editing.windows.window_pitch`: from a window
+tile width the bays', as a person measures them on the drawing (`facaid.reading.windows.window_pitch`: from a window
 to the next one up its column, along its row). Issue 67's item 5: reported by `facaid evaluate-real`, and one of
 what the pipeline ranks its lattice readings by (`facaid.pipeline.best_reading`)."""
 
@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from facaid.editing.parameters import named_parameters
-from facaid.editing.windows import pitches
 from facaid.grammar.procedure import Procedure
+from facaid.reading.windows import pitches
 
 __all__ = ["PITCH", "describes"]
 
@@ -19,7 +19,7 @@ PITCH = 0.15  # floor_height within this share of the window rows' pitch
 def describes(proc: Procedure, rows: np.ndarray) -> dict:
     """Whether the named parameters describe the building of a flattened annotation's ``rows``: ``floor_height``
     within `PITCH` of its floors' pitch (where it has at least three rows of windows: the median step from a window
-    to the next one up its column, `facaid.editing.windows.window_pitch`), ``tile_width`` the same of its bays' pitch,
+    to the next one up its column, `facaid.reading.windows.window_pitch`), ``tile_width`` the same of its bays' pitch,
     and no narrower than ``window_width`` (None where there is nothing to judge)."""
     names = {p.name: p.value for p in named_parameters(proc)}
     floor, bay = pitches(rows)

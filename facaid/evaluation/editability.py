@@ -1,6 +1,6 @@
 """Whether a procedure can be edited as a person means (`facaid evaluate-real`).
 
-Two measures of `floors` + 1 and `bays` + 1. Issue 55's counts the windows (`facaid.editing.windows`): one more row
+Two measures of `floors` + 1 and `bays` + 1. Issue 55's counts the windows (`facaid.reading.windows`): one more row
 (column) of window centres, the same columns (rows). Issue 67's looks at the picture (`facaid.editing.check`): the
 old facade with one band like its others put in between two, every other pixel where it was. A facade is
 *eligible* when its annotation has at least two rows and two columns of windows. And what the procedure keeps of
@@ -12,13 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from facaid.editing.check import check_edits
-from facaid.editing.describes import PITCH, describes
 from facaid.editing.parameters import named_parameters, set_parameter
-from facaid.editing.windows import lattice, segmentation_lattice, window_boxes
 from facaid.grammar.execute import flat_rows
 from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE
 from facaid.metrics import appears
+from facaid.reading.windows import lattice
 from facaid.segmentation import region_boxes
 
 KEPT = 0.5  # an element is kept when the procedure paints at least this share of its pixels with its label
@@ -95,5 +94,4 @@ def generated_edits(seeds: range) -> tuple[int, list[int], dict[int, dict]]:
     return eligible, clean, others
 
 
-__all__ = ["KEPT", "PITCH", "describes", "editability", "generated_edits", "kept_elements", "lattice",
-           "segmentation_lattice", "window_boxes"]
+__all__ = ["KEPT", "editability", "generated_edits", "kept_elements"]

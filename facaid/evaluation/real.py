@@ -25,13 +25,15 @@ from tqdm import tqdm
 
 from facaid.augmentation import annotator_noise
 from facaid.defaults import DEFAULT_K
-from facaid.evaluation.editability import describes, editability, kept_elements, segmentation_lattice
+from facaid.editing.describes import describes
+from facaid.evaluation.editability import editability, kept_elements
 from facaid.formats.render import colorize, side_by_side
 from facaid.grammar.execute import to_segmentation
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.metrics import compression, pixel_accuracy
 from facaid.model import FacaidModel
 from facaid.pipeline import ReconstructOptions, reconstruct
+from facaid.reading.windows import segmentation_lattice
 from facaid.segmentation import Segmentation, flatten, rasterize
 from facaid.tokenizer import Tokenizer
 

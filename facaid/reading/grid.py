@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from facaid.editing.windows import centre_bands
 from facaid.grammar.procedure import MAX_COUNT
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID
+from facaid.reading.windows import centre_bands
 
 ALIGN = 0.05  # a cut between two bands may move to a line this much less wall to sit at the typical offset
 COLUMN_SUPPORT = 0.5  # a column of windows needs windows in this share of the floors
@@ -24,7 +24,7 @@ GROUND_SHARE = 0.05  # a last row of windows whose band is this much door or sho
 
 
 def window_bands(lo: np.ndarray, hi: np.ndarray) -> list[np.ndarray]:
-    """Indices of the boxes [lo, hi) grouped in bands of centres (`facaid.editing.windows.centre_bands`: split where
+    """Indices of the boxes [lo, hi) grouped in bands of centres (`facaid.reading.windows.centre_bands`: split where
     the gap between neighbouring centres is over half the median size); bands whose typical extents overlap (wide and
     narrow windows in one column) are one."""
     out = centre_bands((lo + hi) / 2, hi - lo)

@@ -7,7 +7,7 @@ Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013), in thre
 
 1. **The grid** (`read_grid`). Windows: connected window-or-blind regions of the building (the longest run of
    columns that are mostly not background: a neighbour's strip is left out), but for the strips a balcony or sill
-   leaves uncovered (`facaid.editing.windows.whole_windows`); their rows and columns (`window_bands`: bands of
+   leaves uncovered (`facaid.reading.windows.whole_windows`); their rows and columns (`window_bands`: bands of
    centres split where the gap is over half the median window height, width; bands whose extents overlap are one;
    a column needs windows in `COLUMN_SUPPORT` of the floors). Floors: horizontal bands that each hold one row of
    windows with its companions, cut between two rows where the label map is most wall, at one offset from their
@@ -33,11 +33,11 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from facaid.editing.windows import whole_windows
 from facaid.grammar.procedure import Procedure, ProcedureError
 from facaid.labels import GLASS
-from facaid.reading.grid import ALIGN, COLUMN_SUPPORT, GROUND_SHARE, Grid, footprint, read_grid, window_bands
-from facaid.reading.tiles import JITTER, read_floors
+from facaid.reading.grid import Grid, footprint, read_grid
+from facaid.reading.tiles import read_floors
+from facaid.reading.windows import whole_windows
 from facaid.segmentation import Segmentation, flatten, rasterize, region_boxes
 
 
@@ -50,7 +50,7 @@ def read_lattice(seg: Segmentation, group: tuple[int, int] = (1, 1)) -> Procedur
     grid = grouped(_grid(flat, label_map), group)
     if grid is None:
         return None
-    proc = Procedure(width, height, read_floors(grid), {"source": "facaid.lattice"})
+    proc = Procedure(width, height, read_floors(grid), {"source": SOURCE})
     try:
         return Procedure.from_dict(proc.to_dict())
     except ProcedureError:  # a reading past the grammar's limits (more exceptions than a repeat holds): none
@@ -67,13 +67,14 @@ def readings(seg: Segmentation) -> Iterator[tuple[tuple[int, int], Procedure]]:
     for group in GROUPS:
         g = grouped(grid, group)
         if g is not None:
-            proc = Procedure(label_map.shape[1], label_map.shape[0], read_floors(g), {"source": "facaid.lattice"})
+            proc = Procedure(label_map.shape[1], label_map.shape[0], read_floors(g), {"source": SOURCE})
             try:
                 yield group, Procedure.from_dict(proc.to_dict())
             except ProcedureError:
                 continue
 
 
+SOURCE = "facaid.reading.lattice"  # the meta of its procedures, as `facaid.reading.induce` names itself
 GROUPS = ((1, 1), (2, 1), (1, 2))  # (floors, bays) read as one: the candidate readings
 
 
@@ -96,5 +97,4 @@ def _grid(flat: Segmentation, label_map: np.ndarray) -> Grid | None:
     return read_grid(label_map, windows[(centres >= fx0) & (centres < fx1)])
 
 
-__all__ = ["ALIGN", "COLUMN_SUPPORT", "GROUND_SHARE", "GROUPS", "JITTER", "Grid", "footprint", "grouped", "read_floors",
-           "read_grid", "read_lattice", "readings", "window_bands"]
+__all__ = ["GROUPS", "grouped", "read_lattice", "readings"]

@@ -5,9 +5,12 @@ import numpy as np
 import pytest
 from grammar_helpers import example, facade
 
-from facaid.evaluation.editability import describes, editability, kept_elements, lattice, window_boxes
+from facaid.editing.describes import describes
+from facaid.evaluation.editability import editability, kept_elements
 from facaid.grammar.execute import flat_rows
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
+from facaid.reading.windows import lattice, window_boxes
 
 
 def test_a_window_cut_by_its_blind_counts_once():

@@ -6,13 +6,15 @@ import pytest
 from grammar_helpers import real_like
 
 from facaid.editing.parameters import named_parameters, set_parameter
-from facaid.evaluation.editability import editability, kept_elements, segmentation_lattice
+from facaid.evaluation.editability import editability, kept_elements
 from facaid.generator import generate
 from facaid.grammar.execute import execute, flat_rows, to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.labels import GLASS, LABEL_ID
 from facaid.metrics import pixel_accuracy
+from facaid.reading import grid as grid_module
 from facaid.reading import lattice
+from facaid.reading.windows import segmentation_lattice
 from facaid.segmentation import Segmentation, flatten, rasterize, region_boxes
 from facaid.sizing import fit_sizes
 
@@ -58,7 +60,7 @@ def test_the_typical_floor_is_a_real_one():
     label_map = rasterize(flatten(seg))
     proc = lattice.read_lattice(seg)
     floors = next(n for _, n in proc.nodes() if n.role == "floors")
-    grid = lattice.read_grid(label_map, window_array(seg))
+    grid = grid_module.read_grid(label_map, window_array(seg))
     alike = [pixel_accuracy(rasterize(to_segmentation(Procedure(proc.width, b - a, floors.children[0]))),
                             label_map[a:b]) for a, b in zip(grid.ys[:-1], grid.ys[1:], strict=True)]
     assert max(alike) > 0.96
@@ -112,7 +114,7 @@ def test_readings_come_as_read_first_then_two_by_two():
     seg = real_like()
     groups = [group for group, _ in lattice.readings(seg)]
     assert groups[0] == (1, 1) and set(groups) <= set(lattice.GROUPS)
-    grid = lattice.read_grid(rasterize(flatten(seg)), window_array(seg))
+    grid = grid_module.read_grid(rasterize(flatten(seg)), window_array(seg))
     assert lattice.grouped(grid, (2, 1)) is None  # 5 floors do not go two by two
     pairs = lattice.grouped(grid, (1, 2))
     assert pairs.columns == grid.columns // 2 and pairs.xs == grid.xs[::2]

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from facaid.editing.windows import window_pitch
+from facaid.reading.windows import window_pitch
 
 
 def stack(x0: float, y0: float, step: float, floors: int, width: float = 20, height: float = 30) -> list:
