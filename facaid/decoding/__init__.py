@@ -2,10 +2,10 @@
 
 - `processor`: `GrammarLogitsProcessor`, a Hugging Face ``LogitsProcessor`` that masks every token the token
   grammar forbids (it works inside ``model.generate`` too);
-- `backends`: `Stepper`, the next token's logits from the C step or the decoder's own cached torch step;
+- `backends`: `Stepper`, the next token's logits from the C step (`step`) or the decoder's own cached torch step;
 - `loop`: `decode`, K candidates (greedy or sampled) in one batch, from a prefix if asked;
 - `ranking`: `ranked_candidates` and `best_of_k`, the candidates executed and ranked by how well they
-  reproduce the input, composed region by region.
+  reproduce the input, composed region by region (`composition`).
 """
 
 from facaid.decoding.loop import Candidate, decode, prefix_from_procedure
