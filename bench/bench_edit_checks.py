@@ -3,7 +3,7 @@ readings, its estimate against its time, and what it adds to a save.
 
     .venv/bin/python bench/bench_edit_checks.py [--start 0] [--limit 60] [--saves 15]
 
-1. ``webapp.facades.editcheck.record`` of the editable reading (`facaid.reading.read_lattice`) of CMP facades
+1. ``webapp.facades.editcheck.record`` of the editable reading (`facaid.reading.lattice.read_lattice`) of CMP facades
    ``--start`` to ``--start + --limit``: seconds (median, 90th percentile, most), how many were not checked (their
    estimate past `CHECK_SECONDS`), the estimate over the time it took (at least 1 is an upper bound), and on how
    many the self-check agrees with the rule applied offline (`facaid.editing.check.check_edits`: the same verdict

@@ -14,7 +14,7 @@ from PIL import Image
 from facaid.formats.render import legend, render_segmentation, side_by_side
 from facaid.generator import STYLE_NAMES, generate
 from facaid.grammar import Node, Procedure, Size, to_segmentation
-from facaid.grammar.procedure import Override
+from facaid.grammar.nodes import Override
 
 A, R, F = (lambda v: Size("abs", v)), (lambda v: Size("rel", v)), (lambda v: Size("flt", v))
 L = Node.leaf

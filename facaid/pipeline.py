@@ -24,7 +24,7 @@ A shortcut for annotations unlike the model's training data: when the decoded st
 `FAR_OFF` of the pixels before sizing and the induced one at least `FAR_BEHIND` more, only the induced one is
 sized (``result.shortcut``): sizing the decoded structure could not close that gap, and it is the slowest stage.
 The test is made on the greedy candidate, decoded first and alone, so that the samples are not drawn where it
-holds (`_decoded`).
+holds (`_candidates`).
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ from facaid.editing.describes import describes
 from facaid.grammar.execute import to_segmentation
 from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE
-from facaid.metrics import element_leaves, procedure_accuracy, unexplained
+from facaid.metrics import element_leaves, procedure_accuracy, procedure_iou, unexplained
 from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
 from facaid.reading.induce import induce_procedure
@@ -181,8 +181,6 @@ def reconstruct(segmentation: Segmentation | dict, options: ReconstructOptions |
         tell(0.5, "sizing")
         result = _sized(found, model, tokenizer, readable, flat, opts, tell)
     else:
-        from facaid.metrics import procedure_iou
-
         decoded = found.ranked[0].procedure
         before = procedure_accuracy(decoded, flat)
         result = Reconstruction(decoded, before, before, procedure_iou(decoded, flat), candidates=found.drawn,

@@ -1,6 +1,7 @@
 """Procedures the format and download tests share."""
 
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
 
 
 def window_grid(columns: int, rows: int, size: int = 2000, apart: bool = False) -> Procedure:

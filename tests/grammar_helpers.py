@@ -3,7 +3,8 @@ exceptions issue 66's probe crafted (also built by `bench/bench_request_cost.py`
 
 import numpy as np
 
-from facaid.grammar.procedure import GRAMMAR_VERSION, Node, Override, Procedure, ProcedureError, Size
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import GRAMMAR_VERSION, Procedure, ProcedureError
 from facaid.grammar.repeats import expanded_count, pattern_child
 from facaid.labels import LABEL_ID
 from facaid.segmentation import Segmentation

@@ -12,7 +12,7 @@ from __future__ import annotations
 from celery import Celery
 
 from webapp.env import env_seconds
-from webapp.facades.queue import DEFAULT_QUEUE, GPU_QUEUE, RUN_JOB, broker_settings
+from webapp.facades.queue import broker_settings
 
 # A job past the soft limit gets SoftTimeLimitExceeded and ends `failed` with a message; one stuck where that
 # cannot reach it (native code) is killed at the hard limit and failed by the worker's main process. Limits need
@@ -32,4 +32,4 @@ app.conf.update(
     worker_hijack_root_logger=False,
 )
 
-__all__ = ["DEFAULT_QUEUE", "GPU_QUEUE", "JOB_SOFT_TIME_LIMIT", "JOB_TIME_LIMIT", "RUN_JOB", "app"]
+__all__ = ["JOB_SOFT_TIME_LIMIT", "JOB_TIME_LIMIT", "app"]

@@ -22,7 +22,7 @@ def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed
     """Segmentation JSON -> the result as the worker stores it: ``{"procedure": JSON, "accuracy", "structure",
     "metrics"}`` (``metrics``: what the result says of its tree, `JOB_METRICS`, kept beside its accuracy), and for a
     real facade the other of its two procedures (``structure`` names the one returned first) as ``"alternative"``
-    in the same shape. The one place a `facaid.Reconstruction` becomes JSON for a job.
+    in the same shape. The one place a `facaid.pipeline.Reconstruction` becomes JSON for a job.
 
     ``prefix`` (a procedure JSON) with ``prefix_nodes`` > 0 keeps that procedure's first nodes (BFS) and lets
     the model continue from them. ``progress(fraction, stage)`` hears of each stage: loading the model (the
@@ -44,7 +44,7 @@ def reconstruct(segmentation: dict, checkpoint: str, *, k: int = DEFAULT_K, seed
                  tokenizer=tokenizer, progress=stages)
     summary = result.to_dict()
     out = {"procedure": result.procedure.to_dict(), "accuracy": result.accuracy, "structure": result.structure,
-           "metrics": {k: summary[k] for k in JOB_METRICS}}
+           "metrics": {key: summary[key] for key in JOB_METRICS}}
     if result.alternative is not None:
         other = "exact" if result.structure == "editable" else "editable"
         out["alternative"] = {"procedure": result.alternative.to_dict(), "accuracy": result.alternative_accuracy,

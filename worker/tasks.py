@@ -17,9 +17,10 @@ from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
 from webapp.facades import access, editcheck
 from webapp.facades.models import Change, Job, Photo, Procedure, ProcedureVersion, Visibility, tree_digest
+from webapp.facades.queue import RUN_JOB
 from webapp.facades.services import jobs, versions
 from worker import compute
-from worker.app import RUN_JOB, app
+from worker.app import app
 
 log = logging.getLogger(__name__)
 

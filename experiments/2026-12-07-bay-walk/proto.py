@@ -16,7 +16,7 @@ from bench_corners import facade_box, quad_iou  # noqa: E402
 
 from facaid.evaluation.real import DEV_FACADES, load_records  # noqa: E402
 from facaid.paths import DEFAULT_CMP  # noqa: E402
-from facaid.photo.rectify import propose_corners  # noqa: E402
+from facaid.photo.corners import propose_corners  # noqa: E402
 from facaid.photo.repeats import normalised  # noqa: E402
 
 ap = argparse.ArgumentParser()

@@ -25,7 +25,8 @@ from collections.abc import Callable
 import numpy as np
 
 from facaid.grammar.execute import execute_with_boxes, leaf_array
-from facaid.grammar.procedure import Node, Procedure
+from facaid.grammar.nodes import Node
+from facaid.grammar.procedure import Procedure
 from facaid.metrics import cell_span, element_counts_within, scaled_procedure_map
 
 DEPTH = 2  # splits below the root down to which regions are compared

@@ -10,7 +10,8 @@ import numpy as np
 
 from facaid.editing.resizing import copy_lengths
 from facaid.grammar.execute import first_boxes, flat_rows
-from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure
 from facaid.grammar.repeats import copies_moved
 from facaid.labels import LABEL_ID
 from facaid.metrics import scaled_procedure_map

@@ -5,7 +5,8 @@ node: sky first, then wall."""
 
 from __future__ import annotations
 
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
 from facaid.grammar.repeats import pattern_child
 
 

@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from facaid.grammar.layout import expand_over, layout
-from facaid.grammar.procedure import Node, Procedure
+from facaid.grammar.nodes import Node
+from facaid.grammar.procedure import Procedure
 
 __all__ = ["Instances"]
 

@@ -32,7 +32,8 @@ from facaid.editing.rows import (
 )
 from facaid.grammar.execute import first_boxes, parameter_lengths
 from facaid.grammar.limits import MAX_COUNT, MAX_EXTENT
-from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size, validate
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure, ProcedureError, validate
 from facaid.grammar.repeats import copies_moved, copies_where, most_typical, recount
 
 __all__ = ["AXES", "NAMES", "Parameter", "named_parameters", "normalised", "set_parameter", "set_parameters"]

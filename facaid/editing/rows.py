@@ -18,7 +18,8 @@ import numpy as np
 from facaid.editing.resizing import repeat_unit
 from facaid.grammar.execute import label_map
 from facaid.grammar.layout import expand_over, layout
-from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure
 
 
 def building_of(proc: Procedure, path: str) -> str:

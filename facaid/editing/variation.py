@@ -11,9 +11,10 @@ import random
 from facaid.editing.parameters import named_parameters, set_parameters
 from facaid.editing.resizing import box_sizes, copy_procedure, regions, resize
 from facaid.generator import STYLE_NAMES, generate_procedure
-from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Node, Procedure, ProcedureError, Size, validate
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import MAX_COUNT, MAX_EXTENT, Procedure, ProcedureError, validate
 
-__all__ = ["change_count", "resize", "swap", "vary", "with_count", "with_size"]
+__all__ = ["change_count", "swap", "vary", "with_count", "with_size"]
 
 
 def _node(proc: Procedure, path: str) -> Node:

@@ -25,7 +25,7 @@ from facaid.evaluation.records import RecordLog, model_digest
 from facaid.evaluation.ted import tree_edit_distance, tree_size
 from facaid.generator import generate
 from facaid.generator.dataset import sample_seed
-from facaid.grammar.procedure import Node
+from facaid.grammar.nodes import Node
 from facaid.model import FacaidModel, batch_inputs, batch_outputs
 from facaid.pipeline import fit_to_model
 from facaid.segmentation import Segmentation

@@ -7,7 +7,7 @@ gives it (abs, rel, flt), so that a missing child costs one edit, not two.
 
 from __future__ import annotations
 
-from facaid.grammar.procedure import Node
+from facaid.grammar.nodes import Node
 
 
 def node_label(node: Node, mode: str = "") -> str:

@@ -27,7 +27,8 @@ from statistics import median_high
 
 from facaid.grammar.execute import execute_with_boxes, leaf_array
 from facaid.grammar.layout import expand_over, layout, repeat_count
-from facaid.grammar.procedure import Node, Procedure
+from facaid.grammar.nodes import Node
+from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID, hex_colour
 
 LEAF_RULES: dict[str, str] = {

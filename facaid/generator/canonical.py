@@ -18,7 +18,8 @@ from __future__ import annotations
 
 from facaid.grammar.execute import first_boxes
 from facaid.grammar.floors import lone_child, merge_floor_runs
-from facaid.grammar.procedure import Node, Procedure
+from facaid.grammar.nodes import Node
+from facaid.grammar.procedure import Procedure
 
 MIN_GAP = 1 / 128  # of the image side: narrower wall or background is not part of the canonical tree
 IMPLICIT = ("facade", "background")

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from facaid.generator.plan import WALL, FloorType, Layout
 from facaid.generator.styles import Style
-from facaid.grammar.procedure import Node, Size
+from facaid.grammar.nodes import Node, Size
 
 __all__ = ["GroundFloor"]
 

@@ -16,7 +16,7 @@ from facaid.generator.ground import GroundFloor
 from facaid.generator.plan import WALL, FloorType, Layout
 from facaid.generator.styles import Style
 from facaid.grammar.floors import structure
-from facaid.grammar.procedure import Node, Size
+from facaid.grammar.nodes import Node, Size
 
 
 class Builder(GroundFloor):

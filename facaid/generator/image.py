@@ -8,7 +8,8 @@ import random
 from facaid.generator.canonical import canonical
 from facaid.generator.heuristics import Builder
 from facaid.generator.styles import Style
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
 
 
 def _scaled(node: Node, scale: float) -> Node:

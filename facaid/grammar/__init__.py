@@ -2,15 +2,8 @@
 
 from facaid.grammar.execute import execute, to_segmentation
 from facaid.grammar.layout import layout
-from facaid.grammar.procedure import (
-    GRAMMAR_VERSION,
-    Node,
-    Procedure,
-    ProcedureError,
-    Size,
-    parse_procedure,
-    validate,
-)
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import GRAMMAR_VERSION, Procedure, ProcedureError, parse_procedure, validate
 
 __all__ = [
     "GRAMMAR_VERSION",

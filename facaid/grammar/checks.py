@@ -15,7 +15,8 @@ from facaid.grammar.repeats import path_problem
 from facaid.numbers import finite
 
 if TYPE_CHECKING:
-    from facaid.grammar.procedure import Node, Procedure
+    from facaid.grammar.nodes import Node
+    from facaid.grammar.procedure import Procedure
 
 MODES = ("abs", "rel", "flt")
 TOO_COSTLY = (f"expands to more than {MAX_INSTANCES} node instances (each node once per copy of it, repeats and splits "

@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from facaid.grammar.guillotine import chunked_split, clean_cuts, cut_rects, least_crossed_cut, partition
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS
 from facaid.segmentation import Segmentation, decompose_grid
 

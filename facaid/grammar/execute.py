@@ -12,7 +12,8 @@ import numpy as np
 
 from facaid.grammar.layout import expand_over, layout
 from facaid.grammar.limits import MAX_COUNT
-from facaid.grammar.procedure import MAX_LEAVES, Node, Procedure, ProcedureError
+from facaid.grammar.nodes import Node
+from facaid.grammar.procedure import MAX_LEAVES, Procedure, ProcedureError
 from facaid.labels import BACKGROUND, LABEL_ID
 from facaid.native.rects import executed_rows
 from facaid.segmentation import Segmentation, flatten_array, rasterize

@@ -8,7 +8,7 @@ one floors split, and `structure` is what a tree looks like without its size val
 
 from __future__ import annotations
 
-from facaid.grammar.procedure import Node, Size
+from facaid.grammar.nodes import Node, Size
 
 SLOT_ROLES = ("floor", "ground")  # roles of a slot in the facade's layout, whatever node fills it
 

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from facaid.grammar.procedure import MAX_CHILDREN, Node, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import MAX_CHILDREN
 from facaid.labels import BACKGROUND
 from facaid.segmentation import Segmentation, compressed_grid, decompose_grid
 

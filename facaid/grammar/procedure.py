@@ -82,8 +82,8 @@ ROLES = (
 
 __all__ = [
     "AXES", "FORMAT", "FORMAT_VERSION", "GRAMMAR_VERSION", "MAX_CHILDREN", "MAX_COUNT", "MAX_DEPTH", "MAX_EXCEPTIONS",
-    "MAX_EXTENT", "MAX_INSTANCES", "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES", "Node",
-    "Override", "Procedure", "ProcedureError", "Size", "parse_procedure", "recount", "validate",
+    "MAX_EXTENT", "MAX_INSTANCES", "MAX_LEAVES", "MAX_META_CHARS", "MAX_NODES", "MODES", "RULES", "ROLES",
+    "Procedure", "ProcedureError", "parse_procedure", "recount", "validate",
 ]
 
 

@@ -3,7 +3,7 @@ and how many elements it draws."""
 
 from __future__ import annotations
 
-from facaid.grammar.procedure import Node
+from facaid.grammar.nodes import Node
 
 
 def leaf_paths(node: Node, path: tuple[int, ...] = ()) -> list[tuple[tuple[int, ...], Node]]:

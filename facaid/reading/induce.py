@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from facaid.grammar.guillotine import chunked_split, cut_rects, least_crossed_cut, partition
-from facaid.grammar.procedure import MAX_COUNT, Node, Procedure, ProcedureError, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import MAX_COUNT, Procedure, ProcedureError
 from facaid.labels import BACKGROUND, FACADE, LABELS
 from facaid.segmentation import Segmentation
 

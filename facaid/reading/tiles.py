@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from facaid.grammar.procedure import Node, Override, Size
+from facaid.grammar.nodes import Node, Override, Size
 from facaid.labels import LABEL_ID
 from facaid.reading.grid import Grid
 from facaid.reading.units import Delta, Deltas, Unit, exact_tree, medoid, resample

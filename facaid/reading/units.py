@@ -19,7 +19,8 @@ import numpy as np
 
 from facaid.grammar.decompose import tree_of_label_map
 from facaid.grammar.execute import execute
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
 from facaid.grammar.shapes import elements, leaf_paths, shape
 from facaid.labels import BACKGROUND, FACADE, LABEL_ID, LABELS
 from facaid.metrics import appears, near_edges

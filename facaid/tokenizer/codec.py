@@ -9,7 +9,8 @@ from collections import deque
 import numpy as np
 
 from facaid.grammar.execute import fill_counts
-from facaid.grammar.procedure import GRAMMAR_VERSION, Node, Procedure
+from facaid.grammar.nodes import Node
+from facaid.grammar.procedure import GRAMMAR_VERSION, Procedure
 from facaid.labels import LABELS
 from facaid.segmentation import Segmentation, flatten_array
 from facaid.tokenizer.features import MAX_PEERS, peer_counts, quantize_rel, quantize_size

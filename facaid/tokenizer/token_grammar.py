@@ -9,7 +9,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from facaid.grammar.layout import layout
-from facaid.grammar.procedure import MAX_CHILDREN, MAX_DEPTH, MAX_LEAVES, MAX_NODES, Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import MAX_CHILDREN, MAX_DEPTH, MAX_LEAVES, MAX_NODES, Procedure
 from facaid.tokenizer.features import dequantize_size
 from facaid.tokenizer.vocabulary import EOS, TokenError, Vocabulary
 

@@ -3,10 +3,12 @@
 import numpy as np
 from grammar_helpers import example, tile
 
-from facaid.editing.check import band_holds, band_lattice, check_edits, insertion, judge, judge_insert, label_map
+from facaid.editing.check import band_holds, band_lattice, check_edits, insertion, judge, judge_insert
 from facaid.editing.parameters import set_parameter
 from facaid.generator import generate_procedure
-from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.grammar.execute import label_map
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID
 
 
@@ -118,7 +120,7 @@ def test_a_floor_fewer_takes_a_floor_the_facade_keeps_a_twin_of():
     from grammar_helpers import facade
 
     from facaid.editing.floors import twins
-    from facaid.grammar.procedure import Node, Size
+    from facaid.grammar.nodes import Node, Size
 
     def row(window: str) -> Node:
         return Node.repeat("x", 5, [(Size("flt", 60), tile(window=window))], role="floor")
@@ -143,7 +145,7 @@ def test_a_floor_fewer_leaves_the_copy_that_alone_lays_out_the_floors_pattern():
     from facaid.editing.floors import plain_floor
     from facaid.editing.instances import Instances
     from facaid.editing.parameters import _floor_repeats, normalised
-    from facaid.grammar.procedure import Node, Size
+    from facaid.grammar.nodes import Node, Size
 
     def row(window: str) -> Node:
         out = Node.repeat("x", 5, [(Size("flt", 60), tile(window=window))], role="floor")

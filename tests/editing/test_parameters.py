@@ -11,7 +11,8 @@ from facaid.editing.parameters import NAMES, named_parameters, normalised, set_p
 from facaid.formats.cga import procedure_cga
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar.execute import execute, to_segmentation
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID
 from facaid.segmentation import rasterize
 

@@ -8,7 +8,8 @@ import pytest
 from facaid.editing.resizing import copy_lengths, copy_procedure, repeat_unit, resize
 from facaid.generator import generate_procedure
 from facaid.grammar.execute import execute
-from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID
 
 WINDOW = LABEL_ID["window"]

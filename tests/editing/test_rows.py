@@ -7,13 +7,14 @@ import numpy as np
 import pytest
 from grammar_helpers import leaf, tile
 
-from facaid.editing.check import check_edits, label_map
+from facaid.editing.check import check_edits
 from facaid.editing.parameters import named_parameters, set_parameter
 from facaid.editing.rows import unmirrored
 from facaid.evaluation.editability import generated_edits
 from facaid.generator import generate_procedure
-from facaid.grammar.execute import flat_rows
-from facaid.grammar.procedure import Node, Override, Procedure, Size, validate
+from facaid.grammar.execute import flat_rows, label_map
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure, validate
 from facaid.labels import LABEL_ID
 from facaid.segmentation import region_boxes
 

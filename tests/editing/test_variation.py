@@ -6,7 +6,8 @@ from hypothesis import strategies as st
 
 from facaid.cli import main
 from facaid.editing.parameters import named_parameters
-from facaid.editing.variation import change_count, resize, swap, vary, with_count, with_size
+from facaid.editing.resizing import resize
+from facaid.editing.variation import change_count, swap, vary, with_count, with_size
 from facaid.generator import STYLE_NAMES, generate_procedure
 from facaid.grammar import Procedure, ProcedureError, execute, validate
 from facaid.labels import LABEL_ID, LABELS
@@ -45,7 +46,8 @@ def test_resize_counts_the_copies_that_fit_beside_the_tail():
     pillar need 360 px (tiles 35 px) and three 280 px (tiles 60 px): four fit best. Counting the old region over the
     old count (100 px a bay, the tail shared out) gave three."""
     from facaid.grammar.execute import execute
-    from facaid.grammar.procedure import Node, Procedure, Size
+    from facaid.grammar.nodes import Node, Size
+    from facaid.grammar.procedure import Procedure
 
     bays = Node.repeat("x", 2, [(Size("abs", 40), Node.leaf("pillar")), (Size("flt", 1), Node.leaf("window"))],
                        tail=1)

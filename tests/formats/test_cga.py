@@ -10,7 +10,8 @@ from grammar_helpers import example, facade
 from facaid.formats.cga import LEAF_RULES, default_scale, procedure_cga
 from facaid.generator import generate
 from facaid.grammar.execute import execute
-from facaid.grammar.procedure import Node, Override, Procedure, Size
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure
 from facaid.labels import LABEL_ID, PALETTE
 
 COLOUR_LABEL = {"#{:02x}{:02x}{:02x}".format(*rgb): name for name, rgb in PALETTE.items()}

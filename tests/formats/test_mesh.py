@@ -92,7 +92,8 @@ def test_front_faces_paint_the_label_map(seed):
 
 
 def test_a_recess_has_reveals_facing_into_it_and_a_protrusion_sides_facing_out():
-    from facaid.grammar.procedure import Node, Procedure, Size
+    from facaid.grammar.nodes import Node, Size
+    from facaid.grammar.procedure import Procedure
 
     root = Node.split("x", [(Size("abs", 10), Node.leaf("facade")), (Size("abs", 10), Node.leaf("window")),
                             (Size("abs", 10), Node.leaf("cornice")), (Size("flt", 1), Node.leaf("facade"))])

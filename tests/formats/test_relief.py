@@ -10,7 +10,8 @@ from facaid.formats.annotation import as_annotated, element_array
 from facaid.formats.relief import DEPTHS, procedure_relief
 from facaid.generator import generate
 from facaid.grammar.execute import leaf_array, to_segmentation
-from facaid.grammar.procedure import Node, Procedure, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure
 from facaid.labels import FACADE, LABELS
 from facaid.segmentation import rasterize
 

@@ -8,7 +8,7 @@ from facaid.generator.dataset import sample_seed
 from facaid.grammar import Procedure, execute
 from facaid.grammar.execute import first_boxes, leaf_array
 from facaid.grammar.floors import merge_floor_runs, merge_repeated_floors, structure
-from facaid.grammar.procedure import Node, Size
+from facaid.grammar.nodes import Node, Size
 
 
 def wall(role=None):

@@ -18,7 +18,8 @@ from facaid.grammar.checks import least_units, least_units_of_json
 from facaid.grammar.execute import Trace, execute, first_boxes, flat_rows
 from facaid.grammar.layout import count_expansion, expand_over, layout
 from facaid.grammar.limits import MAX_INSTANCES
-from facaid.grammar.procedure import Node, Override, Procedure, ProcedureError, Size
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure, ProcedureError
 from facaid.grammar.repeats import expanded_count, pattern_child
 
 

@@ -17,14 +17,8 @@ from facaid.generator import generate_procedure
 from facaid.grammar.differentiable import compile_plan, execute_plan
 from facaid.grammar.execute import execute, first_boxes, flat_rows, leaf_array
 from facaid.grammar.layout import count_leaves
-from facaid.grammar.procedure import (
-    Node,
-    Override,
-    Procedure,
-    ProcedureError,
-    Size,
-    validate,
-)
+from facaid.grammar.nodes import Node, Override, Size
+from facaid.grammar.procedure import Procedure, ProcedureError, validate
 from facaid.grammar.repeats import copies_moved, most_typical, recount
 from facaid.labels import LABEL_ID
 from facaid.native import rects

@@ -8,7 +8,8 @@ import pytest
 from facaid.generator import generate_procedure
 from facaid.generator.dataset import sample_line, sample_record
 from facaid.grammar.execute import execute, flat_rows, leaf_array
-from facaid.grammar.procedure import Node, Procedure, ProcedureError, Size
+from facaid.grammar.nodes import Node, Size
+from facaid.grammar.procedure import Procedure, ProcedureError
 from facaid.native import rects
 from facaid.segmentation import flatten_array, flatten_array_numpy, rect_dicts, rects_json
 

@@ -80,7 +80,8 @@ def test_unexplained_counts_disagreement_away_from_the_inputs_edges():
 
 
 def test_reads_through_noise_keeps_a_compact_structure_that_restores_a_missed_window():
-    from facaid.grammar.procedure import Node, Procedure, Size
+    from facaid.grammar.nodes import Node, Size
+    from facaid.grammar.procedure import Procedure
     from facaid.pipeline import reads_through_noise
     from facaid.reading.induce import induce_procedure
 

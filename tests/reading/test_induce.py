@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from facaid.editing.variation import resize
+from facaid.editing.resizing import resize
 from facaid.generator import generate
 from facaid.grammar.decompose import procedure_from_segmentation
 from facaid.grammar.execute import to_segmentation
