@@ -28,12 +28,19 @@ export function patientImage(img, url, tries = 4) {
   img.src = url;
 }
 
-// The editor's calls to the site's API: JSON in and out, errors as messages that name the field.
+/** The pages' calls to the site's API, each with the CSRF token `csrf`: `api(path, options)` sends `options` as
+ * `fetch` would (a body not FormData is JSON), waiting out a busy server (`patientFetch`), and resolves with the JSON
+ * answer, or throws an error whose message names the fields. Two options of its own: `raw: true` resolves with the
+ * Response itself, whatever its status, for a caller that reads the status, the headers or a body not JSON;
+ * `tries` is patientFetch's (1: sent once, a busy answer returned as it is). */
 export function makeApi(csrf) {
   return async function api(path, options = {}) {
-    const json = options.body && !(options.body instanceof FormData);
-    const r = await patientFetch(path, {credentials: "same-origin", ...options,
-      headers: {"X-CSRFToken": csrf, ...(json ? {"Content-Type": "application/json"} : {}), ...(options.headers || {})}});
+    const {raw = false, tries = 4, ...init} = options;
+    const json = init.body && !(init.body instanceof FormData);
+    const r = await patientFetch(path, {credentials: "same-origin", ...init,
+      headers: {"X-CSRFToken": csrf, ...(json ? {"Content-Type": "application/json"} : {}), ...(init.headers || {})}},
+    tries);
+    if (raw) return r;
     const body = r.headers.get("Content-Type")?.includes("json") ? await r.json() : null;
     if (!r.ok) throw new Error(body ? Object.entries(body).map(([k, v]) => `${k}: ${v}`).join("; ") : r.statusText);
     return body;
