@@ -2,7 +2,7 @@
 // compared side by side (both pictures, the pixels whose label differs, both accuracies against the procedure's
 // segmentation), and, for the owner, revert: a new version equal to an old one, after which the page reloads.
 
-import {patientFetch, patientImage} from "../common/server.js";
+import {makeApi, patientImage} from "../common/server.js";
 
 const KINDS = {created: "created", edit: "edited", revert: "reverted", rerun: "re-run"};
 
@@ -17,7 +17,8 @@ function cell(...content) {
 }
 
 export function mountHistory({code, owner, csrf}) {
-  const api = `/api/v1/procedures/${code}/versions/`;
+  const api = makeApi(csrf);
+  const versions = `/api/v1/procedures/${code}/versions/`;
   const rows = document.querySelector("#history tbody");
   const status = document.getElementById("history-status");
   const picked = {a: null, b: null};
@@ -53,7 +54,7 @@ export function mountHistory({code, owner, csrf}) {
   }
 
   async function refresh() {
-    const r = await fetch(`${api}?limit=100`, {credentials: "same-origin"});
+    const r = await api(`${versions}?limit=100`, {raw: true, tries: 1});
     if (!r.ok) { status.textContent = "the history could not be read"; return []; }
     const {results} = await r.json();
     const known = new Set(results.map((v) => v.version));
@@ -67,7 +68,7 @@ export function mountHistory({code, owner, csrf}) {
 
   async function compare(a, b) {
     status.textContent = `comparing version ${a} with version ${b}…`;
-    const r = await patientFetch(`${api}compare?a=${a}&b=${b}`, {credentials: "same-origin"});
+    const r = await api(`${versions}compare?a=${a}&b=${b}`, {raw: true});
     const body = await r.json().catch(() => ({}));
     if (!r.ok) { status.textContent = `could not compare: ${JSON.stringify(body)}`; return; }
     const width = Math.max(body.a.width, body.b.width);
@@ -90,8 +91,7 @@ export function mountHistory({code, owner, csrf}) {
 
   async function revert(version) {
     status.textContent = `reverting to version ${version}…`;
-    const r = await fetch(`${api}${version}/revert`, {method: "POST", credentials: "same-origin",
-      headers: {"X-CSRFToken": csrf}});
+    const r = await api(`${versions}${version}/revert`, {method: "POST", raw: true, tries: 1});
     if (r.ok) { location.reload(); return; }
     const body = await r.json().catch(() => ({}));
     status.textContent = `not reverted: ${JSON.stringify(body)}`;

@@ -1,6 +1,7 @@
-// The procedure page's calls to the server: JSON sent with the CSRF token, patiently (../common/server.js), and the
-// server's picture of a tree, asked once more after the wait it names when rendering is throttled.
-import {busy, patientFetch} from "../common/server.js";
+// The procedure page's calls to the server, through the site's API helper (../common/server.js: JSON sent with the
+// CSRF token, patiently), and the server's picture of a tree, asked once more after the wait it names when
+// rendering is throttled.
+import {busy, makeApi} from "../common/server.js";
 
 export class Throttled extends Error {
   constructor(seconds) { super(`busy: trying again in ${seconds} s`); this.seconds = seconds; }
@@ -9,9 +10,11 @@ export class Throttled extends Error {
 /** The page's requests, each with the CSRF token `csrf`: `send` (JSON in, [response, JSON answer] out) and
  * `renderPatiently` (a tree's picture as an object URL). */
 export function pageRequests(csrf) {
+  const api = makeApi(csrf);
+
+  // sent once: a busy answer is thrown as Throttled, for the page to wait out as long as the server says
   async function render(data) {
-    const r = await fetch("/api/v1/render", {method: "POST", credentials: "same-origin",
-      headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
+    const r = await api("/api/v1/render", {method: "POST", body: JSON.stringify(data), raw: true, tries: 1});
     if (busy(r)) {  // throttled, or every heavy slot of the process taken
       throw new Throttled(Math.max(1, Number(r.headers.get("Retry-After")) || 1));
     }
@@ -32,8 +35,7 @@ export function pageRequests(csrf) {
   }
 
   async function send(url, method, data) {
-    const r = await patientFetch(url, {method, credentials: "same-origin",
-      headers: {"Content-Type": "application/json", "X-CSRFToken": csrf}, body: JSON.stringify(data)});
+    const r = await api(url, {method, body: JSON.stringify(data), raw: true});
     return [r, await r.json().catch(() => ({}))];
   }
 
