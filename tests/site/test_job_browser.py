@@ -6,7 +6,7 @@ from __future__ import annotations
 import shutil
 
 import pytest
-from site_helpers import collect_errors, login
+from site_helpers import collect_errors, login, screenshot
 
 from facaid.generator import generate
 from webapp.facades.models import Job, Procedure, Segmentation
@@ -15,7 +15,7 @@ pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
 
 
-def test_job_page_follows_the_stages_to_the_procedure(live_server, alice, facade_photo, browser):
+def test_job_page_follows_the_stages_to_the_procedure(live_server, alice, facade_photo, browser, tmp_path):
     _, seg = facade_photo
     segmentation = Segmentation.objects.get(photo__code=seg["photo"], version=seg["version"])
     job = Job.objects.create(owner=alice, segmentation=segmentation, status=Job.Status.RUNNING, progress=0.05,
@@ -25,6 +25,11 @@ def test_job_page_follows_the_stages_to_the_procedure(live_server, alice, facade
     login(page, live_server.url, "alice", "alice-password-1")
     page.goto(f"{live_server.url}/jobs/{job.code}")
     assert page.text_content("#stage") == "loading the model"
+    # the page's lines stack (the editor's job bar is a row of its own: its style is not the page's)
+    top = page.evaluate("[...document.querySelectorAll('#job > *')].map(e => e.getBoundingClientRect())"
+                        ".filter(r => r.height > 0).map(r => r.top)")
+    assert top == sorted(top) and len(set(top)) == len(top)
+    screenshot(page, "job-running.png", tmp_path)
     Job.objects.filter(id=job.id).update(progress=0.6, stage="sizing")
     page.wait_for_function("document.getElementById('stage').textContent === 'sizing'", timeout=10_000)
     assert page.evaluate("document.getElementById('progress').value") == pytest.approx(0.6)
