@@ -1,8 +1,8 @@
 """Site-wide guards that answer before a view runs or when the database cannot: a request body larger than any
 the site accepts is refused from its Content-Length (413) before a byte of it is read, and a database that is
 locked or unreachable is a 503 that says so instead of a 500. Both answer JSON under /api/ and the site's error page
-elsewhere (`webapp.errors`), drawn without the session or the database. Whatever is answered below the size limit,
-what the view left unread of the body is read first, so that the connection can carry the next request. And every
+elsewhere (`webapp.error_pages`), drawn without the session or the database. Whatever is answered below the size
+limit, what the view left unread of the body is read first, so that the connection can carry the next request. And every
 request has a work budget: the trees it reads and makes may lay out at most ``FACAID_REQUEST_WORK`` node instances
 in all and take ``FACAID_REQUEST_SECONDS`` of CPU (`facaid.grammar.budget`), past which it is a 400 that names the
 limit. A service's error that a page does not catch (a photo or procedure not found, or not the viewer's to change, a
@@ -17,9 +17,9 @@ from django.conf import settings
 from django.db import OperationalError
 
 from facaid.grammar.budget import WorkLimitError, work_budget
-from webapp.errors import error_response, service_status
+from webapp.error_pages import error_response, service_status
 from webapp.facades import throttling
-from webapp.facades.services.errors import ServiceError
+from webapp.facades.errors import ServiceError
 from webapp.facades.throttling import is_heavy
 
 log = logging.getLogger(__name__)
@@ -136,10 +136,10 @@ class WorkBudgetMiddleware:
 
 
 class ServiceErrorMiddleware:
-    """A service's error (`webapp.facades.services.errors`) that a page did not catch: the error page with the
-    status of its kind (`webapp.errors.service_status`) and its message (a 404 for an object the viewer may not see,
+    """A service's error (`webapp.facades.errors`) that a page did not catch: the error page with the status of
+    its kind (`webapp.error_pages.service_status`) and its message (a 404 for an object the viewer may not see,
     a 403 for one they may not change, a 400 for a write past the storage quota). The API answers them itself
-    (`webapp.facades.api.errors`), in its JSON."""
+    (`webapp.facades.api.exception_handler`), in its JSON."""
 
     def __init__(self, get_response):
         self.get_response = get_response

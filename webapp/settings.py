@@ -46,7 +46,7 @@ SECURE_CONTENT_TYPE_NOSNIFF = True
 SECURE_REFERRER_POLICY = "same-origin"
 SECURE_CROSS_ORIGIN_OPENER_POLICY = "same-origin"
 X_FRAME_OPTIONS = "DENY"
-CSRF_FAILURE_VIEW = "webapp.errors.csrf_failure"  # the site's 403 page, saying to reload the form
+CSRF_FAILURE_VIEW = "webapp.error_pages.csrf_failure"  # the site's 403 page, saying to reload the form
 # proxies in front of the site that append the client's address to X-Forwarded-For: the address that the login
 # lockouts and the API's anonymous throttle count is the one the outermost of them saw (0: REMOTE_ADDR, and a
 # client's own X-Forwarded-For is ignored)
@@ -208,7 +208,7 @@ REST_FRAMEWORK = {
     "DEFAULT_SCHEMA_CLASS": "drf_spectacular.openapi.AutoSchema",
     "DEFAULT_PAGINATION_CLASS": "webapp.facades.paging.Pagination",
     # the services' errors (not found, not allowed, invalid input, ...) as their statuses, in the API's JSON
-    "EXCEPTION_HANDLER": "webapp.facades.api.errors.exception_handler",
+    "EXCEPTION_HANDLER": "webapp.facades.api.exception_handler.exception_handler",
     "PAGE_SIZE": 24,  # (webapp.facades.paging.Pagination: at most 100)
 }
 SPECTACULAR_SETTINGS = {

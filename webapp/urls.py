@@ -24,11 +24,11 @@ urlpatterns = [
     path("", include("webapp.facades.urls")),
 ]
 
-# the site's error pages, and JSON under /api/ (webapp/errors.py)
-handler400 = "webapp.errors.bad_request"
-handler403 = "webapp.errors.permission_denied"
-handler404 = "webapp.errors.page_not_found"
-handler500 = "webapp.errors.server_error"
+# the site's error pages, and JSON under /api/ (webapp/error_pages.py)
+handler400 = "webapp.error_pages.bad_request"
+handler403 = "webapp.error_pages.permission_denied"
+handler404 = "webapp.error_pages.page_not_found"
+handler500 = "webapp.error_pages.server_error"
 
 if settings.DEBUG:
     from django.conf.urls.static import static

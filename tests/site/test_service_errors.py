@@ -1,4 +1,4 @@
-"""The services' errors (`webapp.facades.services.errors`) as the API answers them and the pages show them: each kind
+"""The services' errors (`webapp.facades.errors`) as the API answers them and the pages show them: each kind
 its status with the API's JSON (``{"<field>": …}`` for input at fault, else ``{"detail": …}``), through the real API;
 on a page, the message beside the form that sent the input, else the site's error page. Alice owns, bob is another
 user, charlie is anonymous."""
@@ -11,11 +11,11 @@ import pytest
 from site_helpers import image_bytes, upload
 
 from facaid.generator import generate
-from webapp.errors import SERVICE_STATUS, service_status
-from webapp.facades.api.errors import exception_handler
+from webapp.error_pages import SERVICE_STATUS, service_status
+from webapp.facades.api.exception_handler import exception_handler
+from webapp.facades.errors import Invalid, NotAllowed, NotFound, QuotaError, ServiceError, TooManyJobs
 from webapp.facades.jsonbody import JSONError
 from webapp.facades.models import Job, Photo
-from webapp.facades.services.errors import Invalid, NotAllowed, NotFound, QuotaError, ServiceError, TooManyJobs
 from webapp.facades.uploads import UploadError
 
 pytestmark = pytest.mark.django_db

@@ -6,8 +6,8 @@ from __future__ import annotations
 from django.core.exceptions import ValidationError
 from django.db.models import Q, QuerySet
 
+from webapp.facades.errors import NotAllowed, NotFound
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
-from webapp.facades.services.errors import NotAllowed, NotFound
 
 READABLE = (Visibility.PUBLIC, Visibility.UNLISTED)  # by link; only public ones are listed
 # large JSON columns that lists and job statuses never show: not read at all (they were most of a gallery page's time)

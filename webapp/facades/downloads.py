@@ -23,9 +23,9 @@ from facaid.grammar.budget import charge
 from facaid.grammar.layout import count_leaves
 from facaid.photo.files import read_photo
 from webapp.facades import access, disclosure, drawing
+from webapp.facades.errors import Invalid
 from webapp.facades.models import Procedure
 from webapp.facades.parsing import parse_procedure
-from webapp.facades.services.errors import Invalid
 
 Params = Mapping[str, str]
 # (the procedure, its tree, the request's parameters, the viewer) -> the file: what is in it may depend on who asks

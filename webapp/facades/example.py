@@ -15,9 +15,9 @@ from facaid.grammar.budget import WorkLimitError, work_budget
 from facaid.grammar.procedure import ProcedureError
 from webapp.facades.access import DEMO_USERNAME
 from webapp.facades.drawing import label_map_png
+from webapp.facades.errors import Invalid
 from webapp.facades.models import Procedure, Visibility
 from webapp.facades.parsing import parse_procedure
-from webapp.facades.services.errors import Invalid
 
 DEMO_PASSWORD = "demo-facade"
 VARIANTS = 3

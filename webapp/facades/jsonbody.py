@@ -18,7 +18,7 @@ from rest_framework.exceptions import ParseError
 from rest_framework.utils import json as drf_json
 
 from facaid.grammar.procedure import MAX_DEPTH as GRAMMAR_MAX_DEPTH
-from webapp.facades.services.errors import Invalid
+from webapp.facades.errors import Invalid
 
 # A procedure's node at grammar depth d lies 3 + 2d containers deep in a request ({"data": {"root": {"children":
 # [...]}}}) and its sizes' pairs 2 deeper; the grammar allows d <= 32 (facaid.grammar.procedure.MAX_DEPTH)

@@ -17,8 +17,8 @@ from django.urls import reverse
 from django.utils import timezone
 
 from webapp.facades import editcheck
+from webapp.facades.errors import QuotaError
 from webapp.facades.fields import CompressedJSONField, pack
-from webapp.facades.services.errors import QuotaError
 
 
 class Visibility(models.TextChoices):

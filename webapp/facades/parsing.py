@@ -8,7 +8,7 @@ from facaid.grammar import Procedure as ProcedureTree
 from facaid.grammar.procedure import ProcedureError
 from facaid.grammar.procedure import parse_procedure as parse_tree
 from facaid.segmentation import Segmentation as SegmentationData
-from webapp.facades.services.errors import Invalid
+from webapp.facades.errors import Invalid
 
 
 def parse_segmentation(data) -> SegmentationData:

@@ -16,7 +16,7 @@ from rest_framework.permissions import SAFE_METHODS
 from rest_framework.settings import api_settings
 from rest_framework.throttling import UserRateThrottle
 
-from webapp.errors import error_response
+from webapp.error_pages import error_response
 
 
 class HeavyRateThrottle(UserRateThrottle):

@@ -22,7 +22,7 @@ from PIL import Image, ImageMode, UnidentifiedImageError
 
 from facaid.photo import metadata, webp
 from facaid.photo.files import TRANSPOSE, orientation, read_photo
-from webapp.facades.services.errors import Invalid
+from webapp.facades.errors import Invalid
 
 FORMATS = {"JPEG": "jpg", "PNG": "png", "WEBP": "webp"}
 MIN_SIDE = 16  # pixels: smaller is no photo of a facade (a newcomer's 4 x 4 test image was taken)

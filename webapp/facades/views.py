@@ -20,6 +20,7 @@ from facaid.grammar import ProcedureError
 from facaid.grammar.budget import WorkLimitError
 from webapp.facades import access, disclosure, example, jsonbody, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
+from webapp.facades.errors import Invalid, QuotaError, TooManyJobs
 from webapp.facades.forms import (
     PhotoForm,
     ProcedureVisibilityForm,
@@ -33,7 +34,6 @@ from webapp.facades.models import REAL_SIZE_M, Job, Photo, Procedure
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers.photos import PhotoSerializer
 from webapp.facades.services import jobs, photos, procedures, segmentations, sharing
-from webapp.facades.services.errors import Invalid, QuotaError, TooManyJobs
 
 INTERCHANGE_FORMATS = (("segmentation", "our JSON"), ("coco", "COCO"), ("labelme", "LabelMe"), ("cvat", "CVAT XML"))
 

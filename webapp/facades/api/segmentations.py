@@ -26,13 +26,13 @@ from webapp.facades.api.common import (
     file_format_param,
     page,
 )
+from webapp.facades.errors import Invalid
 from webapp.facades.jsonbody import JSONParser
 from webapp.facades.serializers.segmentations import (
     ConvertSerializer,
     SegmentationSerializer,
     SegmentationSummarySerializer,
 )
-from webapp.facades.services.errors import Invalid
 from webapp.facades.services.segmentations import (
     add_segmentation,
     draft_of,

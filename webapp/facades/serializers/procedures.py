@@ -8,11 +8,11 @@ from rest_framework import serializers
 
 from facaid.formats.cga import MAX_SCALE
 from webapp.facades import access, disclosure
+from webapp.facades.errors import Invalid
 from webapp.facades.models import Procedure, Visibility
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers.base import NumberField, StrictBooleanField, WholeNumberField, title_field, viewer
 from webapp.facades.services import sharing
-from webapp.facades.services.errors import Invalid
 
 
 def procedure_data(value) -> dict:

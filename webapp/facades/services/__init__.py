@@ -10,7 +10,9 @@ use):
 - `versions`: a procedure's trees saved and re-measured, edited, reverted, compared, saved as a new procedure;
 - `sharing`: a procedure and its photo shared, and what viewers see of them;
 - `gallery`: the public gallery's pages, cached while no procedure changes;
-- `files`: what they share of the stored files;
-- `errors`: what they raise, in the site's own words (`Invalid`, `NotFound`, `NotAllowed`, `TooManyJobs`,
-  `QuotaError`), which the API answers with their statuses (`webapp.facades.api.errors`) and the pages show.
+- `files`: what they share of the stored files.
+
+What they raise is in the site's own words (`webapp.facades.errors`: `Invalid`, `NotFound`, `NotAllowed`,
+`TooManyJobs`, `QuotaError`), which the API answers with their statuses (`webapp.facades.api.exception_handler`) and
+the pages show.
 """

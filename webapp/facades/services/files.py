@@ -7,7 +7,7 @@ from contextlib import contextmanager
 
 from PIL import Image
 
-from webapp.facades.services.errors import Invalid
+from webapp.facades.errors import Invalid
 
 
 @contextmanager

@@ -16,8 +16,8 @@ from django.utils import timezone
 from facaid.defaults import DEFAULT_K
 from webapp.env import env_int
 from webapp.facades import queue
+from webapp.facades.errors import TooManyJobs
 from webapp.facades.models import Job, Procedure, Segmentation, check_quota
-from webapp.facades.services.errors import TooManyJobs
 
 log = logging.getLogger(__name__)
 

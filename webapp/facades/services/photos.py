@@ -12,8 +12,8 @@ from django.core.files.base import ContentFile
 from facaid.photo.corners import propose_corners_file
 from facaid.photo.rectify import rectify_file
 from webapp.facades import access
+from webapp.facades.errors import Invalid
 from webapp.facades.models import Photo, Visibility, check_quota
-from webapp.facades.services.errors import Invalid
 from webapp.facades.services.files import file_size, readable
 from webapp.facades.services.segmentations import drop_draft
 from webapp.facades.uploads import normalize_photo

@@ -8,8 +8,8 @@ from collections.abc import Callable
 
 from facaid.defaults import DEFAULT_K
 from webapp.facades import access
+from webapp.facades.errors import Invalid
 from webapp.facades.models import Change, Job, Procedure, ProcedureVersion
-from webapp.facades.services.errors import Invalid
 from webapp.facades.services.jobs import submit_job
 
 

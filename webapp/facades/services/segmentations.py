@@ -14,9 +14,9 @@ from facaid.defaults import DEFAULT_MIN_COPY, DEFAULT_MIN_SCORE
 from facaid.formats import interchange
 from facaid.photo import appearance
 from facaid.segmentation import Segmentation as SegmentationData
+from webapp.facades.errors import Invalid, NotFound
 from webapp.facades.models import Draft, Photo, Segmentation, check_quota, json_size
 from webapp.facades.parsing import parse_segmentation
-from webapp.facades.services.errors import Invalid, NotFound
 from webapp.facades.services.files import readable
 
 

@@ -11,8 +11,8 @@ import copy
 from django.db import transaction
 
 from webapp.facades import access
+from webapp.facades.errors import Invalid
 from webapp.facades.models import Procedure, Visibility
-from webapp.facades.services.errors import Invalid
 
 REACH = {Visibility.PRIVATE: 0, Visibility.UNLISTED: 1, Visibility.PUBLIC: 2}
 # what a procedure shared without its photo still tells of it (`disclosure`): the sharing question says so plainly

@@ -12,10 +12,10 @@ from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
 from webapp.facades import access, drawing, editcheck
+from webapp.facades.errors import Invalid, NotFound
 from webapp.facades.models import Change, Procedure, ProcedureVersion, tree_digest
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.services import sharing
-from webapp.facades.services.errors import Invalid, NotFound
 from webapp.facades.services.procedures import fork_procedure
 
 # figures of the job that made a tree (its timings, the decoded candidate's accuracy, how it searched): true of that

@@ -1,5 +1,5 @@
-"""The API's answers to the services' errors (`webapp.facades.services.errors`), REST_FRAMEWORK's
-``EXCEPTION_HANDLER``: each kind its status (`webapp.errors.service_status`), in the JSON the API gives every error,
+"""The API's answers to the services' errors (`webapp.facades.errors`), REST_FRAMEWORK's ``EXCEPTION_HANDLER``:
+each kind its status (`webapp.error_pages.service_status`), in the JSON the API gives every error,
 ``{"<field>": "<message>"}`` where input is at fault (as DRF's `ValidationError` of a field) and
 ``{"detail": "<message>"}`` otherwise; what the request wrote is rolled back. Any other exception is DRF's."""
 
@@ -9,8 +9,8 @@ from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 from rest_framework.views import set_rollback
 
-from webapp.errors import service_status
-from webapp.facades.services.errors import ServiceError
+from webapp.error_pages import service_status
+from webapp.facades.errors import ServiceError
 
 
 def body(exc: ServiceError) -> dict:

@@ -23,7 +23,7 @@ TEXTS = {
     404: "There is nothing here, or it is not shared with you.",
     500: "Something went wrong on our side. It has been logged; try again in a moment.",
 }
-# the services' errors (`webapp.facades.services.errors`) by kind, as the API answers them and the pages show them
+# the services' errors (`webapp.facades.errors`) by kind, as the API answers them and the pages show them
 SERVICE_STATUS = {"invalid": 400, "over_quota": 400, "not_found": 404, "not_allowed": 403, "too_many_jobs": 429}
 # the page's last resort: what is answered if even the template fails
 BARE_PAGE = ("<!doctype html><html lang=\"en\"><meta charset=\"utf-8\"><title>{title} · FaçAID</title>"

@@ -1,7 +1,8 @@
-"""The services' errors, in the site's own words rather than HTTP's: each has a ``kind`` (what went wrong) and a
-message for a person; `Invalid` also names the ``field`` of the input at fault. The JSON API answers each kind with
-its status (`webapp.errors.service_status`, `webapp.facades.api.errors`); the pages say the message where they
-ask for the input, and show the site's error page for the rest (`webapp.middleware.ServiceErrorMiddleware`).
+"""The site's errors, in its own words rather than HTTP's: what the services raise, and the layers below them
+(the models, access, parsing, uploads) too. Each has a ``kind`` (what went wrong) and a message for a person;
+`Invalid` also names the ``field`` of the input at fault. The JSON API answers each kind with its status
+(`webapp.error_pages.service_status`, `webapp.facades.api.exception_handler`); the pages say the message where
+they ask for the input, and show the site's error page for the rest (`webapp.middleware.ServiceErrorMiddleware`).
 
 Others of the site's errors are of these kinds too: a refused upload (`webapp.facades.uploads.UploadError`) and
 malformed JSON pasted in a page (`webapp.facades.jsonbody.JSONError`) are `Invalid`."""
