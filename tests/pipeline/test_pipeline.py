@@ -121,20 +121,6 @@ def test_progress_hears_each_stage_in_order(tiny):
     assert [s for _, s in heard] == ["decoding 1 candidate", "sizing"]
 
 
-def test_worker_reports_loading_then_the_pipeline_s_stages(tiny, tmp_path):
-    from worker.compute import reconstruct as job
-
-    model, tok = tiny
-    save_model(model, tok, tmp_path / "ckpt")
-    heard = []
-    out = job(generate(6).segmentation.to_dict(), str(tmp_path / "ckpt"), k=2,
-              progress=lambda f, stage: heard.append((round(f, 6), stage)))
-    assert heard[0] == (0.05, "loading the model") and heard[1] == (0.2, "decoding up to 2 candidates")
-    assert heard[2] == (0.6, "sizing") and heard[-1] == (1.0, "done")
-    assert [f for f, _ in heard] == sorted(f for f, _ in heard)
-    Procedure.from_dict(out["procedure"])
-
-
 def test_bad_real_input_gets_a_procedure_or_a_clear_error():
     """Issue 42's bad inputs: an empty annotation, one without a facade rectangle, boxes all over each other, and
     20,000 rectangles: a procedure that reproduces the input, or an error that names the limit."""
