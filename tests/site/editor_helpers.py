@@ -79,6 +79,16 @@ def selected(page) -> list[dict]:
     return page.evaluate(f"[...{E}.ui.selection].map(id => {E}.seg.get(id))")
 
 
+def select_window(page, x: int, y: int, shift: bool = False) -> None:
+    """With the select tool, click inside the window whose top-left corner is image point (x, y); with ``shift``,
+    add it to the selection."""
+    page.keyboard.press("v")
+    if shift:
+        page.keyboard.down("Shift")
+    page.mouse.click(*screen(page, x + 10, y + 10))
+    if shift:
+        page.keyboard.up("Shift")
+
 def drag(page, start, end, steps=6) -> None:
     """Press at image point `start`, move to `end` and release."""
     page.mouse.move(*screen(page, *start))

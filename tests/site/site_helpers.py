@@ -11,12 +11,19 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from PIL import Image
 from rest_framework.test import APIClient
 
+from facaid.editing.variation import vary
 from facaid.formats.render import render_segmentation
 from facaid.generator import generate
+from facaid.grammar import Procedure as Tree
+from facaid.grammar.procedure import GRAMMAR_VERSION
+
+if TYPE_CHECKING:
+    from webapp.facades.models import Procedure
 
 
 def client_for(user=None) -> APIClient:
@@ -59,6 +66,19 @@ def upload(client, data: bytes, name: str = "photo.png", **fields):
     from django.core.files.uploadedfile import SimpleUploadedFile
 
     return client.post("/api/v1/photos/", {"image": SimpleUploadedFile(name, data), **fields}, format="multipart")
+
+
+def wall(width, height) -> dict:
+    """A procedure's JSON of a bare wall, ``width`` x ``height`` pixels."""
+    return {"format": "facaid-procedure", "version": 1, "grammar": GRAMMAR_VERSION, "width": width,
+            "height": height, "root": {"rule": "leaf", "label": "facade"}}
+
+
+def stored_counts() -> tuple[int, ...]:
+    """How many photos, segmentations, procedures and jobs are stored: what a refused request must leave as it was."""
+    from webapp.facades.models import Job, Photo, Procedure, Segmentation
+
+    return tuple(m.objects.count() for m in (Photo, Segmentation, Procedure, Job))
 
 
 # --- a real Redis server and real worker processes ----------------------------------------------------------------
@@ -213,3 +233,56 @@ def screenshot(target, name: str, tmp_path) -> str:
     path = os.path.join(os.environ.get("FACAID_SCREENSHOT_DIR") or str(tmp_path), name)
     target.screenshot(path=path)
     return path
+
+
+# --- the procedure page and its versions ------------------------------------------------------------------------------
+
+def open_as_alice(browser, live_server, proc: Procedure, viewport: dict, advanced: bool = True):
+    """Alice's browser on the procedure's page (with its raw tree opened, unless not ``advanced``), and the list its
+    script errors are gathered in."""
+    page = browser.new_page(viewport=viewport)
+    errors = collect_errors(page, [])  # script errors, and what the page's CSP refused
+    login(page, live_server.url, "alice", "alice-password-1")
+    page.goto(f"{live_server.url}/procedures/{proc.code}")
+    if advanced:
+        page.click("#advanced summary")
+    return page, errors
+
+
+def counted_repeats(node: dict) -> list[dict]:
+    """The repeats of a procedure's JSON tree that have a count (not ``fill``), depth first, in the tree's order."""
+    out = [node] if node["rule"] == "repeat" and node["count"] != "fill" else []
+    for child in node.get("children", []):
+        out += counted_repeats(child)
+    return out
+
+
+def faithful_procedure(alice, seg: dict, title: str = "Generated facade", **fields) -> Procedure:
+    """Alice's procedure of the generated facade her photo shows (``seg``: its segmentation, the API's JSON), with
+    the photo: its own true tree, at pixel accuracy 1 unless ``fields`` say otherwise."""
+    from webapp.facades.models import Procedure, Segmentation
+
+    segmentation = Segmentation.objects.get(code=seg["code"])
+    fields.setdefault("accuracy", 1.0)
+    return Procedure.objects.create(owner=alice, title=title, data=generate(3).procedure.to_dict(),
+                                    segmentation=segmentation, photo=segmentation.photo, **fields)
+
+
+def same_size_variant(data: dict, kind: str = "swap") -> dict:
+    """A variation of the procedure's JSON tree ``data`` of the ``kind`` asked for, of the same size."""
+    for v in vary(Tree.from_dict(data), 8, 0):
+        if v.meta["variation"] == kind and (v.width, v.height) == (data["width"], data["height"]):
+            return v.to_dict()
+    raise AssertionError(f"no {kind} variation of the facade's size")
+
+
+def procedure_url(proc, rest: str = "") -> str:
+    """The API's address of a procedure, or of ``rest`` under it."""
+    return f"/api/v1/procedures/{proc.code}/{rest}"
+
+
+def version_history(client, proc) -> list[dict]:
+    """The procedure's versions as ``client`` reads them, the newest first."""
+    r = client.get(procedure_url(proc, "versions/"))
+    assert r.status_code == 200, r.content
+    return r.json()["results"]

@@ -1,9 +1,9 @@
 """The procedure page in Debian's Chromium through Playwright: the parameter tree shows rounded values without
 changing the stored ones, an edit re-renders at once and saves as a new version, variations come back as eight
-cards, a facade width in metres scales the CGA rules and the mesh, the history lists the versions, compares two
-side by side and reverts, a re-run that fits worse is shown beside the version it continued. (The
-procedure beside its overlay on a photo is checked in `test_editor_end_to_end.py`, which makes a photo's
-procedure through the worker.)"""
+cards, a facade width in metres scales the CGA rules and the mesh, the named parameters come first and the picture
+and the tree select each other. (The history is checked in `test_procedure_history_browser.py`, sharing and the
+overlay in `test_procedure_sharing_browser.py`; the procedure beside its overlay on a photo in
+`test_editor_end_to_end.py`, which makes a photo's procedure through the worker.)"""
 
 from __future__ import annotations
 
@@ -13,35 +13,14 @@ import shutil
 
 import pytest
 from grammar_helpers import probe
-from site_helpers import collect_errors, login
+from site_helpers import counted_repeats, open_as_alice
 
-from facaid.editing.variation import vary
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
 from webapp.facades.models import Procedure, Segmentation
-from webapp.facades.services import versions
 
 pytestmark = [pytest.mark.django_db(transaction=True),
               pytest.mark.skipif(shutil.which("chromium") is None, reason="needs Debian's chromium")]
-
-
-def open_as_alice(browser, live_server, proc: Procedure, viewport: dict, advanced: bool = True):
-    """Alice's browser on the procedure's page (with its raw tree opened, unless not ``advanced``), and the list its
-    script errors are gathered in."""
-    page = browser.new_page(viewport=viewport)
-    errors = collect_errors(page, [])  # script errors, and what the page's CSP refused
-    login(page, live_server.url, "alice", "alice-password-1")
-    page.goto(f"{live_server.url}/procedures/{proc.code}")
-    if advanced:
-        page.click("#advanced summary")
-    return page, errors
-
-
-def _repeats(node: dict) -> list[dict]:
-    out = [node] if node["rule"] == "repeat" and node["count"] != "fill" else []
-    for child in node.get("children", []):
-        out += _repeats(child)
-    return out
 
 
 def _sizes(node: dict) -> list[float]:
@@ -58,7 +37,7 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     assert any("." in v for v in shown)
 
     # the first repeat's count, one more: the render is replaced at once, and saving stores it
-    first = _repeats(data["root"])[0]
+    first = counted_repeats(data["root"])[0]
     count = page.locator("#tree li > input").first  # a count sits in its node's item, a size in a span
     assert count.input_value() == str(first["count"])
     count.fill(str(first["count"] + 1))
@@ -67,7 +46,7 @@ def test_edit_a_count_render_and_save_then_vary(live_server, alice, browser):
     page.click("#save")
     page.wait_for_function("document.getElementById('saved').textContent === 'saved as version 2'")
     stored = Procedure.objects.get(pk=proc.pk).data
-    assert _repeats(stored["root"])[0]["count"] == first["count"] + 1
+    assert counted_repeats(stored["root"])[0]["count"] == first["count"] + 1
     assert _sizes(stored["root"]) == _sizes(data["root"])  # the rounded display did not round the values
 
     page.click("#vary")
@@ -136,6 +115,7 @@ def test_variations_within_ranges_of_named_parameters(live_server, alice, browse
     assert "floors: the range 0-7 leaves 1-256" in page.text_content("#vary-status")
     assert not errors
 
+
 def test_nodes_are_numbered_breadth_first_and_a_click_picks_the_re_run_prefix(live_server, alice, facade_photo,
                                                                                browser):
     _, seg = facade_photo
@@ -154,86 +134,6 @@ def test_nodes_are_numbered_breadth_first_and_a_click_picks_the_re_run_prefix(li
         assert by_index[k] == (node.label if node.is_leaf else f"{node.rule}_{node.axis}")
     page.click('#tree .bfs >> text="#5"')
     assert page.input_value("#id_nodes") == "6"
-
-
-def _faithful(alice, seg: dict) -> Procedure:
-    segmentation = Segmentation.objects.get(photo__code=seg["photo"], version=seg["version"])
-    return Procedure.objects.create(owner=alice, title="Generated facade", data=generate(3).procedure.to_dict(),
-                                    accuracy=1.0, segmentation=segmentation, photo=segmentation.photo)
-
-
-def _pictures_loaded(page) -> None:
-    page.wait_for_function("['compare-a', 'compare-b', 'compare-diff'].every(id => "
-                           "{ const i = document.getElementById(id); return i.complete && i.naturalWidth > 0; })")
-
-
-def test_history_lists_versions_compares_two_and_reverts(live_server, alice, facade_photo, browser, tmp_path):
-    _, seg = facade_photo
-    proc = _faithful(alice, seg)
-    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900})
-    page.wait_for_selector("#history tbody tr")
-    assert page.locator("#history tbody tr").count() == 1 and page.text_content("#version") == "1"
-
-    # an edit saved: version 2, its own accuracy shown at once (the server's), both versions listed
-    first = _repeats(proc.data["root"])[0]
-    page.locator("#tree li > input").first.fill(str(first["count"] + 1))
-    page.wait_for_function("document.getElementById('render').src.startsWith('blob:')")
-    page.click("#save")
-    page.wait_for_function("document.getElementById('saved').textContent === 'saved as version 2'")
-    page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 2")
-    saved = Procedure.objects.get(pk=proc.pk)
-    assert saved.accuracy < 1.0 and page.text_content("#version") == "2"
-    assert page.text_content("#figure").strip() == f"· pixel accuracy {100 * saved.accuracy:.2f} %"
-    assert page.text_content("#history tbody tr.current").count(f"{100 * saved.accuracy:.2f} %") == 1
-
-    # compare: by default the current version (B) against the one before (A)
-    page.click("#compare")
-    page.wait_for_selector("#comparison:not([hidden])")
-    _pictures_loaded(page)
-    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 100.00 %"
-    assert page.text_content("#compare-b-caption") == f"B: version 2 · pixel accuracy {100 * saved.accuracy:.2f} %"
-    assert "% of the pixels: their label differs" in page.text_content("#compare-diff-caption")
-    page.locator("#history-panel").scroll_into_view_if_needed()
-    path = os.environ.get("FACAID_HISTORY_SCREENSHOT") or str(tmp_path / "procedure-history.png")
-    page.locator("#history-panel").screenshot(path=path)
-
-    # revert to version 1: a third version equal to it, the page shows its figures
-    page.click("#history button[data-revert='1']")
-    page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
-    assert page.text_content("#version") == "3" and "100.00 %" in page.text_content("#figure")
-    assert "reverted to version 1" in page.text_content("#history tbody tr.current")
-    assert Procedure.objects.get(pk=proc.pk).data == proc.data
-    assert errors == []
-
-    # someone who may see the procedure reads its history, with no revert
-    Procedure.objects.filter(pk=proc.pk).update(visibility="public")
-    other = browser.new_page()
-    other.goto(f"{live_server.url}/procedures/{proc.code}")
-    other.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
-    assert other.locator("#history button[data-revert]").count() == 0 and other.locator("#save").count() == 0
-
-
-def test_a_re_run_that_fits_worse_is_shown_beside_the_version_it_continued(live_server, alice, facade_photo, browser,
-                                                                          tmp_path):
-    _, seg = facade_photo
-    proc = _faithful(alice, seg)
-    tree = Tree.from_dict(proc.data)
-    worse = next(v for v in vary(tree, 8, 0) if v.meta["variation"] == "swap" and (v.width, v.height) == (
-        tree.width, tree.height)).to_dict()
-    versions.add_rerun(proc, worse, 0.75, {"source": "model"}, based_on=1, nodes=3)  # as the worker stores one
-    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 1100})
-    assert "fits worse than version 1: pixel accuracy 75.00 % against 100.00 %" in page.text_content("#rerun-warning")
-    page.wait_for_selector("#comparison:not([hidden])")  # opened by itself
-    _pictures_loaded(page)
-    assert page.text_content("#compare-a-caption") == "A: version 1 · pixel accuracy 100.00 %"
-    assert page.text_content("#compare-b-caption") == "B: version 2 · pixel accuracy 75.00 %"
-    assert "worse" in page.get_attribute("#history tbody tr.current td:nth-child(5)", "class")
-    path = os.environ.get("FACAID_RERUN_SCREENSHOT") or str(tmp_path / "procedure-rerun-warning.png")
-    page.screenshot(path=path, full_page=True)
-    page.click("#rerun-warning button[data-revert='1']")
-    page.wait_for_function("document.querySelectorAll('#history tbody tr').length === 3")
-    assert page.locator("#rerun-warning").count() == 0 and page.text_content("#version") == "3"
-    assert errors == []
 
 
 def test_named_parameters_first_the_tree_in_advanced(live_server, alice, browser, tmp_path):
@@ -378,66 +278,6 @@ def test_floors_plus_one_on_a_real_like_facade_adds_a_row_of_windows(live_server
     listed = page.eval_on_selector_all("#tree .exception", "els => els.map(e => e.parentElement.textContent)")
     assert any("exception: copy " in text and "blind" in text for text in listed), listed
     assert not errors
-
-
-def test_sharing_asks_whether_to_share_the_photo_and_the_overlay_follows(live_server, alice, facade_photo, browser,
-                                                                        tmp_path):
-    from site_helpers import screenshot
-
-    _, seg = facade_photo
-    proc = _faithful(alice, seg)  # alice's photo and procedure, both private
-    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 800}, advanced=False)
-    assert page.text_content("#viewers-see") == "Only you see this procedure."
-    assert not page.is_visible("#share-photo")  # nothing to ask while it stays private
-    page.select_option("#visibility-form select", "public")
-    assert page.is_visible("#share-photo") and "the photo is private; either way the procedure itself redraws" in (
-        page.text_content("#share-photo"))
-    assert page.text_content("#viewers-will-see") == (
-        "Once saved: Anyone sees the procedure, its pictures and 3D models, but not the photo or the overlay: the "
-        "photo is private. The procedure itself redraws the annotation (an exact version reproduces it as drawn) "
-        "at its size in metres; the photo's title and the accuracy against it are not shown.")
-    page.check("#share-photo input")
-    assert page.text_content("#viewers-will-see") == (
-        "Once saved: Anyone sees the procedure with its photo and the overlay.")
-    page.uncheck("#share-photo input")
-    form = page.locator("#visibility-form").locator("xpath=ancestor::div[contains(@class, 'panel')]")
-    form.scroll_into_view_if_needed()
-    screenshot(form, "share-photo.png", tmp_path)
-    page.click("#visibility-form button")  # public, the photo left private: the page says what viewers see
-    page.wait_for_selector(".msg")
-    assert "the photo is private. The procedure itself redraws the annotation" in page.text_content("#viewers-see")
-    anonymous = browser.new_page()
-    anonymous.goto(f"{live_server.url}/procedures/{proc.code}")
-    assert anonymous.locator("#overlay").count() == 0 and "No photo to overlay" in anonymous.content()
-    page.select_option("#visibility-form select", "public")
-    page.check("#share-photo input")
-    page.click("#visibility-form button")
-    page.wait_for_selector("text=Anyone sees the procedure with its photo and the overlay.")
-    anonymous.reload()
-    anonymous.wait_for_function("document.getElementById('overlay') && document.getElementById('overlay').complete "
-                                "&& document.getElementById('overlay').naturalWidth > 0")
-    assert not errors
-
-
-def test_the_overlay_hides_while_the_procedure_is_not_the_photos_size(live_server, alice, facade_photo, browser):
-    """A newcomer saw a floor more drawn stretched over the photo, as if the reconstruction had broken."""
-    from facaid.editing.parameters import named_parameters
-
-    _, seg = facade_photo
-    proc = _faithful(alice, seg)  # the photo's size
-    page, errors = open_as_alice(browser, live_server, proc, {"width": 1280, "height": 900}, advanced=False)
-    page.wait_for_selector("#named input[name=floors]")
-    assert page.is_visible("#overlay") and page.is_hidden("#overlay-note")
-    floors = next(p.value for p in named_parameters(Tree.from_dict(proc.data)) if p.name == "floors")
-    field = page.locator("#named input[name=floors]")
-    field.fill(str(floors + 1))
-    field.dispatch_event("change")
-    page.wait_for_function("!document.getElementById('overlay-note').hidden")
-    assert page.is_hidden("#overlay") and "its photo" in page.text_content("#overlay-note")
-    field.fill(str(floors))  # back to the photo's size: the overlay again
-    field.dispatch_event("change")
-    page.wait_for_function("document.getElementById('overlay-note').hidden")
-    assert page.is_visible("#overlay") and not errors
 
 
 def test_a_tree_that_cannot_be_drawn_is_shown_without_its_picture(live_server, alice, browser, tmp_path):

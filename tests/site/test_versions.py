@@ -1,6 +1,8 @@
 """Versions of procedures: every save is a new version and none is lost; revert; compare with a difference picture
 and both accuracies; figures fresh after each save; save as a new procedure with lineage; a re-run from a prefix
-as a version with a warning when it fits worse; the access rules and bad input; migration 0006."""
+as a version with a warning when it fits worse; the access rules and bad input. (A version's named parameters and a
+real facade's two readings are checked in `test_versions_parameters.py`; how versions are stored, migrations 0006
+and 0007 and the quota, in `test_versions_storage.py`.)"""
 
 from __future__ import annotations
 
@@ -10,52 +12,32 @@ import json
 import numpy as np
 import pytest
 from PIL import Image
+from site_helpers import faithful_procedure, procedure_url, same_size_variant, version_history
 
 from facaid.editing.variation import vary
 from facaid.generator import generate
 from facaid.grammar import Procedure as Tree
-from facaid.grammar import to_segmentation
-from facaid.labels import LABELS
 from facaid.metrics import measure
 from facaid.segmentation import Segmentation as SegmentationData
 from facaid.segmentation import flatten
 from webapp.facades.drawing import DIFFERENT
-from webapp.facades.models import Job, Procedure, ProcedureVersion, Segmentation, stored_bytes
+from webapp.facades.models import Job, Procedure, ProcedureVersion, Segmentation
 
 pytestmark = pytest.mark.django_db
 
 
 def _faithful(alice, seg, **fields) -> Procedure:
-    """Alice's procedure of the generated facade the photo shows, its own true tree (accuracy 1)."""
-    segmentation = Segmentation.objects.get(code=seg["code"])
-    fields.setdefault("accuracy", 1.0)
-    return Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict(), title="Rivoli",
-                                    segmentation=segmentation, photo=segmentation.photo, **fields)
-
-
-def _same_size_variant(data: dict, kind: str = "swap") -> dict:
-    for v in vary(Tree.from_dict(data), 8, 0):
-        if v.meta["variation"] == kind and (v.width, v.height) == (data["width"], data["height"]):
-            return v.to_dict()
-    raise AssertionError(f"no {kind} variation of the facade's size")
-
-
-def _url(proc, rest: str = "") -> str:
-    return f"/api/v1/procedures/{proc.code}/{rest}"
-
-
-def _history(client, proc) -> list[dict]:
-    r = client.get(_url(proc, "versions/"))
-    assert r.status_code == 200, r.content
-    return r.json()["results"]
+    """Alice's procedure of the generated facade the photo shows, its own true tree (accuracy 1), titled as the
+    lineage's titles below read."""
+    return faithful_procedure(alice, seg, title="Rivoli", **fields)
 
 
 def _edited_once(facade_photo, as_alice, alice) -> tuple[Procedure, dict, dict]:
     """The faithful procedure and a worse tree of its size saved over it: the procedure and its two versions."""
     _, seg = facade_photo
     proc = _faithful(alice, seg)
-    as_alice.patch(_url(proc), {"data": _same_size_variant(proc.data)}, format="json")
-    [v2, v1] = _history(as_alice, proc)
+    as_alice.patch(procedure_url(proc), {"data": same_size_variant(proc.data)}, format="json")
+    [v2, v1] = version_history(as_alice, proc)
     return proc, v2, v1
 
 
@@ -63,25 +45,25 @@ def test_a_save_is_a_new_version_and_the_first_is_unchanged(facade_photo, as_ali
     _, seg = facade_photo
     proc = _faithful(alice, seg)
     first = generate(3).procedure.to_dict()
-    [v1] = _history(as_alice, proc)
+    [v1] = version_history(as_alice, proc)
     assert v1["version"] == 1 and v1["kind"] == "created" and v1["picture"].endswith("/versions/1/labels.png")
-    edited = _same_size_variant(first)
-    r = as_alice.patch(_url(proc), {"data": edited}, format="json")
+    edited = same_size_variant(first)
+    r = as_alice.patch(procedure_url(proc), {"data": edited}, format="json")
     assert r.status_code == 200 and r.json()["version"] == 2
-    assert [v["version"] for v in _history(as_alice, proc)] == [2, 1]
-    again = as_alice.get(_url(proc, "versions/1/")).json()
+    assert [v["version"] for v in version_history(as_alice, proc)] == [2, 1]
+    again = as_alice.get(procedure_url(proc, "versions/1/")).json()
     assert again["data"] == first and again["digest"] == v1["digest"]  # version 1 is as it was
-    assert as_alice.get(_url(proc, "versions/2/")).json()["data"] == Tree.from_dict(edited).to_dict()
+    assert as_alice.get(procedure_url(proc, "versions/2/")).json()["data"] == Tree.from_dict(edited).to_dict()
     # a title or visibility change alone records no version, and neither does the same tree saved again
-    assert as_alice.patch(_url(proc), {"title": "Rivoli 12", "visibility": "unlisted"}, format="json").json()[
+    assert as_alice.patch(procedure_url(proc), {"title": "Rivoli 12", "visibility": "unlisted"}, format="json").json()[
         "version"] == 2
     for _ in range(20):
-        assert as_alice.patch(_url(proc), {"data": edited}, format="json").json()["version"] == 2
+        assert as_alice.patch(procedure_url(proc), {"data": edited}, format="json").json()["version"] == 2
     for values in ({}, {"width": proc.data["width"]}):  # parameters set to what they are: the same tree
-        r = as_alice.post(_url(proc, "parameters"), {"values": values, "save": True}, format="json")
+        r = as_alice.post(procedure_url(proc, "parameters"), {"values": values, "save": True}, format="json")
         assert r.status_code == 200 and r.json()["version"] == 2, r.content[:300]
-    assert [v["version"] for v in _history(as_alice, proc)] == [2, 1]
-    r = as_alice.post(_url(proc, "parameters"), {"values": {"width": proc.data["width"] + 10}, "save": True},
+    assert [v["version"] for v in version_history(as_alice, proc)] == [2, 1]
+    r = as_alice.post(procedure_url(proc, "parameters"), {"values": {"width": proc.data["width"] + 10}, "save": True},
                       format="json")
     assert r.json()["version"] == 3
 
@@ -90,18 +72,18 @@ def test_figures_are_measured_again_on_every_save_and_never_left_stale(facade_ph
     _, seg = facade_photo
     proc = _faithful(alice, seg, accuracy=0.5, metrics={"iou": {"window": 0.1}, "timings": {"decode": 1.0},
                                                           "source": "model"})
-    worse = _same_size_variant(proc.data)
-    body = as_alice.patch(_url(proc), {"data": worse}, format="json").json()
+    worse = same_size_variant(proc.data)
+    body = as_alice.patch(procedure_url(proc), {"data": worse}, format="json").json()
     accuracy, iou = measure(Tree.from_dict(worse), flatten(SegmentationData.from_dict(seg["data"])))
     assert body["accuracy"] == accuracy < 0.99 and body["metrics"]["iou"] == iou
     assert "timings" not in body["metrics"] and body["metrics"]["source"] == "model"  # the job's figures go
-    assert as_alice.get(_url(proc)).json()["accuracy"] == accuracy  # stored, not only answered
-    assert _history(as_alice, proc)[0]["accuracy"] == accuracy
+    assert as_alice.get(procedure_url(proc)).json()["accuracy"] == accuracy  # stored, not only answered
+    assert version_history(as_alice, proc)[0]["accuracy"] == accuracy
     page = as_alice.get(f"/procedures/{proc.code}").content.decode()
     assert f"{100 * accuracy:.2f} %" in page and "50.00 %" not in page
     # a resized tree is not comparable with the segmentation: no figure, and a reason in its place
     resized = next(v.to_dict() for v in vary(Tree.from_dict(proc.data), 8, 0) if v.meta["variation"] == "resize")
-    body = as_alice.patch(_url(proc), {"data": resized}, format="json").json()
+    body = as_alice.patch(procedure_url(proc), {"data": resized}, format="json").json()
     assert body["accuracy"] is None and "iou" not in body["metrics"]
     assert body["metrics"]["unmeasured"].startswith(f"the tree is {round(resized['width'])}x")
     page = as_alice.get(f"/procedures/{proc.code}").content.decode()
@@ -110,15 +92,15 @@ def test_figures_are_measured_again_on_every_save_and_never_left_stale(facade_ph
 
 def test_revert_makes_a_new_version_equal_to_the_old_one(facade_photo, as_alice, alice):
     proc, v2, v1 = _edited_once(facade_photo, as_alice, alice)
-    r = as_alice.post(_url(proc, "versions/1/revert"))
+    r = as_alice.post(procedure_url(proc, "versions/1/revert"))
     assert r.status_code == 201 and r.json()["version"] == 3
-    v3 = as_alice.get(_url(proc, "versions/3/")).json()
-    assert v3["data"] == as_alice.get(_url(proc, "versions/1/")).json()["data"] == r.json()["data"]
+    v3 = as_alice.get(procedure_url(proc, "versions/3/")).json()
+    assert v3["data"] == as_alice.get(procedure_url(proc, "versions/1/")).json()["data"] == r.json()["data"]
     assert v3["accuracy"] == v1["accuracy"] == pytest.approx(1.0) and v3["digest"] == v1["digest"]
     assert v3["kind"] == "revert" and v3["based_on"] == 1 and v3["note"] == "reverted to version 1"
-    assert [v["version"] for v in _history(as_alice, proc)] == [3, 2, 1]  # nothing deleted
-    assert as_alice.get(_url(proc, "versions/2/")).json()["digest"] == v2["digest"]
-    r = as_alice.post(_url(proc, "versions/1/revert"))  # the tree it holds now: nothing to do, said so
+    assert [v["version"] for v in version_history(as_alice, proc)] == [3, 2, 1]  # nothing deleted
+    assert as_alice.get(procedure_url(proc, "versions/2/")).json()["digest"] == v2["digest"]
+    r = as_alice.post(procedure_url(proc, "versions/1/revert"))  # the tree it holds now: nothing to do, said so
     assert r.status_code == 400 and "holds now" in r.json()["version"]
     assert ProcedureVersion.objects.filter(procedure=proc).count() == 3
 
@@ -126,7 +108,7 @@ def test_revert_makes_a_new_version_equal_to_the_old_one(facade_photo, as_alice,
 def test_compare_two_versions_gives_both_accuracies_and_a_difference_picture(facade_photo, as_alice, alice):
     _, seg = facade_photo
     proc, v2, v1 = _edited_once(facade_photo, as_alice, alice)
-    r = as_alice.get(_url(proc, "versions/compare?a=1&b=2"))
+    r = as_alice.get(procedure_url(proc, "versions/compare?a=1&b=2"))
     assert r.status_code == 200, r.content
     body = r.json()
     assert body["a"]["accuracy"] == v1["accuracy"] == pytest.approx(1.0)
@@ -138,44 +120,47 @@ def test_compare_two_versions_gives_both_accuracies_and_a_difference_picture(fac
     pixels = np.asarray(Image.open(io.BytesIO(picture.content)).convert("RGB"))
     assert pixels.shape[0] * pixels.shape[1] == body["pixels"]
     assert (pixels == DIFFERENT).all(axis=2).sum() == body["differing_pixels"]  # highlighted: those and no others
-    same = as_alice.get(_url(proc, "versions/compare?a=1&b=1")).json()
+    same = as_alice.get(procedure_url(proc, "versions/compare?a=1&b=1")).json()
     assert same["differing_pixels"] == 0
     for n in (1, 2):
-        png = as_alice.get(_url(proc, f"versions/{n}/labels.png"))
+        png = as_alice.get(procedure_url(proc, f"versions/{n}/labels.png"))
         assert png.status_code == 200 and png["ETag"] == f'"{body["ab"[n - 1]]["digest"]}"'
-        assert as_alice.get(_url(proc, f"versions/{n}/labels.png"), HTTP_IF_NONE_MATCH=png["ETag"]).status_code == 304
+        assert as_alice.get(procedure_url(proc, f"versions/{n}/labels.png"),
+                            HTTP_IF_NONE_MATCH=png["ETag"]).status_code == 304
 
 
 def test_bad_input_is_a_clear_4xx_and_changes_nothing(facade_photo, as_alice, as_bob, as_charlie, alice):
     _, seg = facade_photo
     proc = _faithful(alice, seg)
     for path in ("versions/9/", "versions/0/", "versions/abc/", "versions/1e3/labels.png", "versions/-1/revert"):
-        r = as_alice.post(_url(proc, path)) if path.endswith("revert") else as_alice.get(_url(proc, path))
+        r = (as_alice.post(procedure_url(proc, path)) if path.endswith("revert")
+             else as_alice.get(procedure_url(proc, path)))
         assert r.status_code == 404, path
-    assert "it has versions 1 to 1" in as_alice.get(_url(proc, "versions/9/")).json()["detail"]
-    assert as_alice.post(_url(proc, "versions/9/revert")).status_code == 404
+    assert "it has versions 1 to 1" in as_alice.get(procedure_url(proc, "versions/9/")).json()["detail"]
+    assert as_alice.post(procedure_url(proc, "versions/9/revert")).status_code == 404
     for query, field in (("a=1", "b"), ("a=x&b=1", "a"), ("a=1&b=7", "b"), ("a=1&b=" + "9" * 30, "b")):
-        r = as_alice.get(_url(proc, f"versions/compare?{query}"))
+        r = as_alice.get(procedure_url(proc, f"versions/compare?{query}"))
         assert r.status_code == 400 and field in r.json(), (query, r.content)
     bad = generate(3).procedure.to_dict()
     bad["root"]["rule"] = "explode"
-    r = as_alice.patch(_url(proc), {"data": bad}, format="json")
+    r = as_alice.patch(procedure_url(proc), {"data": bad}, format="json")
     assert r.status_code == 400 and "explode" in json.dumps(r.json())
-    r = as_alice.post(_url(proc, "save-as-new"), {"data": bad}, format="json")
+    r = as_alice.post(procedure_url(proc, "save-as-new"), {"data": bad}, format="json")
     assert r.status_code == 400 and "explode" in json.dumps(r.json())
-    assert as_alice.post(_url(proc, "save-as-new"), {"title": 5}, format="json").status_code == 400
+    assert as_alice.post(procedure_url(proc, "save-as-new"), {"title": 5}, format="json").status_code == 400
     # someone else's private procedure is not there; a visible one's history is theirs to read, not to change
-    assert as_bob.get(_url(proc, "versions/")).status_code == 404
-    assert as_bob.post(_url(proc, "versions/1/revert")).status_code == 404
-    assert as_bob.get(_url(proc, "versions/compare?a=1&b=1")).status_code == 404
-    assert as_bob.post(_url(proc, "save-as-new"), {}, format="json").status_code == 404
-    as_alice.patch(_url(proc), {"data": _same_size_variant(proc.data), "visibility": "public"}, format="json")
-    assert [v["version"] for v in _history(as_bob, proc)] == [2, 1] == [v["version"] for v in
-                                                                        _history(as_charlie, proc)]
-    assert as_charlie.get(_url(proc, "versions/compare?a=1&b=2")).status_code == 200
-    assert as_bob.post(_url(proc, "versions/1/revert")).status_code == 403
-    assert as_charlie.post(_url(proc, "versions/1/revert")).status_code in (401, 403)
-    assert as_bob.patch(_url(proc), {"data": generate(3).procedure.to_dict()}, format="json").status_code == 403
+    assert as_bob.get(procedure_url(proc, "versions/")).status_code == 404
+    assert as_bob.post(procedure_url(proc, "versions/1/revert")).status_code == 404
+    assert as_bob.get(procedure_url(proc, "versions/compare?a=1&b=1")).status_code == 404
+    assert as_bob.post(procedure_url(proc, "save-as-new"), {}, format="json").status_code == 404
+    as_alice.patch(procedure_url(proc), {"data": same_size_variant(proc.data), "visibility": "public"}, format="json")
+    assert [v["version"] for v in version_history(as_bob, proc)] == [2, 1] == [v["version"] for v in
+                                                                        version_history(as_charlie, proc)]
+    assert as_charlie.get(procedure_url(proc, "versions/compare?a=1&b=2")).status_code == 200
+    assert as_bob.post(procedure_url(proc, "versions/1/revert")).status_code == 403
+    assert as_charlie.post(procedure_url(proc, "versions/1/revert")).status_code in (401, 403)
+    assert as_bob.patch(procedure_url(proc), {"data": generate(3).procedure.to_dict()},
+                        format="json").status_code == 403
     assert ProcedureVersion.objects.filter(procedure=proc).count() == 2
     assert Procedure.objects.count() == 1
 
@@ -184,8 +169,8 @@ def test_save_as_new_and_saved_variations_have_lineage_and_titles_of_their_own(f
                                                                                alice):
     _, seg = facade_photo
     proc = _faithful(alice, seg, visibility="public")
-    variant = _same_size_variant(proc.data)
-    r = as_alice.post(_url(proc, "save-as-new"), {"data": variant}, format="json")
+    variant = same_size_variant(proc.data)
+    r = as_alice.post(procedure_url(proc, "save-as-new"), {"data": variant}, format="json")
     assert r.status_code == 201, r.content
     copy = r.json()
     assert copy["parent"] == str(proc.code) and copy["owner"] == "alice" and copy["visibility"] == "private"
@@ -199,20 +184,22 @@ def test_save_as_new_and_saved_variations_have_lineage_and_titles_of_their_own(f
     first = copies.versions.get(version=1)
     assert first.note == "saved from a variation of version 1 of “Rivoli”" and first.kind == "created"
     assert first.accuracy == accuracy and copies.metrics["edits"]
-    plain = as_alice.post(_url(proc, "save-as-new"), {}, format="json").json()
+    plain = as_alice.post(procedure_url(proc, "save-as-new"), {}, format="json").json()
     assert plain["title"] == "Rivoli · variant 2" and plain["version"] == 1 and plain["data"] == proc.data
-    assert _history(as_alice, Procedure.objects.get(code=plain["code"]))[0]["note"] == \
+    assert version_history(as_alice, Procedure.objects.get(code=plain["code"]))[0]["note"] == \
         "saved as a new procedure from version 1 of “Rivoli”"
-    unedited = as_alice.post(_url(proc, "save-as-new"), {"data": proc.data}, format="json").json()  # as the page
-    assert _history(as_alice, Procedure.objects.get(code=unedited["code"]))[0]["note"] == \
+    unedited = as_alice.post(procedure_url(proc, "save-as-new"), {"data": proc.data},
+                             format="json").json()  # as the page
+    assert version_history(as_alice, Procedure.objects.get(code=unedited["code"]))[0]["note"] == \
         "saved as a new procedure from version 1 of “Rivoli”"  # sends it, not edited: no edit is said
-    fork = as_bob.post(_url(proc, "fork"), {}, format="json").json()
-    assert _history(as_bob, Procedure.objects.get(code=fork["code"]))[0]["note"] == "forked from version 1 of “Rivoli”"
-    named = as_alice.post(_url(proc, "save-as-new"), {"title": "Rivoli, five floors"}, format="json").json()
+    fork = as_bob.post(procedure_url(proc, "fork"), {}, format="json").json()
+    assert version_history(as_bob, Procedure.objects.get(code=fork["code"]))[0]["note"] == (
+        "forked from version 1 of “Rivoli”")
+    named = as_alice.post(procedure_url(proc, "save-as-new"), {"title": "Rivoli, five floors"}, format="json").json()
     assert named["title"] == "Rivoli, five floors"
     assert Procedure.objects.get(id=proc.id).data == proc.data  # the original is untouched
-    assert [v["version"] for v in _history(as_alice, proc)] == [1]
-    theirs = as_bob.post(_url(proc, "save-as-new"), {"data": variant}, format="json").json()
+    assert [v["version"] for v in version_history(as_alice, proc)] == [1]
+    theirs = as_bob.post(procedure_url(proc, "save-as-new"), {"data": variant}, format="json").json()
     assert theirs["owner"] == "bob" and theirs["parent"] == str(proc.code)
     assert theirs["title"].startswith("Rivoli · swap variant")
 
@@ -227,7 +214,7 @@ def test_a_re_run_from_a_prefix_is_a_new_version_with_a_warning_when_it_fits_wor
     proc = _faithful(alice, seg)
 
     def rerun(nodes: int) -> Job:
-        r = as_alice.post(_url(proc, "rerun"), {"nodes": nodes, "k": 1}, format="json")
+        r = as_alice.post(procedure_url(proc, "rerun"), {"nodes": nodes, "k": 1}, format="json")
         assert r.status_code == 202, r.content
         job = Job.objects.get(code=r.json()["code"])
         tasks.run_job.apply(args=[job.id])
@@ -238,7 +225,7 @@ def test_a_re_run_from_a_prefix_is_a_new_version_with_a_warning_when_it_fits_wor
     job = rerun(1)  # continuing the true tree from its root: the model's own sizes fit a little worse
     assert job.result_id == proc.id and job.result_version == 2 and job.params["as_version"] is True
     assert Procedure.objects.count() == 1  # a version of this procedure, not a fork with the same title
-    [v2, v1] = _history(as_alice, proc)
+    [v2, v1] = version_history(as_alice, proc)
     assert v2["kind"] == "rerun" and v2["based_on"] == 1 and v1["accuracy"] == pytest.approx(1.0)
     assert v2["accuracy"] < v1["accuracy"] and v2["metrics"]["source"] in ("model", "model+repair", "induced")
     assert v2["warning"].startswith("This re-run fits worse than version 1: pixel accuracy")
@@ -246,12 +233,12 @@ def test_a_re_run_from_a_prefix_is_a_new_version_with_a_warning_when_it_fits_wor
     page = as_alice.get(f"/procedures/{proc.code}").content.decode()
     assert 'id="rerun-warning"' in page and "fits worse than version 1" in page and 'data-compare="1,2"' in page
     # kept or reverted: a revert brings version 1 back as version 3
-    assert as_alice.post(_url(proc, "versions/1/revert")).json()["accuracy"] == pytest.approx(1.0)
+    assert as_alice.post(procedure_url(proc, "versions/1/revert")).json()["accuracy"] == pytest.approx(1.0)
     assert 'id="rerun-warning"' not in as_alice.get(f"/procedures/{proc.code}").content.decode()
     # from a tree that fits badly, a re-run that fits better says nothing
-    as_alice.patch(_url(proc), {"data": _same_size_variant(proc.data)}, format="json")
+    as_alice.patch(procedure_url(proc), {"data": same_size_variant(proc.data)}, format="json")
     job = rerun(1)
-    [v5, v4] = _history(as_alice, proc)[:2]
+    [v5, v4] = version_history(as_alice, proc)[:2]
     assert job.result_version == 5 and v5["based_on"] == 4 and v5["accuracy"] > v4["accuracy"]
     assert v5["warning"] == ""
 
@@ -267,192 +254,3 @@ def test_a_re_run_of_someone_elses_procedure_is_a_new_procedure_told_apart(facad
     newer = as_alice.post(f"/api/v1/photos/{seg['photo']}/segmentations/", seg["data"], format="json").json()
     other = submit_job(alice, Segmentation.objects.get(code=newer["code"]), prefix=proc, prefix_nodes=2)
     assert other.params["as_version"] is False  # another segmentation: its figures would not compare
-
-
-def test_migration_0005_gives_every_procedure_its_tree_as_version_1(alice):
-    import importlib
-
-    from django.apps import apps
-
-    data = generate(4).procedure.to_dict()
-    proc = Procedure.objects.create(owner=alice, data=data, accuracy=0.93, metrics={"source": "model"})
-    ProcedureVersion.objects.all().delete()  # as stored before versions
-    importlib.import_module("webapp.facades.migrations.0006_procedure_versions").first_versions(apps, None)
-    [v1] = ProcedureVersion.objects.filter(procedure=proc)
-    assert (v1.version, v1.data, v1.digest, v1.accuracy, v1.metrics) == (1, data, proc.digest, 0.93,
-                                                                         proc.metrics)
-    assert proc.metrics["source"] == "model"  # (and its edits checked as it was saved)
-    assert v1.kind == "created" and v1.created == proc.updated
-
-
-def test_named_parameters_through_the_api(facade_photo, as_alice, as_bob, alice):
-    """GET lists the named parameters; POST sets them (returned only, or saved as the next version with a fresh
-    accuracy); bad names and values are a 400 naming them, and another user cannot save."""
-    _, seg = facade_photo
-    proc = _faithful(alice, seg, visibility="public")
-    r = as_alice.get(_url(proc, "parameters"))
-    assert r.status_code == 200, r.content
-    floors = {p["name"]: p for p in r.json()["parameters"]}["floors"]
-    assert floors["integer"] and floors["nodes"]
-    # where each element is drawn, with its node: the rectangles of the executed tree, background left out
-    tree = Tree.from_dict(proc.data)
-    drawn = [r for r in to_segmentation(tree).rects if LABELS[r.label] != "background"]
-    leaves = r.json()["leaves"]
-    nodes = dict(tree.nodes())
-    assert len(leaves) == len(drawn) and all(leaf[5] in nodes and nodes[leaf[5]].label == leaf[0] for leaf in leaves)
-    assert sorted(tuple(leaf[1:5]) for leaf in leaves if leaf[0] != "facade") == sorted(
-        (r.x0, r.y0, r.x1, r.y1) for r in drawn if LABELS[r.label] != "facade")
-    target = floors["value"] + 1
-    r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": target}}, format="json")
-    assert r.status_code == 200, r.content
-    body = r.json()
-    assert {p["name"]: p["value"] for p in body["parameters"]}["floors"] == target
-    assert body["version"] is None and len(_history(as_alice, proc)) == 1  # not saved
-    r = as_alice.post(_url(proc, "parameters"), {"values": {"floors": target}, "save": True}, format="json")
-    assert r.status_code == 200, r.content
-    saved = r.json()
-    assert saved["version"] == 2, saved
-    # a taller facade than its segmentation: measured again on save, and said to be unmeasurable, never stale
-    assert saved["accuracy"] is None and "its segmentation is" in saved["metrics"]["unmeasured"]
-    [v2, v1] = _history(as_alice, proc)
-    assert v2["kind"] == "edit" and "floors" in v2["note"] and v1["version"] == 1
-    proc.refresh_from_db()
-    assert proc.data["height"] > generate(3).procedure.height and proc.accuracy is None
-    for bad, word in (({"values": {"storeys": 3}}, "storeys"), ({"values": {"floors": 0}}, "floors"),
-                      ({"values": {"floors": "x"}}, "values"), ({}, "values")):
-        r = as_alice.post(_url(proc, "parameters"), bad, format="json")
-        assert r.status_code == 400 and word in json.dumps(r.json()), (bad, r.content)
-    r = as_bob.post(_url(proc, "parameters"), {"values": {"floors": target}, "save": True}, format="json")
-    assert r.status_code in (403, 404) and len(_history(as_alice, proc)) == 2
-
-
-def test_variations_by_named_ranges_through_the_api(facade_photo, as_alice, alice):
-    _, seg = facade_photo
-    proc = _faithful(alice, seg)
-    r = as_alice.post(_url(proc, "variations"), {"n": 4, "seed": 1, "ranges": {"floors": [2, 3]}}, format="json")
-    assert r.status_code == 200, r.content
-    variants = r.json()["variants"]
-    assert len(variants) == 4 and {v["meta"]["parameters"]["floors"] for v in variants} <= {2, 3}
-    for bad in ({"ranges": {"storeys": [1, 2]}}, {"ranges": {"floors": [1]}}, {"ranges": {"floors": [3, 2]}}):
-        r = as_alice.post(_url(proc, "variations"), bad, format="json")
-        assert r.status_code == 400 and "ranges" in r.json(), (bad, r.content)
-
-
-def _real_like_job(client, structure: str | None = None) -> tuple[Procedure, Job]:
-    """A photo of a real-like facade (drawn as people draw CMP's), reconstructed in this process as the worker does
-    it, with the shipped model."""
-    import io
-
-    from grammar_helpers import real_like
-
-    from facaid.formats.render import render_segmentation
-    from tests.site.site_helpers import upload
-    from worker import tasks
-
-    seg = real_like()
-    out = io.BytesIO()
-    render_segmentation(seg).save(out, "PNG")
-    photo = upload(client, out.getvalue(), title="Real-like").json()
-    made = client.post(f"/api/v1/photos/{photo['code']}/segmentations/", seg.to_dict(), format="json").json()
-    body = {"segmentation": made["code"], "k": 2} | ({"structure": structure} if structure else {})
-    r = client.post("/api/v1/jobs/", body, format="json")
-    assert r.status_code == 202, r.content
-    job = Job.objects.get(code=r.json()["code"])
-    tasks.run_job.apply(args=[job.id])
-    job.refresh_from_db()
-    assert job.status == "done", job.message
-    return Procedure.objects.get(id=job.result_id), job
-
-
-def test_a_real_facade_gets_both_procedures_the_editable_one_current(as_alice, monkeypatch):
-    """The editable reading is the current version, the exact one version 1; the page names both with their
-    accuracies and switches between them by a revert; the parameters edit the editable one."""
-    monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")
-    proc, job = _real_like_job(as_alice)
-    assert job.result_version == 2
-    [v2, v1] = _history(as_alice, proc)
-    assert (v1["metrics"]["structure"], v2["metrics"]["structure"]) == ("exact", "editable")
-    assert v2["metrics"]["source"] == "lattice" and v1["accuracy"] > v2["accuracy"] > 0.94
-    assert v2["note"].startswith("editable: floors of tiles") and v1["note"] == "exact: the annotation as drawn"
-    # the worker checked both trees' edits as it stored them (issue 67), each record naming its own tree
-    assert [v["metrics"]["edits"]["digest"] for v in (v1, v2)] == [v1["digest"], v2["digest"]]
-    assert v2["metrics"]["edits"]["verdicts"].keys() == {"floors+1", "floors-1", "bays+1", "bays-1"}
-    params = {p["name"]: p for p in as_alice.get(_url(proc, "parameters")).json()["parameters"]}
-    assert params["floors"]["value"] == 5 and params["bays"]["value"] == 6
-    assert params["floors"]["checked"] == all(v["clean"] for k, v in v2["metrics"]["edits"]["verdicts"].items()
-                                              if k.startswith("floors"))
-    page = as_alice.get(f"/procedures/{proc.code}").content.decode()
-    assert "editable structure: floors of tiles with exceptions" in page
-    assert 'id="other-structure"' in page and "The exact procedure (pixel accuracy" in page
-    assert 'data-revert="1" id="switch-structure"' in page and "Switch to the exact one" in page
-    assert as_alice.post(_url(proc, "versions/1/revert")).status_code in (200, 201)
-    page = as_alice.get(f"/procedures/{proc.code}").content.decode()
-    assert "exact structure: the annotation as drawn" in page and "Switch to the editable one" in page
-
-
-def test_the_exact_procedure_first_when_asked(as_alice, monkeypatch):
-    monkeypatch.setenv("FACAID_HEARTBEAT_SECONDS", "3600")
-    proc, job = _real_like_job(as_alice, "exact")
-    [v2, v1] = _history(as_alice, proc)
-    assert (v1["metrics"]["structure"], v2["metrics"]["structure"]) == ("editable", "exact")
-    assert job.params["structure"] == "exact"
-
-
-@pytest.mark.django_db(transaction=True)
-def test_migration_0007_stores_every_version_compressed_and_keeps_its_tree(alice):
-    from django.db import connection
-    from django.db.migrations.executor import MigrationExecutor
-
-    from webapp.facades.fields import pack
-
-    before = [("facades", "0006_procedure_versions")]
-    executor = MigrationExecutor(connection)
-    executor.migrate(before)
-    old = executor.loader.project_state(before).apps
-    trees = [generate(i).procedure.to_dict() for i in (4, 5)]
-    proc = old.get_model("facades", "Procedure").objects.create(owner_id=alice.id, data=trees[1], digest="x")
-    rows = old.get_model("facades", "ProcedureVersion").objects
-    for n, tree in enumerate(trees, start=1):
-        rows.create(procedure_id=proc.id, version=n, data=tree, digest=f"d{n}", kind="edit")
-    executor = MigrationExecutor(connection)
-    executor.loader.build_graph()
-    executor.migrate([("facades", "0007_compressed_versions")])
-    executor.loader.build_graph()
-    executor.migrate(executor.loader.graph.leaf_nodes())  # the later ones too: the tests after this one need them
-    versions = ProcedureVersion.objects.filter(procedure_id=proc.id).order_by("version")
-    assert [v.data for v in versions] == trees  # (PostgreSQL's jsonb kept them in its own key order)
-    assert all(v.size == len(pack(v.data)) for v in versions)
-    with connection.cursor() as cursor:
-        cursor.execute("SELECT data FROM facades_procedureversion WHERE procedure_id = %s", [proc.id])
-        stored = [bytes(row[0]) for row in cursor.fetchall()]
-    assert all(len(b) * 4 < len(json.dumps(t)) for b, t in zip(stored, trees, strict=True))  # compressed
-
-
-def test_versions_past_the_accounts_quota_are_refused_by_name_and_nothing_is_lost(facade_photo, as_alice, alice,
-                                                                                   settings):
-    _, seg = facade_photo
-    proc = _faithful(alice, seg)
-    used = sum(stored_bytes(alice.pk).values())  # the photo, its segmentation, the tree and its version
-    settings.FACAID_STORAGE_QUOTA_MB = (used + ProcedureVersion.objects.get(procedure=proc).size * 2.5) / 2**20
-    kept = []
-    for seed in range(10, 20):
-        tree = _same_size_variant(generate(seed).procedure.to_dict()) if seed % 2 else None
-        tree = tree or {**Tree.from_dict(proc.data).to_dict(), "meta": {"note": f"save {seed}"}}
-        r = as_alice.patch(_url(proc), {"data": tree}, format="json")
-        if r.status_code != 200:
-            break
-        kept.append(r.json()["version"])
-    assert r.status_code == 400 and "your account stores" in r.json()["detail"], r.content[:300]
-    assert "nothing was saved" in r.json()["detail"]
-    assert [v["version"] for v in _history(as_alice, proc)] == [*reversed(kept), 1]  # all kept, none added
-    assert as_alice.get(_url(proc)).json()["version"] == (kept or [1])[-1]
-    jobs = Job.objects.count()  # a job would fail on its result: it is refused when asked for
-    r = as_alice.post("/api/v1/jobs/", {"segmentation": seg["code"]}, format="json")
-    assert r.status_code == 400 and "your account stores" in r.json()["detail"] and Job.objects.count() == jobs
-
-
-def test_a_compressed_tree_reads_back_from_the_database_from_a_dump_and_as_given():
-    from webapp.facades.fields import CompressedJSONField, pack
-
-    field, tree = CompressedJSONField(), generate(3).procedure.to_dict()
-    assert field.to_python(pack(tree)) == tree == field.to_python(json.dumps(tree)) == field.to_python(tree)
