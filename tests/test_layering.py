@@ -157,10 +157,11 @@ def test_facaid_imports_point_down():
 
 def test_facaid_has_at_most_12_top_level_modules_and_no_source_file_over_400_lines():
     """Issue 69: facaid's stages are its folders (model, reading, editing, decoding, ...); at its top level at most 12
-    modules, its front door among them; no source file (facaid, webapp, worker, bench, frontend) over 400 lines."""
+    modules, its front door among them; no source file (facaid, webapp, worker, bench, frontend, tests) over 400
+    lines."""
     top = list((ROOT / "facaid").glob("*.py"))
     assert len(top) <= 12, sorted(p.name for p in top)
-    sources = [p for folder in ("facaid", "webapp", "worker", "bench") for p in (ROOT / folder).rglob("*.py")
+    sources = [p for folder in ("facaid", "webapp", "worker", "bench", "tests") for p in (ROOT / folder).rglob("*.py")
                if "migrations" not in p.parts]
     sources += [p for p in (ROOT / "frontend").rglob("*.js") if "tests" not in p.parts]
     sources += list((ROOT / "facaid" / "native").glob("*.c"))
