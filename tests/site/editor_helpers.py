@@ -106,3 +106,6 @@ def import_file(page, path, choice: str = "replace") -> None:
                            "/^(Imported|Not imported)/.test(document.querySelector('#status').textContent)")
     if page.evaluate("document.querySelector('#import-choice').open"):
         page.click(f"#import-choice button[value={choice}]")
+        # the answer comes once the rectangles are in: a test that then counts them counts the import's, not the
+        # drawing's it replaces (seen under load: the editor's two rectangles counted as the import's two)
+        page.wait_for_function("/^(Imported|Not imported)/.test(document.querySelector('#status').textContent)")
