@@ -24,7 +24,8 @@ TEXTS = {
     500: "Something went wrong on our side. It has been logged; try again in a moment.",
 }
 # the services' errors (`webapp.facades.errors`) by kind, as the API answers them and the pages show them
-SERVICE_STATUS = {"invalid": 400, "over_quota": 400, "not_found": 404, "not_allowed": 403, "too_many_jobs": 429}
+SERVICE_STATUS = {"invalid": 400, "over_quota": 400, "not_found": 404, "not_allowed": 403, "not_signed_in": 401,
+                  "too_many_jobs": 429}
 # the page's last resort: what is answered if even the template fails
 BARE_PAGE = ("<!doctype html><html lang=\"en\"><meta charset=\"utf-8\"><title>{title} · FaçAID</title>"
              "<p><a href=\"/\">FaçAID</a></p><h1>{title}</h1><p>{message}</p></html>")

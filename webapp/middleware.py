@@ -14,12 +14,13 @@ import logging
 import secrets
 
 from django.conf import settings
+from django.contrib.auth.views import redirect_to_login
 from django.db import OperationalError
 
 from facaid.grammar.budget import WorkLimitError, work_budget
 from webapp.error_pages import error_response, service_status
 from webapp.facades import throttling
-from webapp.facades.errors import ServiceError
+from webapp.facades.errors import NotSignedIn, ServiceError
 from webapp.facades.throttling import is_heavy
 
 log = logging.getLogger(__name__)
@@ -150,6 +151,8 @@ class ServiceErrorMiddleware:
     def process_exception(self, request, exception):
         if not isinstance(exception, ServiceError):
             return None
+        if isinstance(exception, NotSignedIn):
+            return redirect_to_login(request.get_full_path())
         return error_response(request, service_status(exception), exception.text())
 
 

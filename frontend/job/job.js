@@ -13,6 +13,7 @@ function show(job) {
   document.getElementById("progress").value = job.progress;
   document.getElementById("message").textContent = job.message;
   document.getElementById("note").textContent = job.note;  // a late job: waiting for a worker, or one gone silent
+  document.getElementById("attempts").textContent = job.attempts;  // a worker took it (again, if one was lost)
   if (job.result) {
     const version = job.result_version > 1 ? ` (its version ${job.result_version})` : "";
     document.getElementById("result").innerHTML =

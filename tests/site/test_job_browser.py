@@ -30,8 +30,10 @@ def test_job_page_follows_the_stages_to_the_procedure(live_server, alice, facade
                         ".filter(r => r.height > 0).map(r => r.top)")
     assert top == sorted(top) and len(set(top)) == len(top)
     screenshot(page, "job-running.png", tmp_path)
-    Job.objects.filter(id=job.id).update(progress=0.6, stage="sizing")
+    assert page.text_content("#attempts") == "0"
+    Job.objects.filter(id=job.id).update(progress=0.6, stage="sizing", attempts=1)
     page.wait_for_function("document.getElementById('stage').textContent === 'sizing'", timeout=10_000)
+    assert page.text_content("#attempts") == "1"  # followed as it runs, not only when the page is drawn
     assert page.evaluate("document.getElementById('progress').value") == pytest.approx(0.6)
     proc = Procedure.objects.create(owner=alice, data=generate(3).procedure.to_dict())
     Job.objects.filter(id=job.id).update(status=Job.Status.DONE, progress=1.0, stage="done", result=proc)

@@ -8,15 +8,25 @@ from __future__ import annotations
 import uuid
 
 import pytest
+from rest_framework.test import APIClient
 from site_helpers import image_bytes, upload
 
 from facaid.generator import generate
 from webapp.error_pages import SERVICE_STATUS, service_status
 from webapp.facades.api.exception_handler import exception_handler
-from webapp.facades.errors import Invalid, NotAllowed, NotFound, QuotaError, ServiceError, TooManyJobs
+from webapp.facades.errors import (
+    Invalid,
+    NotAllowed,
+    NotFound,
+    NotSignedIn,
+    QuotaError,
+    ServiceError,
+    TooManyJobs,
+)
 from webapp.facades.jsonbody import JSONError
-from webapp.facades.models import Job, Photo
+from webapp.facades.models import Job, Photo, Procedure
 from webapp.facades.uploads import UploadError
+from webapp.middleware import ServiceErrorMiddleware
 
 pytestmark = pytest.mark.django_db
 
@@ -74,6 +84,35 @@ def test_what_may_not_be_changed_is_a_403(as_alice, as_bob):
     r = as_bob.patch(f"/api/v1/photos/{photo['code']}/", {"title": "mine"}, format="json")
     assert (r.status_code, r.json()) == (403, {"detail": "only the owner may change this"})
     assert Photo.objects.get(code=photo["code"]).title == ""
+
+
+def test_a_change_asked_without_an_account_is_a_401_or_the_sign_in_page(as_alice, rf):
+    """The smoke test of the seventh session: an anonymous PATCH of someone's photo or procedure was a 403 "only the
+    owner may change this", where fork, jobs and the rest said 401. Now DRF's 401 with its challenge; on a page,
+    the sign-in page."""
+    photo = upload(as_alice, image_bytes(size=(64, 48)), visibility="public").json()
+    proc = as_alice.post("/api/v1/procedures/", {"data": generate(3).procedure.to_dict(), "visibility": "public"},
+                         format="json").json()
+    anon = APIClient()
+    for r in (anon.patch(f"/api/v1/photos/{photo['code']}/", {"title": "mine"}, format="json"),
+              anon.patch(f"/api/v1/procedures/{proc['code']}/", {"title": "mine"}, format="json"),
+              anon.delete(f"/api/v1/procedures/{proc['code']}/")):
+        assert r.status_code == 401 and r.json() == {"detail": "Authentication credentials were not provided."}
+        assert r.headers["WWW-Authenticate"] == "Token"
+    assert Photo.objects.get(code=photo["code"]).title == "" and Procedure.objects.filter(code=proc["code"]).exists()
+    page = ServiceErrorMiddleware(lambda request: None).process_exception(rf.post("/procedures/x/fork"),
+                                                                          NotSignedIn("sign in to change this"))
+    assert page.status_code == 302 and page.url.startswith("/accounts/login/?next=")
+
+
+def test_a_bad_procedure_is_one_flat_message_under_data(as_alice):
+    """Not ``{"data": {"data": ...}}``: the library's message under the field, as every service error gives it."""
+    proc = as_alice.post("/api/v1/procedures/", {"data": generate(3).procedure.to_dict()}, format="json").json()
+    for bad in ({"bogus": 1}, "x"):
+        r = as_alice.patch(f"/api/v1/procedures/{proc['code']}/", {"data": bad}, format="json")
+        assert r.status_code == 400 and isinstance(r.json()["data"], str) and "procedure" in r.json()["data"]
+    r = as_alice.post("/api/v1/procedures/", {"data": {"bogus": 1}}, format="json")
+    assert r.status_code == 400 and isinstance(r.json()["data"], str)
 
 
 def test_too_many_jobs_is_a_429(facade_photo, as_alice, settings):

@@ -6,7 +6,7 @@ from __future__ import annotations
 from django.core.exceptions import ValidationError
 from django.db.models import Q, QuerySet
 
-from webapp.facades.errors import NotAllowed, NotFound
+from webapp.facades.errors import NotAllowed, NotFound, NotSignedIn
 from webapp.facades.models import Job, Photo, Procedure, Segmentation, Visibility
 
 READABLE = (Visibility.PUBLIC, Visibility.UNLISTED)  # by link; only public ones are listed
@@ -34,7 +34,9 @@ def _get(qs: QuerySet, code):
 
 
 def _owned(obj, user, owner):
-    if not (user.is_authenticated and owner == user):
+    if not user.is_authenticated:
+        raise NotSignedIn("sign in to change this")
+    if owner != user:
         raise NotAllowed("only the owner may change this")
     if is_demo(obj):
         raise NotAllowed(DEMO_READ_ONLY)

@@ -47,6 +47,13 @@ class NotAllowed(ServiceError):
     kind = "not_allowed"
 
 
+class NotSignedIn(NotAllowed):
+    """A change asked without an account: the API answers it as DRF's 401 (with its ``WWW-Authenticate``), a page
+    sends to the sign-in page. A `NotAllowed`: what catches that one catches it too."""
+
+    kind = "not_signed_in"
+
+
 class TooManyJobs(ServiceError):
     """The account has as many reconstructions waiting or running as it may (``FACAID_MAX_ACTIVE_JOBS``)."""
 

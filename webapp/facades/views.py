@@ -18,6 +18,7 @@ from facaid.formats import interchange
 from facaid.formats.cga import MAX_SCALE
 from facaid.grammar import ProcedureError
 from facaid.grammar.budget import WorkLimitError
+from facaid.grammar.procedure import MAX_NODES
 from webapp.facades import access, disclosure, example, jsonbody, throttling
 from webapp.facades.downloads import DOWNLOADS, download_scale, drawn_on_original
 from webapp.facades.errors import Invalid, QuotaError, TooManyJobs
@@ -320,7 +321,7 @@ def procedure_rerun(request, code):
     proc = access.get_rw_procedure_for_user(request.user, code)
     form = RerunForm(request.POST)
     if not form.is_valid():
-        messages.error(request, "Re-running needs a node count of at least 1.")
+        messages.error(request, f"Re-running needs a node count from 1 to {MAX_NODES}.")
         return redirect(proc)
     try:
         job = procedures.rerun(request.user, proc, form.cleaned_data["nodes"])

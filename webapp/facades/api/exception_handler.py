@@ -5,12 +5,13 @@ each kind its status (`webapp.error_pages.service_status`), in the JSON the API 
 
 from __future__ import annotations
 
+from rest_framework.exceptions import NotAuthenticated
 from rest_framework.response import Response
 from rest_framework.views import exception_handler as drf_exception_handler
 from rest_framework.views import set_rollback
 
 from webapp.error_pages import service_status
-from webapp.facades.errors import ServiceError
+from webapp.facades.errors import NotSignedIn, ServiceError
 
 
 def body(exc: ServiceError) -> dict:
@@ -19,6 +20,11 @@ def body(exc: ServiceError) -> dict:
 
 
 def exception_handler(exc, context):
+    if isinstance(exc, NotSignedIn):  # DRF's 401: its message and the authentication's challenge, as the view
+        # gives them to its own NotAuthenticated (`APIView.handle_exception`)
+        unsigned = NotAuthenticated()
+        unsigned.auth_header = context["view"].get_authenticate_header(context["request"])
+        return drf_exception_handler(unsigned, context)
     if isinstance(exc, ServiceError):
         set_rollback()
         return Response(body(exc), status=service_status(exc))

@@ -8,7 +8,6 @@ from rest_framework import serializers
 
 from facaid.formats.cga import MAX_SCALE
 from webapp.facades import access, disclosure
-from webapp.facades.errors import Invalid
 from webapp.facades.models import Procedure, Visibility
 from webapp.facades.parsing import parse_procedure
 from webapp.facades.serializers.base import NumberField, StrictBooleanField, WholeNumberField, title_field, viewer
@@ -16,12 +15,10 @@ from webapp.facades.services import sharing
 
 
 def procedure_data(value) -> dict:
-    """A procedure JSON validated (`parsing.parse_procedure`), as a field's value: a bad one is the field's error,
-    ``{"data": <the library's message>}``."""
-    try:
-        return parse_procedure(value).to_dict()
-    except Invalid as exc:
-        raise serializers.ValidationError({exc.field: exc.message}) from None
+    """A procedure JSON validated (`parsing.parse_procedure`), as a field's value: a bad one raises its `Invalid`,
+    which the API answers as every service's, ``{"data": <the library's message>}`` (not nested in DRF's field
+    errors as ``{"data": {"data": ...}}``)."""
+    return parse_procedure(value).to_dict()
 
 
 class ProcedureSerializer(serializers.ModelSerializer):
