@@ -13,14 +13,15 @@ from django.template import loader
 
 log = logging.getLogger(__name__)
 
-TITLES = {400: "Bad request", 403: "Not allowed", 404: "Not found", 413: "Too large", 500: "Server error",
-          503: "Try again in a moment"}
+TITLES = {400: "Bad request", 403: "Not allowed", 404: "Not found", 405: "Not this way", 413: "Too large",
+          500: "Server error", 503: "Try again in a moment"}
 # what each page says besides the error's own message; the 404 reads the same for a page that does not exist and one
 # the viewer may not see, so that it does not tell which
 TEXTS = {
     400: "The request could not be read.",
     403: "You may look at this, but only its owner may change it.",
     404: "There is nothing here, or it is not shared with you.",
+    405: "This address takes a form's button, not a link: go back and use the button.",
     500: "Something went wrong on our side. It has been logged; try again in a moment.",
 }
 # the services' errors (`webapp.facades.errors`) by kind, as the API answers them and the pages show them

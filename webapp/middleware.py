@@ -18,7 +18,7 @@ from django.contrib.auth.views import redirect_to_login
 from django.db import OperationalError
 
 from facaid.grammar.budget import WorkLimitError, work_budget
-from webapp.error_pages import error_response, service_status
+from webapp.error_pages import error_response, is_api, service_status
 from webapp.facades import throttling
 from webapp.facades.errors import NotSignedIn, ServiceError
 from webapp.facades.throttling import is_heavy
@@ -139,14 +139,19 @@ class WorkBudgetMiddleware:
 class ServiceErrorMiddleware:
     """A service's error (`webapp.facades.errors`) that a page did not catch: the error page with the status of
     its kind (`webapp.error_pages.service_status`) and its message (a 404 for an object the viewer may not see,
-    a 403 for one they may not change, a 400 for a write past the storage quota). The API answers them itself
-    (`webapp.facades.api.exception_handler`), in its JSON."""
+    a 403 for one they may not change, a 400 for a write past the storage quota; a change asked without an account
+    goes to the sign-in page). The API answers them itself (`webapp.facades.api.exception_handler`), in its JSON.
+    And a page's empty 405 (a POST-only address opened as a link) becomes the site's error page."""
 
     def __init__(self, get_response):
         self.get_response = get_response
 
     def __call__(self, request):
-        return self.get_response(request)
+        response = self.get_response(request)
+        if response.status_code == 405 and not response.content and not is_api(request):  # a POST-only page opened
+            # as a link (`require_POST` answers an empty 405): the site's page, its Allow kept
+            return error_response(request, 405, Allow=response.get("Allow", ""))
+        return response
 
     def process_exception(self, request, exception):
         if not isinstance(exception, ServiceError):

@@ -67,7 +67,8 @@ export function mountFiles(ed) {
       $("#result-link").href = `/procedures/${job.result}`;
       $("#result").hidden = false;
       const note = noFacadeNote(ed.seg);  // the elements alone, with no wall around them
-      if (note) ed.status(`Reconstructed. ${note}`);
+      // the last message (an import's, a save's) is no longer the news: say what the job made
+      ed.status(`Reconstructed: its picture is over yours; open the procedure to edit it.${note ? ` ${note}` : ""}`);
       ed.draw();
     } catch (err) {
       ed.status(`Not submitted: ${err.message}`, "error");

@@ -104,6 +104,8 @@ def test_editor_from_upload_to_downloads(live_server, alice, worker, page, tmp_p
     page.click("#submit")
     page.wait_for_selector("#result:not([hidden])", timeout=240_000)
     assert page.text_content("#job-status") == "done"
+    # the status says what the job made, not the last save's news (the smoke test of the seventh session)
+    page.wait_for_function("document.querySelector('#status').textContent.startsWith('Reconstructed: ')")
     assert "No facade is drawn" not in page.text_content("#status")  # it is: no hint to draw it
     page.click("#result-link")
     page.wait_for_url(f"{base}/procedures/*")

@@ -55,6 +55,15 @@ def test_a_missing_photo_page_is_the_styled_404(as_alice, as_charlie):
     assert "tried" not in site_page(as_charlie.get("/no/such/page"))  # the resolver's patterns are not shown
 
 
+def test_a_post_only_address_opened_as_a_link_is_the_styled_405(photo, as_alice):
+    """The smoke test of the seventh session: a GET of a form's address (`require_POST`) was an empty 405 that the
+    browser showed as its own error."""
+    r = as_alice.get(f"/photos/{photo.code}/visibility")
+    assert r.status_code == 405 and r["Allow"] == "POST"
+    html = site_page(r)
+    assert "Not this way" in html and "use the button" in html and "alice" in html
+
+
 def test_another_users_private_photo_is_the_same_404_and_a_visible_one_is_403_to_change(photo, as_alice, as_bob):
     missing = as_bob.get(f"/photos/{uuid.uuid4()}")
     for url in (f"/photos/{photo.code}", f"/photos/{photo.code}/edit"):
