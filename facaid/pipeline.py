@@ -51,6 +51,7 @@ from facaid.model import FacaidModel, load_model
 from facaid.paths import DEFAULT_CHECKPOINT
 from facaid.reading.induce import induce_procedure
 from facaid.reading.lattice import readings
+from facaid.reading.windows import pitches
 from facaid.segmentation import Segmentation, flatten, flatten_array, rasterize
 from facaid.sizing import fit_sizes, forget_tables
 from facaid.tokenizer import Tokenizer
@@ -293,12 +294,13 @@ def best_reading(flat: Segmentation):
     is two of the building's is worth an edit); a `SizingResult`, its procedure's meta naming its ``group``, or None
     where there is no lattice."""
     rows = flat.to_array()
+    pitch = pitches(rows)  # the input's, judged against each reading
     best, key = None, None
     for group, proc in readings(flat):
         fitted = fit_sizes(proc, flat)
         verdicts = list(check_edits(fitted.procedure, MORE).values())
         fitted.procedure.meta["group"] = list(group)
-        mine = reading_key(verdicts, fitted.accuracy, describes(fitted.procedure, rows)["floor_height_ok"])
+        mine = reading_key(verdicts, fitted.accuracy, describes(fitted.procedure, rows, pitch)["floor_height_ok"])
         if key is None or mine > key:
             best, key = fitted, mine
         if all(v.clean for v in verdicts):

@@ -16,13 +16,15 @@ __all__ = ["PITCH", "describes"]
 PITCH = 0.15  # floor_height within this share of the window rows' pitch
 
 
-def describes(proc: Procedure, rows: np.ndarray) -> dict:
+def describes(proc: Procedure, rows: np.ndarray,
+              pitch: tuple[float | None, float | None] | None = None) -> dict:
     """Whether the named parameters describe the building of a flattened annotation's ``rows``: ``floor_height``
     within `PITCH` of its floors' pitch (where it has at least three rows of windows: the median step from a window
     to the next one up its column, `facaid.reading.windows.window_pitch`), ``tile_width`` the same of its bays' pitch,
-    and no narrower than ``window_width`` (None where there is nothing to judge)."""
+    and no narrower than ``window_width`` (None where there is nothing to judge). ``pitch``: ``pitches(rows)``,
+    where the caller judges several procedures of the same rows."""
     names = {p.name: p.value for p in named_parameters(proc)}
-    floor, bay = pitches(rows)
+    floor, bay = pitches(rows) if pitch is None else pitch
     out = {"floor_pitch": floor, "bay_pitch": bay, "floor_height": names.get("floor_height"),
            "tile_width": names.get("tile_width"), "floor_height_ok": None, "tile_width_ok": None}
     if floor is not None and "floor_height" in names:
