@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from PIL import Image
 
-from facaid.photo.nodata import LEFT_IN, clear_of, data_edges, held, nodata_mask, off_wedges
+from facaid.photo.nodata import clear_of, data_edges, nodata_mask, off_wedges
 from facaid.photo.rectify import check_corners
 from facaid.photo.vanishing import (
     Family,
@@ -27,6 +27,7 @@ STRONG = 0.15  # a boundary line has at least this share of the strongest line's
 MIN_SPAN = 0.1  # the boundaries of a family lie at least this far apart (of the frame's extent), or they are noise
 EXTENT_WIDEN = 0.03
 MERGE_PX = 3.0  # segments whose lines lie within this many work pixels are one line
+DEEP = 0.1  # a wedge that takes this share of the proposal along cuts into the facade: the note says how much
 
 
 def _work_channels(image: Image.Image) -> list[np.ndarray]:
@@ -211,7 +212,8 @@ def propose_corners(image: Image.Image) -> dict:
     ``confidence`` is the share of the quadrilateral's four sides that detected segments cover (0 for a side that
     is the photo's edge); ``notes`` say what was guessed. No-data wedges at the photo's edges (an earlier
     rectification's pure black or white) are no facade: their borders do not vote, and the quadrilateral is moved off
-    them (`facaid.photo.nodata`). Never raises for an image PIL decoded."""
+    them (`facaid.photo.nodata`); where that leaves out a part of the facade (`DEEP`), ``"whole"`` holds the corners
+    with the wedge in, for the person to choose. Never raises for an image PIL decoded."""
     w, h = image.size
     if min(w, h) < 1:
         return _fallback(w, h, "the photo is empty")
@@ -219,20 +221,37 @@ def propose_corners(image: Image.Image) -> dict:
     gh, gw = channels[0].shape
     if min(gw, gh) < MIN_WORK_SIDE:
         return _fallback(w, h, f"the photo is too small or too narrow to find lines in ({w}x{h})")
-    nodata = nodata_mask(channels[0])
+    nodata = nodata_mask(_nearest_luma(image, (gw, gh), channels[0]))
     found = _from_lines((w, h), channels, nodata)
     if nodata.any():
         scale = np.array([w / gw, h / gh])
         pts = np.array(found["corners"]) / scale
-        cleared = clear_of(pts, nodata)
+        cleared, lost = clear_of(pts, nodata)
         if np.abs(cleared - pts).max() * scale.max() > 0.5:
+            if lost >= DEEP:  # the facade as its lines bound it, wedge and all: the person's other choice
+                found["whole"] = found["corners"]
             found["corners"] = [[round(float(x), 2), round(float(y), 2)] for x, y in cleared * scale]
-            found["notes"].append("the photo's no-data wedges at its edges (pure black, white or flat grey) are "
-                                  "left out")
-        elif held(pts, nodata) > LEFT_IN:
-            found["notes"].append("the facade runs deep into the photo's no-data wedges (pure black, white or flat "
-                                  "grey): they are left in, not to cut off a floor; drag a corner to leave them out")
+            found["notes"].append(_left_out(lost))
     return found
+
+
+def _nearest_luma(image: Image.Image, size: tuple[int, int], luma: np.ndarray) -> np.ndarray:
+    """The photo's luminance at the work ``size``, each pixel one of the photo's (not a blend): a wedge's thin black
+    sliver stays pure black, as a bilinear shrink would grey it. ``luma`` (the work luminance) where the photo's
+    mode has no plain grey level."""
+    if image.mode not in ("RGB", "RGBA", "L", "LA", "CMYK", "YCbCr"):
+        return luma
+    return np.asarray(image.resize(size, Image.Resampling.NEAREST).convert("L"))
+
+
+def _left_out(lost: float) -> str:
+    """The note on a proposal moved off the photo's no-data wedges, which says how much of the facade went with them
+    where a wedge cuts into it (``lost``: the share of the first proposal left out)."""
+    note = "the photo's no-data wedges at its edges (pure black, white or flat grey) are left out"
+    if lost >= DEEP:
+        note += (f", and {lost:.0%} of the facade's quadrilateral with them, for a wedge cuts into it: \"Take in the "
+                 "wedge\" proposes the whole facade, no data and all")
+    return note
 
 
 def _from_lines(size: tuple[int, int], channels: list[np.ndarray], nodata: np.ndarray) -> dict:

@@ -21,7 +21,6 @@ UNIFORM = 2.0  # ... and its grey levels spread by at most this (standard deviat
 AXIS_DEG = 2.0  # a segment this near horizontal or vertical along a wedge may be the facade's own line
 NEAR = 3  # work pixels: a segment whose middle lies this near a wedge is its border
 LEFT_IN = 0.002  # of the quadrilateral's area: the no data it may still hold (JPEG's ringing at the border)
-KEEP = 0.9  # a wedge deep in the facade, to clear which would leave less of the quadrilateral, stays in it
 GRID = 200  # cells a side of the facade's plane that the proposal is cleared on
 
 
@@ -74,18 +73,19 @@ def held(pts: np.ndarray, mask: np.ndarray) -> float:
     return float((inside.astype(bool) & mask).sum() / area) if area else 0.0
 
 
-def clear_of(pts: np.ndarray, mask: np.ndarray) -> np.ndarray:
+def clear_of(pts: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, float]:
     """The quadrilateral ``pts`` (TL, TR, BR, BL, in the mask's pixels) moved off the no data, as a rectangle of the
-    facade's own plane: in the frame where ``pts`` is the unit square (`GRID` cells a side), the side whose next
-    `GRID`-th in takes out the most no data for what it gives up moves in, until at most `LEFT_IN` of the rest is no
-    data. So a thin wedge along the top takes the top down by its own height, and the proposal stays the facade's
-    rectangle: rectified from it, the facade is only cropped, never skewed. A wedge deep in the facade, which would
-    leave less than `KEEP` of it, stays in it (the caller says so): a floor cut off costs more than a black corner."""
+    facade's own plane: in the frame where ``pts`` is the unit square (`GRID` cells a side), the largest rectangle
+    of cells that holds none (`largest_clear`). So a thin wedge along the top takes the top down by its own height,
+    a wedge at a corner takes in whichever of its two sides leaves more, and the proposal stays the facade's
+    rectangle: rectified from it, the facade is only cropped, never skewed. With the share of ``pts`` that the
+    rectangle leaves out (0 where it holds no data): the caller says how much, for a wedge deep in the facade takes a
+    part of it along."""
     import cv2
 
     pts = pts.astype(np.float32)
     if not mask.any():
-        return pts.astype(float)
+        return pts.astype(float), 0.0
     square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32)
     to_photo = cv2.getPerspectiveTransform(square, pts)
     centres = (np.arange(GRID, dtype=np.float32) + 0.5) / GRID
@@ -94,17 +94,47 @@ def clear_of(pts: np.ndarray, mask: np.ndarray) -> np.ndarray:
     h, w = mask.shape
     bad = mask[np.clip(where[..., 1].round().astype(int), 0, h - 1), np.clip(where[..., 0].round().astype(int), 0,
                                                                               w - 1)]
-    top, bottom, left, right = 0, GRID, 0, GRID
-    while bad[top:bottom, left:right].sum() > LEFT_IN * (bottom - top) * (right - left):
-        if (bottom - top) * (right - left) < KEEP * GRID * GRID:
-            return pts.astype(float)  # a wedge deep in the facade: the facade stays whole, the wedge in it
+    if bad.sum() <= LEFT_IN * GRID * GRID:
+        return pts.astype(float), 0.0
+    top, bottom, left, right = max(largest_clear(bad), _shrunk(bad), key=lambda r: (r[1] - r[0]) * (r[3] - r[2]))
+    rect = np.array([[left, top], [right, top], [right, bottom], [left, bottom]], np.float32) / GRID
+    lost = 1.0 - (bottom - top) * (right - left) / (GRID * GRID)
+    return cv2.perspectiveTransform(rect.reshape(-1, 1, 2), to_photo).reshape(4, 2).astype(float), lost
+
+
+def _shrunk(bad: np.ndarray) -> tuple[int, int, int, int]:
+    """(top, bottom, left, right): ``bad``'s grid with a side at a time moved in, the one whose next line is the most
+    bad, until at most `LEFT_IN` of the rest is (a sliver of JPEG's ringing along a side costs no strip of the
+    facade, as the exact `largest_clear` would make it)."""
+    top, bottom, left, right = 0, bad.shape[0], 0, bad.shape[1]
+    while bottom - top > 1 and right - left > 1 and bad[top:bottom, left:right].sum() > LEFT_IN * (bottom - top) * (
+            right - left):
         cut = {"top": bad[top, left:right].mean(), "bottom": bad[bottom - 1, left:right].mean(),
                "left": bad[top:bottom, left].mean(), "right": bad[top:bottom, right - 1].mean()}
         side = max(cut, key=cut.get)
         top, bottom = top + (side == "top"), bottom - (side == "bottom")
         left, right = left + (side == "left"), right - (side == "right")
-    rect = np.array([[left, top], [right, top], [right, bottom], [left, bottom]], np.float32) / GRID
-    return cv2.perspectiveTransform(rect.reshape(-1, 1, 2), to_photo).reshape(4, 2).astype(float)
+    return top, bottom, left, right
+
+
+def largest_clear(bad: np.ndarray) -> tuple[int, int, int, int]:
+    """(top, bottom, left, right), ends exclusive: the rectangle of the most cells of ``bad`` (a boolean grid)
+    that are all False, by the largest rectangle under each row's histogram of clear cells above it (a stack of
+    rising bars); the whole grid's top row where every cell is bad."""
+    rows, cols = bad.shape
+    above = np.zeros(cols + 1, dtype=int)  # clear cells in a run ending at this row; a sentinel 0 at the end
+    best, out = 0, (0, 1, 0, cols)
+    for r in range(rows):
+        above[:cols] = np.where(bad[r], 0, above[:cols] + 1)
+        stack: list[int] = []
+        for c in range(cols + 1):
+            while stack and above[stack[-1]] >= above[c]:
+                height = int(above[stack.pop()])
+                start = stack[-1] + 1 if stack else 0
+                if height * (c - start) > best:
+                    best, out = height * (c - start), (r + 1 - height, r + 1, start, c)
+            stack.append(c)
+    return out
 
 
 def data_edges(nodata: np.ndarray, box) -> tuple[float, float, float, float]:
@@ -127,4 +157,4 @@ def _grown(mask: np.ndarray, by: int) -> np.ndarray:
     return cv2.dilate(mask.astype(np.uint8), np.ones((2 * by + 1, 2 * by + 1), np.uint8)) > 0
 
 
-__all__ = ["clear_of", "data_edges", "held", "nodata_mask", "off_wedges"]
+__all__ = ["clear_of", "data_edges", "held", "largest_clear", "nodata_mask", "off_wedges"]

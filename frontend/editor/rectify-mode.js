@@ -66,12 +66,15 @@ export class RectifyMode {
   }
 
   /** Ask the server for the facade's corners (`POST photos/<code>/corners/propose`) and place the handles there;
-   * `say(text)` tells the user how sure the proposal is and what it guessed. */
-  async propose(api, code, say) {
+   * `say(text)` tells the user how sure the proposal is and what it guessed; `offer(whole, corners)` is given the
+   * proposal's other choice where a no-data wedge cuts into the facade (the corners with the wedge in), else null. */
+  async propose(api, code, say, offer = () => {}) {
     say("Looking for the facade's lines…");
+    offer(null);
     try {
       const found = await api(`/api/v1/photos/${code}/corners/propose`, {method: "POST"});
       if (!this.setCorners(found.corners)) return say("The proposal was not a quadrilateral; drag the corners.");
+      offer(found.whole || null, found.corners);
       const notes = found.notes.length ? ` (${found.notes.join("; ")})` : "";
       say(`Corners proposed, ${Math.round(100 * found.confidence)} % of their sides on lines found${notes}. ` +
         "Drag them to adjust.");
@@ -135,7 +138,25 @@ export async function openRectifyMode(canvas, preview, info) {
     const api = makeApi(document.querySelector("meta[name=csrf-token]").content);
     const say = (text) => { if (note) note.textContent = text; };
     say("");
-    button.onclick = () => mode.propose(api, info.code, say);  // one handler, for the mode open now
+    button.onclick = () => mode.propose(api, info.code, say, wedgeChoice(mode));  // one handler, for the mode open now
   }
   return mode;
+}
+
+/** The "Take in the wedge" button's offer: shown where the proposal left out a part of the facade with a no-data
+ * wedge, it swaps between the corners with the wedge in (`whole`) and the proposal's. */
+function wedgeChoice(mode) {
+  const button = document.getElementById("rectify-whole");
+  return (whole, cleared) => {
+    if (!button) return;
+    button.hidden = !whole;
+    if (!whole) return;
+    let taken = false;
+    button.textContent = "Take in the wedge";
+    button.onclick = () => {
+      taken = !taken;
+      mode.setCorners(taken ? whole : cleared);
+      button.textContent = taken ? "Leave the wedge out" : "Take in the wedge";
+    };
+  };
 }

@@ -8,7 +8,7 @@ from PIL import Image, ImageDraw
 
 from facaid.generator import generate
 from facaid.photo.corners import propose_corners
-from facaid.photo.nodata import clear_of, data_edges, held, nodata_mask
+from facaid.photo.nodata import clear_of, data_edges, held, largest_clear, nodata_mask
 from facaid.photo.photolike import facade_box, render_photo
 
 
@@ -52,41 +52,54 @@ def test_wedges_are_found_but_not_a_dark_window_or_a_bright_sky():
     assert not mask[sky].any()
 
 
-def test_a_wedge_deep_in_the_facade_stays_in_it_rather_than_a_floor_cut_off():
+def test_a_wedge_deep_in_the_facade_is_left_out_with_the_part_it_cuts_off_said():
+    """No data is never inside a proposal (issue 68, item 4): a wedge that cuts deep into the facade takes the side
+    that loses less with it, and the share it took is returned for the note."""
     mask = _quad_mask([(0, 0), (300, 0), (0, 200)], (400, 300))
     pts = np.array([[10.0, 10.0], [390.0, 10.0], [390.0, 290.0], [10.0, 290.0]])
-    assert np.allclose(clear_of(pts, mask), pts)
+    cleared, lost = clear_of(pts, mask)
+    assert held(cleared, mask) <= 0.002
+    kept = _quad_mask(cleared, (400, 300)).sum() / _quad_mask(pts, (400, 300)).sum()
+    assert 0.4 < kept < 0.9 and abs((1 - lost) - kept) < 0.03, (kept, lost)
 
 
 def test_clear_of_takes_the_quadrilateral_off_a_corner_wedge_and_keeps_the_rest():
     mask = _quad_mask([(0, 0), (150, 0), (0, 40)], (400, 300))  # a thin wedge along the top-left
     pts = np.array([[10.0, 10.0], [390.0, 10.0], [390.0, 290.0], [10.0, 290.0]])
     assert held(pts, mask) > 0.01
-    cleared = clear_of(pts, mask)
+    cleared, lost = clear_of(pts, mask)
     assert held(cleared, mask) <= 0.002
     kept = _quad_mask(cleared, (400, 300)).sum() / _quad_mask(pts, (400, 300)).sum()
-    assert kept > 0.9, kept  # the side tilts to the wedge's border: the far corners stay where they were
-    assert np.allclose(cleared[2], pts[2]) and np.allclose(cleared[3], pts[3])
+    assert kept > 0.85 and lost < 0.15, kept  # the top comes down by the wedge's height: the bottom stays
+    assert np.allclose(cleared[2:], pts[2:], atol=3)  # within a cell or two of where they were
+    assert np.allclose(clear_of(pts, np.zeros_like(mask))[0], pts)  # no wedge: nothing moves
+
+
+def test_thelargest_clear_rectangle_is_found_exactly():
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        bad = rng.random((9, 11)) < 0.25
+        top, bottom, left, right = largest_clear(bad)
+        assert not bad[top:bottom, left:right].any()
+        best = max((b - t) * (r - l) for t in range(9) for b in range(t + 1, 10) for l in range(11)
+                   for r in range(l + 1, 12) if not bad[t:b, l:r].any())
+        assert (bottom - top) * (right - left) == best
 
 
 def test_the_proposal_on_a_photo_with_wedges_holds_none_or_says_so_and_finds_the_facade():
-    ious, cleared = [], 0
+    ious, deep = [], 0
     for seed in range(12):
         photo, wedges, box = _wedged(seed)
         found = propose_corners(photo)
         inside = _quad_mask(found["corners"], photo.size)
-        if (inside & wedges).sum() <= 0.005 * inside.sum():
-            cleared += 1
-            assert any("are left out" in note for note in found["notes"]), found["notes"]
-        else:  # a wedge deep in the facade stays, and the note says so
-            assert any("are left in" in note for note in found["notes"]), found["notes"]
+        held_share = (inside & wedges).sum() / inside.sum()
+        assert held_share <= 0.005, (seed, held_share)  # never inside a proposal
+        assert any("are left out" in note for note in found["notes"]), found["notes"]
+        deep += any("of the facade's quadrilateral with them" in note for note in found["notes"])
         truth = _quad_mask([(box[0], box[1]), (box[2], box[1]), (box[2], box[3]), (box[0], box[3])], photo.size)
         data = ~wedges
         ious.append((inside & truth & data).sum() / ((inside | truth) & data).sum())
-    # measured: 10 of 12 cleared to 0.2 % no data (seeds 1 and 2 keep 2.7 and 4 %: clearing would cut off more
-    # than a tenth); IoU over the data median 0.94 (0.77 to 0.99). Without `facaid.photo.nodata`, 10 of the 12 held
-    # 0.8 to 4 % no data, IoU median 0.94
-    assert cleared >= 10, cleared
+    print(deep, sorted(round(float(x), 3) for x in ious))
     assert np.median(ious) >= 0.9 and min(ious) >= 0.75, ious
 
 

@@ -121,3 +121,51 @@ def test_at_1280x800_the_rectification_step_keeps_its_size_field_and_apply_in_vi
     page.wait_for_function(f"{E}?.seg !== null && {E}?.seg !== undefined")
     assert not page.text_content("#status").startswith("Rectified:")
     assert page.errors == []
+
+
+def test_a_wedge_cutting_into_the_facade_is_left_out_and_one_click_takes_it_in(live_server, as_alice, browser,
+                                                                                 tmp_path):
+    """Issue 68, item 4: no data is never inside the proposal; where the wedge cuts into the facade, the note says how
+    much went with it and "Take in the wedge" swaps to the whole facade and back."""
+    import io
+
+    from PIL import Image, ImageDraw
+    from site_helpers import screenshot
+
+    data, true = photo_like()
+    image = Image.open(io.BytesIO(data)).convert("RGB")
+    w, h = image.size
+    wedge = [(0.25 * w, 0), (w, 0), (w, 0.75 * h)]  # an earlier rectification's black corner, deep in the facade
+    ImageDraw.Draw(image).polygon(wedge, fill=(0, 0, 0))
+    out = io.BytesIO()
+    image.save(out, "PNG")
+    photo = upload(as_alice, out.getvalue(), title="Wedged").json()
+    page, _ = open_page(live_server, browser, photo["code"], f"{E}?.seg !== null && {E}?.seg !== undefined",
+                        viewport=(1280, 800))
+    page.click("#rectify")
+    page.wait_for_function(f"{E}.rectifying")
+    assert page.is_hidden("#rectify-whole")
+    page.click("#rectify-propose")
+    page.wait_for_function("document.querySelector('#rectify-note').textContent.startsWith('Corners proposed')")
+    note = page.text_content("#rectify-note")
+    assert "of the facade's quadrilateral with them" in note and "Take in the wedge" in note, note
+    cleared = np.array(page.evaluate(f"{E}.rectifying.corners"))
+    inside = Image.new("1", (w, h))
+    ImageDraw.Draw(inside).polygon([tuple(p) for p in cleared], fill=1)
+    black = Image.new("1", (w, h))
+    ImageDraw.Draw(black).polygon(wedge, fill=1)
+    inside, black = np.asarray(inside, dtype=bool), np.asarray(black, dtype=bool)
+    assert (inside & black).sum() <= 0.005 * inside.sum()  # no data inside the proposal
+    assert page.is_visible("#rectify-whole")
+    screenshot(page, "rectify-wedge-left-out.png", tmp_path)
+
+    page.click("#rectify-whole")  # the whole facade, wedge and all, where its lines bound it
+    whole = np.array(page.evaluate(f"{E}.rectifying.corners"))
+    diag = np.hypot(*(true.max(axis=0) - true.min(axis=0)))
+    assert np.linalg.norm(whole - true, axis=1).max() < 0.01 * diag, whole
+    assert page.text_content("#rectify-whole") == "Leave the wedge out"
+    screenshot(page, "rectify-wedge-taken-in.png", tmp_path)
+    page.click("#rectify-whole")
+    assert np.allclose(page.evaluate(f"{E}.rectifying.corners"), cleared)
+    assert page.text_content("#rectify-whole") == "Take in the wedge"
+    assert page.errors == []
