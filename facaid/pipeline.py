@@ -288,11 +288,11 @@ def _chosen(result: Reconstruction, flat: Segmentation, opts: ReconstructOptions
 def best_reading(flat: Segmentation):
     """Of the lattice readings of a flattened segmentation (`facaid.reading.lattice.readings`), sized, the first
     whose `floors` + 1 and `bays` + 1 are clean (`facaid.editing.check`: the grid as read is tried first, the others
-    only where its edits fail), else the best by `reading_key`: the most clean edits and a floor height that is the
-    floors' pitch (`facaid.editing.describes`), then the most accurate (a reading of floors two by two whose edits
-    both fail is no better for being a little more accurate than the grid whose new floor is clean; one whose floor
-    is two of the building's is worth an edit); a `SizingResult`, its procedure's meta naming its ``group``, or None
-    where there is no lattice."""
+    only where its edits fail) and whose floor height is not off the floors' pitch, else the best by `reading_key`:
+    the most clean edits and a floor height that is the floors' pitch (`facaid.editing.describes`), then the most
+    accurate (a reading of floors two by two whose edits both fail is no better for being a little more accurate
+    than the grid whose new floor is clean; one whose floor is two of the building's is worth an edit); a
+    `SizingResult`, its procedure's meta naming its ``group``, or None where there is no lattice."""
     rows = flat.to_array()
     pitch = pitches(rows)  # the input's, judged against each reading
     best, key = None, None
@@ -300,10 +300,11 @@ def best_reading(flat: Segmentation):
         fitted = fit_sizes(proc, flat)
         verdicts = list(check_edits(fitted.procedure, MORE).values())
         fitted.procedure.meta["group"] = list(group)
-        mine = reading_key(verdicts, fitted.accuracy, describes(fitted.procedure, rows, pitch)["floor_height_ok"])
+        floor_pitch = describes(fitted.procedure, rows, pitch)["floor_height_ok"]
+        mine = reading_key(verdicts, fitted.accuracy, floor_pitch)
         if key is None or mine > key:
             best, key = fitted, mine
-        if all(v.clean for v in verdicts):
+        if all(v.clean for v in verdicts) and floor_pitch is not False:
             break
     return best
 

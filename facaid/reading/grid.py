@@ -56,20 +56,38 @@ def _cut(profile: np.ndarray, lo: int, hi: int, near: float | None = None) -> in
     return lo + int(run[len(run) // 2])
 
 
-def _edges(profile: np.ndarray, starts: np.ndarray, ends: np.ndarray, limit: int) -> list[int]:
+def _edges(profile: np.ndarray, starts: np.ndarray, ends: np.ndarray, limit: int, pitch: bool = False) -> list[int]:
     """The cuts around bands that start at ``starts`` and end at ``ends`` (sorted): one between each two, each as
     near its band's start less the typical distance of the cuts from their bands as the wall allows (`ALIGN`:
     floors and tiles cut at one offset from their windows are as long as the windows' pitch), and an outer one on
-    each side at that distance."""
+    each side at that distance. With ``pitch`` (the floors), every cut is at one offset before its band (`_offset`)
+    wherever the gap is that long, whatever it crosses: a floor is as high as from its windows to the next row's,
+    as a person measures it, and a balcony or cornice the cut crosses is in every floor alike."""
     inner = [_cut(profile, int(e), int(s)) for e, s in zip(ends[:-1], starts[1:], strict=True)]
     before = np.median([s - c for s, c in zip(starts[1:], inner, strict=True)])
-    if ALIGN:
+    if pitch and inner:
+        d = _offset(profile, starts, ends, before)
+        inner = [int(s - d) if e <= s - d else c for e, s, c in zip(ends[:-1], starts[1:], inner, strict=True)]
+        before = np.median([s - c for s, c in zip(starts[1:], inner, strict=True)])
+    elif ALIGN:
         inner = [_cut(profile, int(e), int(s), s - before) for e, s in zip(ends[:-1], starts[1:], strict=True)]
         before = np.median([s - c for s, c in zip(starts[1:], inner, strict=True)])
     after = np.median([c - e for e, c in zip(ends[:-1], inner, strict=True)])
     first = int(np.clip(round(starts[0] - before), 0, starts[0]))
     last = int(np.clip(round(ends[-1] + after), ends[-1], limit))
     return [first, *inner, last]
+
+
+def _offset(profile: np.ndarray, starts: np.ndarray, ends: np.ndarray, before: float) -> int:
+    """The one distance before each band to cut at: the one whose cuts (in the gaps at least that long) cross the
+    most wall in all, the nearest ``before`` (the free cuts' median) of equals."""
+    s, e = starts[1:].astype(int), ends[:-1]
+    offsets = np.arange(0, max(0, int((starts[1:] - e).max())) + 1)
+    at = s[None, :] - offsets[:, None]
+    fits = (at >= e[None, :]) & (at >= 0)
+    wall = np.where(fits, profile[np.clip(at, 0, len(profile) - 1)], 0.0).sum(axis=1)
+    best = np.flatnonzero(wall >= wall.max() - 1e-6)
+    return int(best[np.argmin(np.abs(best - before))])
 
 
 def footprint(label_map: np.ndarray) -> tuple[int, int]:
@@ -123,9 +141,10 @@ class Grid:
         return np.diff(self.xs).astype(float)
 
 
-def read_grid(label_map: np.ndarray, windows: np.ndarray) -> Grid | None:
-    """The floors and tiles of the windows' rows and columns, or None where
-    there are fewer than two of either."""
+def read_grid(label_map: np.ndarray, windows: np.ndarray, pitch: bool = True) -> Grid | None:
+    """The floors and tiles of the windows' rows and columns, or None where there are fewer than two of either.
+    ``pitch``: the floors cut at one offset from their windows (`_edges`), the ground floor's top where the wall is;
+    else each cut where the wall is, moved to the offset only where the wall allows (`ALIGN`)."""
     height, width = label_map.shape
     if len(windows) < 4:
         return None
@@ -135,11 +154,14 @@ def read_grid(label_map: np.ndarray, windows: np.ndarray) -> Grid | None:
     wall = label_map == FACADE
     tops = np.array([np.median(windows[r, 1]) for r in rows])
     bottoms = np.array([np.median(windows[r, 3]) for r in rows])
-    ys = _edges(wall.mean(axis=1), tops, bottoms, height)
+    ys = _edges(wall.mean(axis=1), tops, bottoms, height, pitch=pitch)
     if any(b <= a for a, b in zip(ys[:-1], ys[1:], strict=True)):
         return None
     n_rows = len(rows) - _ground_rows(label_map, ys)
     ys = ys[: n_rows + 1]
+    if pitch and n_rows < len(rows):  # the ground floor's top is where the wall is, not at the floors' offset:
+        free = _edges(wall.mean(axis=1), tops, bottoms, height)[n_rows]  # its doors and shops are its own
+        ys[-1] = free if free > ys[-2] else ys[-1]
     row_of = np.concatenate([np.full(len(r), i) for i, r in enumerate(rows[:n_rows])])
     upper = windows[np.concatenate(rows[:n_rows])]
     cols = window_bands(upper[:, 0], upper[:, 2])

@@ -10,10 +10,12 @@ Müller et al. 2007, Riemenschneider et al. 2012 and Zhang et al. 2013), in thre
    leaves uncovered (`facaid.reading.windows.whole_windows`); their rows and columns (`window_bands`: bands of
    centres split where the gap is over half the median window height, width; bands whose extents overlap are one;
    a column needs windows in `COLUMN_SUPPORT` of the floors). Floors: horizontal bands that each hold one row of
-   windows with its companions, cut between two rows where the label map is most wall, at one offset from their
-   windows where the wall allows (`ALIGN`: floors as high as the windows' pitch); the last rows whose bands hold
-   doors or shops are the ground floor. Tiles: the columns within the floors, cut the same way; the side margins;
-   the attic above.
+   windows with its companions, cut at one offset above their windows, the one whose cuts cross the most wall in
+   all, whatever a cut crosses (floors as high as from a row of windows to the next, as a person measures them);
+   the last rows whose bands hold doors or shops are the ground floor, its top where the wall is. A second reading
+   cuts each floor where the label map is most wall, at the one offset only where the wall allows (`ALIGN`): a cut
+   at the pitch may cross a balcony, and its new bay is then like no bay. Tiles: the columns within the floors,
+   cut the second way; the side margins; the attic above.
 2. **The typical floor and bay** (`read_floors`). The typical floor is a real one, the medoid of the floors; the
    typical bay the medoid column; the typical tile is where they cross (`facaid.reading.units`). The typical floor
    is that floor as it is: a row of typical tiles with its own cells' deltas, so that a new floor is a copy of it.
@@ -60,13 +62,18 @@ def read_lattice(seg: Segmentation, group: tuple[int, int] = (1, 1)) -> Procedur
 def readings(seg: Segmentation) -> Iterator[tuple[tuple[int, int], Procedure]]:
     """The candidate readings of a segmentation, each with its ``group``: the grid as read, and where they fit it,
     its floors read two by two (a floor with a mezzanine: two rows of windows) and its columns two by two (a bay of
-    a pair of windows). The pipeline keeps the most accurate one whose edits pass."""
+    a pair of windows); each with its floors cut at their windows' pitch first, then (where they differ) where the
+    wall is (`facaid.reading.grid.read_grid`): a cut at the pitch may cross a balcony whose new bay is then like no
+    bay. The pipeline keeps the first whose edits pass and whose floor is the pitch, else the best of them."""
     flat = flatten(seg)
     label_map = rasterize(flat)
-    grid = _grid(flat, label_map)
+    grids = [_grid(flat, label_map, pitch) for pitch in (True, False)]
     for group in GROUPS:
-        g = grouped(grid, group)
-        if g is not None:
+        seen = []
+        for g in (grouped(grid, group) for grid in grids):
+            if g is None or any(g.ys == other.ys and g.xs == other.xs for other in seen):
+                continue
+            seen.append(g)
             proc = Procedure(label_map.shape[1], label_map.shape[0], read_floors(g), {"source": SOURCE})
             try:
                 yield group, Procedure.from_dict(proc.to_dict())
@@ -89,12 +96,13 @@ def grouped(grid: Grid | None, group: tuple[int, int]) -> Grid | None:
     return Grid(grid.label_map, grid.ys[::gy], grid.xs[::gx])
 
 
-def _grid(flat: Segmentation, label_map: np.ndarray) -> Grid | None:
-    """The grid of a flattened segmentation: its windows, but strips, within the main building's footprint."""
+def _grid(flat: Segmentation, label_map: np.ndarray, pitch: bool = True) -> Grid | None:
+    """The grid of a flattened segmentation: its windows, but strips, within the main building's footprint
+    (``pitch``: how the floors are cut, `facaid.reading.grid.read_grid`)."""
     fx0, fx1 = footprint(label_map)
     windows = whole_windows(region_boxes(flat.to_array(), GLASS))  # a strip of a window is no window of the lattice
     centres = (windows[:, 0] + windows[:, 2]) / 2
-    return read_grid(label_map, windows[(centres >= fx0) & (centres < fx1)])
+    return read_grid(label_map, windows[(centres >= fx0) & (centres < fx1)], pitch)
 
 
 __all__ = ["GROUPS", "grouped", "read_lattice", "readings"]
