@@ -154,13 +154,14 @@ def read_grid(label_map: np.ndarray, windows: np.ndarray, pitch: bool = True) ->
     wall = label_map == FACADE
     tops = np.array([np.median(windows[r, 1]) for r in rows])
     bottoms = np.array([np.median(windows[r, 3]) for r in rows])
-    ys = _edges(wall.mean(axis=1), tops, bottoms, height, pitch=pitch)
+    profile = wall.mean(axis=1)
+    ys = _edges(profile, tops, bottoms, height, pitch=pitch)
     if any(b <= a for a, b in zip(ys[:-1], ys[1:], strict=True)):
         return None
     n_rows = len(rows) - _ground_rows(label_map, ys)
     ys = ys[: n_rows + 1]
     if pitch and n_rows < len(rows):  # the ground floor's top is where the wall is, not at the floors' offset:
-        free = _edges(wall.mean(axis=1), tops, bottoms, height)[n_rows]  # its doors and shops are its own
+        free = _edges(profile, tops, bottoms, height)[n_rows]  # its doors and shops are its own
         ys[-1] = free if free > ys[-2] else ys[-1]
     row_of = np.concatenate([np.full(len(r), i) for i, r in enumerate(rows[:n_rows])])
     upper = windows[np.concatenate(rows[:n_rows])]

@@ -67,7 +67,8 @@ def readings(seg: Segmentation) -> Iterator[tuple[tuple[int, int], Procedure]]:
     bay. The pipeline keeps the first whose edits pass and whose floor is the pitch, else the best of them."""
     flat = flatten(seg)
     label_map = rasterize(flat)
-    grids = [_grid(flat, label_map, pitch) for pitch in (True, False)]
+    windows = _windows(flat, label_map)
+    grids = [read_grid(label_map, windows, pitch) for pitch in (True, False)]
     for group in GROUPS:
         seen = []
         for g in (grouped(grid, group) for grid in grids):
@@ -97,12 +98,17 @@ def grouped(grid: Grid | None, group: tuple[int, int]) -> Grid | None:
 
 
 def _grid(flat: Segmentation, label_map: np.ndarray, pitch: bool = True) -> Grid | None:
-    """The grid of a flattened segmentation: its windows, but strips, within the main building's footprint
-    (``pitch``: how the floors are cut, `facaid.reading.grid.read_grid`)."""
+    """The grid of a flattened segmentation's windows (`_windows`; ``pitch``: how the floors are cut,
+    `facaid.reading.grid.read_grid`)."""
+    return read_grid(label_map, _windows(flat, label_map), pitch)
+
+
+def _windows(flat: Segmentation, label_map: np.ndarray) -> np.ndarray:
+    """The windows of a flattened segmentation, but strips, within the main building's footprint."""
     fx0, fx1 = footprint(label_map)
     windows = whole_windows(region_boxes(flat.to_array(), GLASS))  # a strip of a window is no window of the lattice
     centres = (windows[:, 0] + windows[:, 2]) / 2
-    return read_grid(label_map, windows[(centres >= fx0) & (centres < fx1)], pitch)
+    return windows[(centres >= fx0) & (centres < fx1)]
 
 
 __all__ = ["GROUPS", "grouped", "read_lattice", "readings"]

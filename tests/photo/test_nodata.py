@@ -75,7 +75,7 @@ def test_clear_of_takes_the_quadrilateral_off_a_corner_wedge_and_keeps_the_rest(
     assert np.allclose(clear_of(pts, np.zeros_like(mask))[0], pts)  # no wedge: nothing moves
 
 
-def test_thelargest_clear_rectangle_is_found_exactly():
+def test_the_largest_clear_rectangle_is_found_exactly():
     rng = np.random.default_rng(3)
     for _ in range(20):
         bad = rng.random((9, 11)) < 0.25
@@ -99,7 +99,10 @@ def test_the_proposal_on_a_photo_with_wedges_holds_none_or_says_so_and_finds_the
         truth = _quad_mask([(box[0], box[1]), (box[2], box[1]), (box[2], box[3]), (box[0], box[3])], photo.size)
         data = ~wedges
         ious.append((inside & truth & data).sum() / ((inside | truth) & data).sum())
-    print(deep, sorted(round(float(x), 3) for x in ious))
+    # measured: every proposal clear of the wedges, 5 of 12 cut deep enough for the note to say how much went (a
+    # tenth of the quadrilateral or more); IoU over the data median 0.90 (0.78 to 0.95). Before no data was never
+    # inside, 10 of 12 were cleared and the other two kept 2.7 and 4 % no data, IoU median 0.94
+    assert deep >= 1, deep
     assert np.median(ious) >= 0.9 and min(ious) >= 0.75, ious
 
 
